@@ -1,0 +1,80 @@
+#pragma once
+// The FOT (Everett) function F(α,β) on a grid, read by the paper's rectangle/triangle
+// interpolation (Eqs. 8 and 9). Values are F(δ_i, δ_j) for 0 <= j <= i <= n.
+#include <array>
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "hystlab/models/grid.hpp"
+
+namespace hystlab::models {
+
+// Up to four node indices and weights whose weighted sum is F at a point.
+struct InterpolationStencil {
+  std::array<std::size_t, 4> node{};
+  std::array<double, 4> weight{};
+  int size = 0;
+};
+
+class EverettTable {
+ public:
+  EverettTable() : EverettTable(Grid{}) {}
+  // All nodes zero.
+  explicit EverettTable(Grid grid);
+  // Throws std::invalid_argument when values has the wrong size, holds a non-finite value,
+  // or a diagonal value F(δ_i, δ_i) is not zero.
+  EverettTable(Grid grid, std::vector<double> values, double force_offset = 0.0);
+
+  [[nodiscard]] const Grid& grid() const noexcept { return grid_; }
+  [[nodiscard]] std::span<const double> values() const noexcept { return values_; }
+  [[nodiscard]] double node_value(int i, int j) const noexcept { return values_[Grid::index(i, j)]; }
+  // Force at δmin added to the Preisach sum (zero when identified from rest at δmin).
+  [[nodiscard]] double force_offset() const noexcept { return force_offset_; }
+
+  // F(a, b) with a, b clamped to the grid and b clamped to <= a. Continuous.
+  [[nodiscard]] double value(double a, double b) const noexcept {
+    double s = 0.0, t = 0.0;
+    int i = 0, j = 0;
+    locate(a, b, i, j, s, t);
+    const double* v = values_.data();
+    if (j < i) {  // rectangle, Eq. 8: bilinear in the four corners
+      const std::size_t r1 = Grid::index(i - 1, 0), r2 = Grid::index(i, 0);
+      const double f00 = v[r1 + static_cast<std::size_t>(j - 1)], f01 = v[r1 + static_cast<std::size_t>(j)];
+      const double f10 = v[r2 + static_cast<std::size_t>(j - 1)], f11 = v[r2 + static_cast<std::size_t>(j)];
+      return (1.0 - s) * ((1.0 - t) * f00 + t * f01) + s * ((1.0 - t) * f10 + t * f11);
+    }
+    // triangle on the diagonal, Eq. 9: linear through (δ_{i-1},δ_{i-1}), (δ_i,δ_{i-1}), (δ_i,δ_i)
+    const double f1 = v[Grid::index(i - 1, i - 1)], f2 = v[Grid::index(i, i - 1)], f3 = v[Grid::index(i, i)];
+    return f1 + (f2 - f1) * s + (f3 - f2) * t;
+  }
+
+  // The same interpolation as value(), as weights on nodes (for linear identification).
+  [[nodiscard]] InterpolationStencil stencil(double a, double b) const noexcept;
+
+ private:
+  void locate(double a, double b, int& i, int& j, double& s, double& t) const noexcept {
+    const double lo = grid_.lo, hi = grid_.hi;
+    a = a < lo ? lo : (a > hi ? hi : a);
+    b = b < lo ? lo : (b > a ? a : b);
+    const double u = (a - lo) * inv_step_, w = (b - lo) * inv_step_;
+    i = static_cast<int>(u);
+    if (static_cast<double>(i) < u || i == 0) ++i;  // ceil, at least 1
+    if (i > grid_.n) i = grid_.n;
+    j = static_cast<int>(w);
+    if (static_cast<double>(j) < w || j == 0) ++j;
+    if (j > i) j = i;
+    s = u - static_cast<double>(i - 1);
+    t = w - static_cast<double>(j - 1);
+    s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    if (j == i && t > s) t = s;
+  }
+
+  Grid grid_;
+  double inv_step_ = 1.0;
+  std::vector<double> values_;
+  double force_offset_ = 0.0;
+};
+
+}  // namespace hystlab::models
