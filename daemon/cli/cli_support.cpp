@@ -1,0 +1,247 @@
+#include "cli_support.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/preisach_model.hpp"
+#include "hystlab/models/simplified_sma.hpp"
+
+namespace hystlab::cli {
+
+Options::Options(const std::vector<std::string>& args, const std::set<std::string>& with_value,
+                 const std::set<std::string>& flags) {
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    std::string a = args[k];
+    if (a == "-o") a = "--output";
+    if (a.rfind("--", 0) != 0) throw CliError("unexpected argument '" + a + "' (see --help)");
+    std::string name = a.substr(2), value;
+    const auto eq = name.find('=');
+    const bool inline_value = eq != std::string::npos;
+    if (inline_value) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    }
+    if (flags.count(name)) {
+      if (inline_value) throw CliError("option --" + name + " takes no value");
+      values_[name] = "1";
+    } else if (with_value.count(name)) {
+      if (!inline_value) {
+        if (k + 1 >= args.size()) throw CliError("option --" + name + " needs a value");
+        value = args[++k];
+      }
+      values_[name] = value;
+    } else {
+      throw CliError("unknown option --" + name + " (see --help)");
+    }
+  }
+}
+
+std::string Options::get(const std::string& name, const std::string& fallback) const {
+  const auto it = values_.find(name);
+  return it == values_.end() ? fallback : it->second;
+}
+
+std::string Options::require(const std::string& name) const {
+  const auto it = values_.find(name);
+  if (it == values_.end() || it->second.empty()) throw CliError("missing required option --" + name);
+  return it->second;
+}
+
+namespace {
+double parse_double(const std::string& s, const std::string& what) {
+  const char* b = s.data();
+  const char* e = b + s.size();
+  while (b < e && (*b == ' ' || *b == '\t')) ++b;
+  while (e > b && (e[-1] == ' ' || e[-1] == '\t' || e[-1] == '\r')) --e;
+  if (b < e && *b == '+') ++b;
+  double v = 0.0;
+  const auto r = std::from_chars(b, e, v);
+  if (b == e || r.ec != std::errc() || r.ptr != e) throw CliError(what + ": '" + s + "' is not a number");
+  if (!std::isfinite(v)) throw CliError(what + ": '" + s + "' is not a finite number");
+  return v;
+}
+}  // namespace
+
+double Options::number(const std::string& name, double fallback) const {
+  return has(name) ? parse_double(get(name), "option --" + name) : fallback;
+}
+
+int Options::integer(const std::string& name, int fallback, int lo, int hi) const {
+  if (!has(name)) return fallback;
+  const double v = number(name, 0.0);
+  if (v != std::floor(v) || v < lo || v > hi)
+    throw CliError("option --" + name + ": must be a whole number from " + std::to_string(lo) + " to " +
+                   std::to_string(hi) + ", got '" + get(name) + "'");
+  return static_cast<int>(v);
+}
+
+std::pair<double, double> Options::range(const std::string& name) const {
+  const std::string s = require(name);
+  const auto comma = s.find(',');
+  if (comma == std::string::npos) throw CliError("option --" + name + ": expected 'start,end', got '" + s + "'");
+  const double a = parse_double(s.substr(0, comma), "option --" + name);
+  const double b = parse_double(s.substr(comma + 1), "option --" + name);
+  if (!(b > a)) throw CliError("option --" + name + ": the end must be greater than the start, got '" + s + "'");
+  return {a, b};
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CliError("cannot open '" + path + "': " + std::strerror(errno));
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw CliError("cannot read '" + path + "'");
+  return s.str();
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  // Write beside the target and rename, so a failure never leaves half a file.
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw CliError("cannot write '" + path + "': " + std::strerror(errno));
+    out << text;
+    out.flush();
+    if (!out) throw CliError("cannot write '" + path + "'");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw CliError("cannot write '" + path + "': " + std::strerror(errno));
+  }
+}
+
+void write_output(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") std::cout << text << std::flush;
+  else write_file(path, text);
+}
+
+namespace {
+std::vector<std::string> split_fields(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : line) {
+    if (c == ',') {
+      out.push_back(cur);
+      cur.clear();
+    } else if (c != '\r') {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  for (std::string& f : out) {  // trim blanks and one pair of quotes
+    const auto b = f.find_first_not_of(" \t"), e = f.find_last_not_of(" \t");
+    f = b == std::string::npos ? std::string() : f.substr(b, e - b + 1);
+    if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
+  }
+  return out;
+}
+}  // namespace
+
+Csv Csv::load(const std::string& path) { return parse(read_file(path), path); }
+
+Csv Csv::parse(const std::string& text, const std::string& name) {
+  Csv csv;
+  csv.name_ = name;
+  std::istringstream in(text);
+  std::string line;
+  std::size_t lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    if (csv.header_.empty()) {
+      csv.header_ = split_fields(line);
+      continue;
+    }
+    auto fields = split_fields(line);
+    if (fields.size() != csv.header_.size())
+      throw CliError(name + ": line " + std::to_string(lineno) + ": has " + std::to_string(fields.size()) +
+                     " fields, the header has " + std::to_string(csv.header_.size()));
+    csv.rows_.push_back(std::move(fields));
+    csv.lines_.push_back(lineno);
+  }
+  if (csv.header_.empty()) throw CliError(name + ": empty file (expected a header row)");
+  if (csv.rows_.empty()) throw CliError(name + ": no data rows below the header");
+  return csv;
+}
+
+std::vector<double> Csv::column(const std::string& col) const {
+  std::size_t idx = header_.size();
+  for (std::size_t k = 0; k < header_.size(); ++k)
+    if (header_[k] == col) idx = k;
+  if (idx == header_.size()) {
+    std::string have;
+    for (const auto& h : header_) have += (have.empty() ? "" : ", ") + h;
+    throw CliError(name_ + ": no column '" + col + "' (the header has: " + have + ")");
+  }
+  std::vector<double> out;
+  out.reserve(rows_.size());
+  for (std::size_t r = 0; r < rows_.size(); ++r)
+    out.push_back(parse_double(rows_[r][idx], name_ + ": line " + std::to_string(lines_[r]) + ", column '" + col + "'"));
+  return out;
+}
+
+std::string format_number(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest form that reads back exactly
+  return std::string(buf, r.ptr);
+}
+
+std::string to_csv(const std::vector<std::string>& header, const std::vector<std::vector<double>>& cols) {
+  std::string out;
+  for (std::size_t c = 0; c < header.size(); ++c) out += (c ? "," : "") + header[c];
+  out += '\n';
+  const std::size_t n = cols.empty() ? 0 : cols.front().size();
+  for (std::size_t r = 0; r < n; ++r) {
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      if (c) out += ',';
+      out += format_number(cols[c][r]);
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+std::string now_iso8601() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+LoadedModel load_model(const Options& opt) {
+  LoadedModel m;
+  if (opt.has("table")) {
+    if (opt.has("model")) throw CliError("give either --table or --model, not both");
+    const std::string path = opt.require("table");
+    auto doc = models::table_from_json(read_file(path));
+    m.lo = doc.table.grid().lo;
+    m.hi = doc.table.grid().hi;
+    m.description = "Everett table " + path + " (n = " + std::to_string(doc.table.grid().n) + ")";
+    m.model = std::make_unique<models::PreisachModel>(std::move(doc.table));
+    return m;
+  }
+  const std::string kind = opt.get("model");
+  if (kind.empty()) throw CliError("missing --table T.json or --model simplified");
+  if (kind != "simplified") throw CliError("unknown model '" + kind + "' (known: simplified)");
+  models::SmaParameters p = models::table1_parameters();
+  m.description = "simplified SMA model, Table 1 parameters (built in)";
+  if (opt.has("params")) {
+    const std::string path = opt.require("params");
+    p = models::params_from_json(read_file(path));
+    m.description = "simplified SMA model, parameters " + path;
+  }
+  m.model = std::make_unique<models::SimplifiedSmaModel>(p);
+  return m;
+}
+
+}  // namespace hystlab::cli

@@ -1,0 +1,69 @@
+#pragma once
+// Shared plumbing of the hystlab CLI: options, files, CSV. Every user error is a CliError,
+// printed as one line by main() with exit code 2.
+#include <map>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "hystlab/models/hysteresis_model.hpp"
+
+namespace hystlab::cli {
+
+struct CliError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Parses "--name value", "--name=value", flags and "-o value". Unknown options are errors.
+class Options {
+ public:
+  Options(const std::vector<std::string>& args, const std::set<std::string>& with_value,
+          const std::set<std::string>& flags);
+  [[nodiscard]] bool has(const std::string& name) const { return values_.count(name) > 0; }
+  [[nodiscard]] std::string get(const std::string& name, const std::string& fallback = "") const;
+  [[nodiscard]] std::string require(const std::string& name) const;
+  [[nodiscard]] double number(const std::string& name, double fallback) const;
+  [[nodiscard]] int integer(const std::string& name, int fallback, int lo, int hi) const;
+  // "a,b" with a < b.
+  [[nodiscard]] std::pair<double, double> range(const std::string& name) const;
+
+ private:
+  std::map<std::string, std::string> values_;
+};
+
+[[nodiscard]] std::string read_file(const std::string& path);
+void write_file(const std::string& path, const std::string& text);
+// Writes to the file, or to stdout when path is empty or "-".
+void write_output(const std::string& path, const std::string& text);
+
+class Csv {
+ public:
+  static Csv load(const std::string& path);
+  static Csv parse(const std::string& text, const std::string& name);
+  // The named column as finite numbers; errors name the file, line and column.
+  [[nodiscard]] std::vector<double> column(const std::string& name) const;
+  [[nodiscard]] std::size_t rows() const { return rows_.size(); }
+  [[nodiscard]] std::size_t line_of(std::size_t row) const { return lines_[row]; }
+
+ private:
+  std::string name_;
+  std::vector<std::string> header_;
+  std::vector<std::vector<std::string>> rows_;
+  std::vector<std::size_t> lines_;
+};
+
+[[nodiscard]] std::string format_number(double v);
+[[nodiscard]] std::string to_csv(const std::vector<std::string>& header, const std::vector<std::vector<double>>& cols);
+[[nodiscard]] std::string now_iso8601();
+
+// --model simplified [--params P.json] or --table T.json
+struct LoadedModel {
+  std::unique_ptr<models::HysteresisModel> model;
+  std::string description;
+  double lo = 0.0, hi = 0.0;  // range of a table model (lo == hi: unbounded)
+};
+[[nodiscard]] LoadedModel load_model(const Options& opt);
+
+}  // namespace hystlab::cli

@@ -1,0 +1,165 @@
+// hystlab identify / fit / calibrate: tables and parameters from models or data.
+#include <iostream>
+#include <sstream>
+
+#include "cli_support.hpp"
+#include "commands.hpp"
+#include "hystlab/models/fot_identification.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/lsq_fit.hpp"
+#include "hystlab/models/sma_calibration.hpp"
+
+namespace hystlab::cli {
+
+namespace {
+const char* kIdentifyHelp = R"(usage: hystlab identify --model simplified [--params P.json] --range A,B --subdivisions N -o T.json
+       hystlab identify --fot nodes.csv [--noise SIGMA_N] -o T.json
+
+Virtual campaign: runs the FOT identification input (to δmin, up to each δ_i, down through every
+δ_j) on the model and tabulates F(α,β) (MODELS.md §3). Without --params, Table 1.
+From measured nodes: columns alpha_mm,beta_mm,force_alpha_N,force_alpha_beta_N. Repeated nodes
+are averaged; the spread of repeated f_α is the drift figure; cells whose Preisach weight is
+negative beyond noise (--noise, default: the drift figure) are reported.
+)";
+
+const char* kFitHelp = R"(usage: hystlab fit --data X.csv --subdivisions N [--range A,B] [--lambda L] -o T.json
+
+Constrained least-squares Preisach table from any displacement/force record (columns
+displacement_mm, force_N): every cell weight >= 0, F(α,α) = 0, smoothing weight chosen by
+generalized cross-validation unless --lambda is given. N at most 48. The range defaults to the
+data's displacement range. The record is assumed to start from rest at the bottom of the range.
+)";
+
+const char* kCalibrateHelp = R"(usage: hystlab calibrate --data loop.csv (--initial P.json | --temperature T --clausius C) -o P.json
+
+Fits the simplified SMA model to one measured loop (columns displacement_mm, force_N) that loads
+past the end of the forward transformation and unloads below the end of the reverse one.
+One isothermal loop fixes KA, KM, dtr_max and the four transition forces; C (N/°C) and T (°C)
+come from --initial or the options, and the transition temperatures are derived from them.
+)";
+
+std::string grid_text(const models::Grid& g) {
+  std::ostringstream s;
+  s << "n = " << g.n << " on " << format_number(g.lo) << ".." << format_number(g.hi) << " mm";
+  return s.str();
+}
+}  // namespace
+
+int run_identify(const Args& args) {
+  if (print_help_if_asked(args, kIdentifyHelp)) return 0;
+  const Options opt(args, {"model", "params", "range", "subdivisions", "fot", "noise", "output"}, {});
+  const std::string out = opt.require("output");
+  models::TableProvenance prov;
+  prov.created = now_iso8601();
+  models::EverettTable table;
+  if (opt.has("fot")) {
+    if (opt.has("model")) throw CliError("give either --fot or --model, not both");
+    const std::string path = opt.require("fot");
+    const Csv csv = Csv::load(path);
+    const auto a = csv.column("alpha_mm"), b = csv.column("beta_mm");
+    const auto fa = csv.column("force_alpha_N"), fab = csv.column("force_alpha_beta_N");
+    std::vector<models::FotNode> nodes;
+    for (std::size_t k = 0; k < a.size(); ++k) nodes.push_back(models::FotNode{a[k], b[k], fa[k], fab[k]});
+    const double noise = opt.number("noise", -1.0);
+    if (opt.has("noise") && noise < 0) throw CliError("option --noise: must be >= 0");
+    const models::FotIdentification id = models::identify_from_nodes(nodes, noise);
+    table = id.table;
+    prov.source = "measured FOT nodes";
+    prov.method = "fot";
+    prov.from = path;
+    prov.extra = {{"nodes", id.node_count},
+                  {"drift_max_spread_N", id.drift.max_spread},
+                  {"drift_pooled_std_N", id.drift.pooled_std},
+                  {"violations", id.violations.size()}};
+    std::cout << "identified " << grid_text(table.grid()) << " from " << id.node_count << " nodes\n"
+              << "drift: max spread of f_alpha " << format_number(id.drift.max_spread) << " N, pooled std "
+              << format_number(id.drift.pooled_std) << " N over " << id.drift.repeated_rows << " repeated rows\n";
+    for (const auto& c : id.violations)
+      std::cout << "warning: cell alpha in [" << format_number(table.grid().node(c.p - 1)) << ", "
+                << format_number(table.grid().node(c.p)) << "] beta in [" << format_number(table.grid().node(c.q - 1))
+                << ", " << format_number(table.grid().node(c.q)) << "] has weight " << format_number(c.weight)
+                << " N (below -" << format_number(id.violation_threshold) << " N): F is not monotone there\n";
+  } else {
+    LoadedModel m = load_model(opt);
+    const auto [lo, hi] = opt.range("range");
+    if (!opt.has("subdivisions")) throw CliError("missing required option --subdivisions");
+    const models::Grid g = models::Grid::make(lo, hi, opt.integer("subdivisions", 0, 1, 2000));
+    table = models::identify_virtual(*m.model, g);
+    prov.source = m.description;
+    prov.method = "virtual-fot";
+    prov.from = opt.get("params", "built-in Table 1");
+    std::cout << "identified " << grid_text(g) << " (" << g.node_count() << " nodes) from the " << m.description
+              << "\n";
+  }
+  write_file(out, models::table_to_json(table, prov).dump(2) + "\n");
+  std::cout << "wrote " << out << "\n";
+  return 0;
+}
+
+int run_fit(const Args& args) {
+  if (print_help_if_asked(args, kFitHelp)) return 0;
+  const Options opt(args, {"data", "subdivisions", "range", "lambda", "output"}, {});
+  const std::string out = opt.require("output"), path = opt.require("data");
+  const Csv csv = Csv::load(path);
+  const auto x = csv.column("displacement_mm"), y = csv.column("force_N");
+  if (!opt.has("subdivisions")) throw CliError("missing required option --subdivisions");
+  const int n = opt.integer("subdivisions", 0, 1, 48);
+  double lo = *std::min_element(x.begin(), x.end()), hi = *std::max_element(x.begin(), x.end());
+  if (opt.has("range")) std::tie(lo, hi) = opt.range("range");
+  if (!(hi > lo)) throw CliError(path + ": the displacement never changes");
+  models::LsqFitOptions fo;
+  fo.lambda = opt.number("lambda", -1.0);
+  if (opt.has("lambda") && fo.lambda < 0) throw CliError("option --lambda: must be >= 0");
+  const models::LsqFitResult r = models::fit_preisach_lsq(x, y, models::Grid::make(lo, hi, n), fo);
+  models::TableProvenance prov{"displacement/force record", "lsq", now_iso8601(), path, {}};
+  prov.extra = {{"lambda", r.lambda},
+                {"rms_residual_N", r.rms_residual},
+                {"max_residual_N", r.max_residual},
+                {"effective_parameters", r.effective_parameters},
+                {"cells_at_bound", r.cells_at_bound},
+                {"cell_sigma_N", r.cell_sigma}};
+  write_file(out, models::table_to_json(r.table, prov).dump(2) + "\n");
+  std::cout << "fitted " << grid_text(r.table.grid()) << " to " << x.size() << " samples\n"
+            << "smoothing lambda " << format_number(r.lambda) << (opt.has("lambda") ? " (given)" : " (GCV)")
+            << ", effective parameters " << format_number(r.effective_parameters) << "\n"
+            << "residual: rms " << format_number(r.rms_residual) << " N, max " << format_number(r.max_residual)
+            << " N; cells held at zero weight: " << r.cells_at_bound << " of " << r.cell_weight.size() << "\n"
+            << "wrote " << out << "\n";
+  return 0;
+}
+
+int run_calibrate(const Args& args) {
+  if (print_help_if_asked(args, kCalibrateHelp)) return 0;
+  const Options opt(args, {"data", "initial", "temperature", "clausius", "output"}, {});
+  const std::string out = opt.require("output"), path = opt.require("data");
+  models::SmaCalibrationOptions co;
+  if (opt.has("initial")) {
+    const models::SmaParameters p = models::params_from_json(read_file(opt.require("initial")));
+    co.C = p.C;
+    co.T = p.T;
+  } else if (!opt.has("temperature") || !opt.has("clausius")) {
+    throw CliError("calibrate needs --initial P.json, or both --temperature T and --clausius C");
+  }
+  co.T = opt.number("temperature", co.T);
+  co.C = opt.number("clausius", co.C);
+  if (!(co.C > 0)) throw CliError("option --clausius: must be > 0");
+  const Csv csv = Csv::load(path);
+  const auto x = csv.column("displacement_mm"), y = csv.column("force_N");
+  const models::SmaCalibration c = models::calibrate_simplified_sma(x, y, co);
+  write_file(out, models::params_to_json(c.parameters, "calibrated from " + path).dump(2) + "\n");
+  const auto& p = c.parameters;
+  std::cout << "KA " << format_number(p.KA) << " N/mm, KM " << format_number(p.KM) << " N/mm, dtr_max "
+            << format_number(p.dtr_max) << " mm\n"
+            << "transition forces: Ms " << format_number(c.transitions.Ms.force) << " N, Mf "
+            << format_number(c.transitions.Mf.force) << " N, As " << format_number(c.transitions.As.force)
+            << " N, Af " << format_number(c.transitions.Af.force) << " N\n"
+            << "temperatures (C = " << format_number(p.C) << " N/degC, T = " << format_number(p.T) << " degC): Mf0 "
+            << format_number(p.Mf0) << ", Ms0 " << format_number(p.Ms0) << ", As0 " << format_number(p.As0)
+            << ", Af0 " << format_number(p.Af0) << "\n"
+            << "residual: rms " << format_number(c.rms_residual) << " N, max " << format_number(c.max_residual)
+            << " N after " << c.iterations << " iterations\n"
+            << "wrote " << out << "\n";
+  return 0;
+}
+
+}  // namespace hystlab::cli

@@ -1,0 +1,22 @@
+#pragma once
+#include <string>
+#include <vector>
+
+namespace hystlab::cli {
+
+using Args = std::vector<std::string>;
+
+// Each verb returns the process exit code; user errors throw CliError.
+int run_eval(const Args& args);
+int run_identify(const Args& args);
+int run_fit(const Args& args);
+int run_calibrate(const Args& args);
+int run_invert(const Args& args);
+int run_check(const Args& args);
+int run_compare(const Args& args);
+int run_demo(const Args& args);
+
+// True (and the help printed) when args ask for it.
+bool print_help_if_asked(const Args& args, const char* text);
+
+}  // namespace hystlab::cli

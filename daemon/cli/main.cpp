@@ -1,0 +1,62 @@
+// hystlab: the command-line tool. Verbs in cmd_*.cpp; user errors exit 2 with one line.
+#include <cstring>
+#include <exception>
+#include <iostream>
+
+#include "cli_support.hpp"
+#include "commands.hpp"
+
+namespace hystlab::cli {
+
+bool print_help_if_asked(const Args& args, const char* text) {
+  for (const auto& a : args)
+    if (a == "--help" || a == "-h") {
+      std::cout << text;
+      return true;
+    }
+  return false;
+}
+
+namespace {
+const char* kUsage = R"(hystlab: identify and use hysteresis models (Preisach/Everett tables, simplified SMA model)
+
+usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
+
+  eval       run a table or the simplified model on a displacement series
+  identify   a table from a model (virtual FOT campaign) or from measured FOT nodes
+  fit        a table from any displacement/force record (constrained least squares)
+  calibrate  simplified-model parameters from one measured loop
+  invert     displacements that produce requested forces (force control)
+  check      wiping-out and congruency of a record, as numbers
+  compare    accuracy of a table or model against a record
+  demo       the paper's §3.3 study on Table 1, with a report and plots
+)";
+
+int dispatch(const std::string& verb, const Args& args) {
+  if (verb == "eval") return run_eval(args);
+  if (verb == "identify") return run_identify(args);
+  if (verb == "fit") return run_fit(args);
+  if (verb == "calibrate") return run_calibrate(args);
+  if (verb == "invert") return run_invert(args);
+  if (verb == "check") return run_check(args);
+  if (verb == "compare") return run_compare(args);
+  if (verb == "demo") return run_demo(args);
+  throw CliError("unknown verb '" + verb + "' (hystlab --help lists them)");
+}
+}  // namespace
+}  // namespace hystlab::cli
+
+int main(int argc, char** argv) {
+  using namespace hystlab::cli;
+  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
+    std::cout << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  const Args args(argv + 2, argv + argc);
+  try {
+    return dispatch(argv[1], args);
+  } catch (const std::exception& e) {  // CliError, and the models' std::invalid_argument / FormatError
+    std::cerr << "hystlab: error: " << e.what() << "\n";
+    return 2;
+  }
+}

@@ -1,0 +1,263 @@
+// The hystlab CLI as a user runs it: the real binary, real files, exit codes and messages.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "hystlab/models/fot_identification.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/preisach_model.hpp"
+#include "hystlab/models/simplified_sma.hpp"
+
+namespace fs = std::filesystem;
+using namespace hystlab::models;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Workdir {
+ public:
+  Workdir() {
+    char tmpl[] = "/tmp/hystlab-cli-XXXXXX";
+    dir_ = mkdtemp(tmpl);
+  }
+  ~Workdir() { fs::remove_all(dir_); }
+  fs::path operator/(const std::string& name) const { return dir_ / name; }
+  void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
+  Result run(const std::string& args) const {
+    const std::string cmd = "cd '" + dir_.string() + "' && '" HYSTLAB_CLI "' " + args + " > out.txt 2> err.txt < /dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(dir_ / "out.txt");
+    r.err = slurp(dir_ / "err.txt");
+    return r;
+  }
+
+ private:
+  fs::path dir_;
+};
+
+std::string series_csv(const std::vector<double>& x, const std::vector<double>& f) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "time_s,displacement_mm,force_N\n";
+  for (std::size_t k = 0; k < x.size(); ++k) s << static_cast<double>(k) * 0.01 << "," << x[k] << "," << f[k] << "\n";
+  return s.str();
+}
+
+std::vector<double> column(const std::string& csv, int col) {
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<double> v;
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::string cell;
+    for (int c = 0; c <= col; ++c) std::getline(ls, cell, ',');
+    v.push_back(std::stod(cell));
+  }
+  return v;
+}
+
+// One error line naming the problem, exit code 2, nothing on stdout.
+void check_error(const Result& r, const std::string& needle) {
+  CAPTURE(r.err);
+  CHECK(r.code == 2);
+  CHECK(r.err.find(needle) != std::string::npos);
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK(r.err.rfind("hystlab: error: ", 0) == 0);
+}
+
+const std::vector<double> kPath = ramp_through({0.0, 3.5, 1.0, 3.0, 1.5, 4.0, 0.0}, 0.01);
+
+}  // namespace
+
+TEST_CASE("cli: --help on every verb") {
+  Workdir w;
+  for (const char* verb : {"eval", "identify", "fit", "calibrate", "invert", "check", "compare", "demo"}) {
+    CAPTURE(verb);
+    const Result r = w.run(std::string(verb) + " --help");
+    CHECK(r.code == 0);
+    CHECK(r.out.find(std::string("usage: hystlab ") + verb) != std::string::npos);
+  }
+  const Result top = w.run("--help");
+  CHECK(top.code == 0);
+  CHECK(top.out.find("calibrate") != std::string::npos);
+}
+
+TEST_CASE("cli: identify (virtual) then eval reproduces the library to the last digit") {
+  Workdir w;
+  REQUIRE(w.run("identify --model simplified --range 0,4 --subdivisions 12 -o T.json").code == 0);
+  const TableDocument doc = table_from_json(slurp(w / "T.json"));
+  CHECK(doc.table.grid().n == 12);
+  CHECK(doc.provenance.method == "virtual-fot");
+  SimplifiedSmaModel sma(table1_parameters());
+  const EverettTable expected = identify_virtual(sma, Grid::make(0, 4, 12));
+  for (std::size_t k = 0; k < expected.values().size(); ++k) CHECK(doc.table.values()[k] == expected.values()[k]);
+
+  w.write("X.csv", series_csv(kPath, std::vector<double>(kPath.size(), 0.0)));
+  const Result r = w.run("eval --table T.json --input X.csv -o Y.csv");
+  REQUIRE(r.code == 0);
+  const std::string y = slurp(w / "Y.csv");
+  CHECK(y.rfind("displacement_mm,force_N\n", 0) == 0);
+  const auto xs = column(y, 0), fs_ = column(y, 1);
+  REQUIRE(fs_.size() == kPath.size());
+  PreisachModel pm(expected);
+  for (std::size_t k = 0; k < kPath.size(); ++k) {
+    CHECK(xs[k] == kPath[k]);
+    CHECK(fs_[k] == pm.step(kPath[k]));  // exact: shortest round-trip formatting
+  }
+  const Result m = w.run("eval --model simplified --input X.csv");
+  REQUIRE(m.code == 0);
+  SimplifiedSmaModel ref(table1_parameters());
+  const auto fm = column(m.out, 1);
+  REQUIRE(fm.size() == kPath.size());
+  for (std::size_t k = 0; k < kPath.size(); ++k) CHECK(fm[k] == ref.step(kPath[k]));
+}
+
+TEST_CASE("cli: identify from measured FOT nodes, with drift and violation report") {
+  Workdir w;
+  SimplifiedSmaModel sma(table1_parameters());
+  const auto nodes = run_virtual_fot(sma, Grid::make(0, 4, 6)).nodes;
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "alpha_mm,beta_mm,force_alpha_N,force_alpha_beta_N\n";
+  for (int rep = 0; rep < 2; ++rep)
+    for (const FotNode& n : nodes) csv << n.alpha << "," << n.beta << "," << n.force_alpha + rep * 0.1 << "," << n.force_alpha_beta << "\n";
+  w.write("nodes.csv", csv.str());
+  const Result r = w.run("identify --fot nodes.csv -o T.json");
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("identified n = 6") != std::string::npos);
+  CHECK(r.out.find("drift: max spread of f_alpha 0.1") != std::string::npos);
+  CHECK(r.out.find("warning: cell") != std::string::npos);  // the SMA table is not monotone near the diagonal
+  const TableDocument doc = table_from_json(slurp(w / "T.json"));
+  CHECK(doc.table.node_value(6, 0) == doctest::Approx(nodes[20].everett() + 0.05));
+}
+
+TEST_CASE("cli: fit, calibrate, invert, check and compare on generated data") {
+  Workdir w;
+  SimplifiedSmaModel sma(table1_parameters());
+  std::vector<double> f(kPath.size());
+  sma.evaluate(kPath, f);
+  w.write("X.csv", series_csv(kPath, f));
+
+  const Result fit = w.run("fit --data X.csv --subdivisions 10 -o F.json");
+  REQUIRE(fit.code == 0);
+  CHECK(fit.out.find("(GCV)") != std::string::npos);
+  const TableDocument fitted = table_from_json(slurp(w / "F.json"));
+  CHECK(fitted.provenance.method == "lsq");
+  for (const CellWeight& c : cell_weights(fitted.table)) CHECK(c.weight >= -1e-9);
+
+  const auto loop = ramp_through({0.0, 4.0, 0.0}, 0.005);
+  std::vector<double> lf(loop.size());
+  sma.reset();
+  sma.evaluate(loop, lf);
+  w.write("loop.csv", series_csv(loop, lf));
+  const Result cal = w.run("calibrate --data loop.csv --temperature 25 --clausius 5.7 -o P.json");
+  REQUIRE(cal.code == 0);
+  const SmaParameters p = params_from_json(slurp(w / "P.json"));
+  CHECK(p.KA == doctest::Approx(40.0).epsilon(1e-3));
+  CHECK(p.Af0 == doctest::Approx(21.5).epsilon(1e-3));
+
+  REQUIRE(w.run("identify --model simplified --range 0,4 --subdivisions 24 -o T.json").code == 0);
+  w.write("F.csv", "force_N\n20\n60\n100\n40\n25\n");
+  const Result inv = w.run("invert --table T.json --input F.csv");
+  REQUIRE(inv.code == 0);
+  const auto reached = column(inv.out, 1);
+  const std::vector<double> wanted{20, 60, 100, 40, 25};
+  for (std::size_t k = 0; k < wanted.size(); ++k) CHECK(reached[k] == doctest::Approx(wanted[k]).epsilon(1e-6));
+
+  const Result chk = w.run("check --data X.csv");
+  REQUIRE(chk.code == 0);
+  CHECK(chk.out.find("wiping-out: ") != std::string::npos);
+  CHECK(chk.out.find("congruency: ") != std::string::npos);
+
+  const Result cmp = w.run("compare --table T.json --data X.csv");
+  REQUIRE(cmp.code == 0);
+  CHECK(cmp.out.find("ascending") != std::string::npos);
+  CHECK(cmp.out.find("descending") != std::string::npos);
+  CHECK(cmp.out.find("loop energy: reference") != std::string::npos);
+}
+
+TEST_CASE("cli: demo writes the report, plots and tables") {
+  Workdir w;
+  const Result r = w.run("demo --out d");
+  REQUIRE(r.code == 0);
+  for (const char* f : {"report.md", "major_loop.svg", "minor_loops.svg", "random_input.svg", "table_n4.json", "table_n48.json"})
+    CHECK(fs::exists(w / "d" / f));
+  const std::string report = slurp(w / "d" / "report.md");
+  for (const char* n : {"|   4 |", "|   8 |", "|  12 |", "|  24 |", "|  48 |"}) CHECK(report.find(n) != std::string::npos);
+  CHECK(slurp(w / "d" / "major_loop.svg").find("<polyline") != std::string::npos);
+}
+
+TEST_CASE("cli: every error is one line naming the problem, exit code 2") {
+  Workdir w;
+  REQUIRE(w.run("identify --model simplified --range 0,4 --subdivisions 4 -o T.json").code == 0);
+  w.write("X.csv", "displacement_mm,force_N\n0,0\n1,2\n");
+  check_error(w.run("eval --table missing.json --input X.csv"), "cannot open 'missing.json'");
+  check_error(w.run("eval --table T.json --input nope.csv"), "cannot open 'nope.csv'");
+  w.write("nocol.csv", "disp,force_N\n0,0\n");
+  check_error(w.run("eval --table T.json --input nocol.csv"), "no column 'displacement_mm'");
+  w.write("nan.csv", "displacement_mm\n0\nnan\n");
+  check_error(w.run("eval --table T.json --input nan.csv"), "line 3, column 'displacement_mm': 'nan' is not a finite number");
+  w.write("text.csv", "displacement_mm\n0\n1.2.3\n");
+  check_error(w.run("eval --table T.json --input text.csv"), "'1.2.3' is not a number");
+  w.write("empty.csv", "");
+  check_error(w.run("eval --table T.json --input empty.csv"), "empty file");
+  w.write("header.csv", "displacement_mm\n");
+  check_error(w.run("eval --table T.json --input header.csv"), "no data rows");
+  w.write("ragged.csv", "displacement_mm,force_N\n0,0\n1\n");
+  check_error(w.run("eval --table T.json --input ragged.csv"), "line 3: has 1 fields");
+  w.write("far.csv", "displacement_mm\n0\n4.5\n");
+  check_error(w.run("eval --table T.json --input far.csv"), "outside the table's range");
+  CHECK(w.run("eval --table T.json --input far.csv --clamp").code == 0);
+
+  auto doc = nlohmann::json::parse(slurp(w / "T.json"));
+  auto bad = doc;
+  bad["version"] = 7;
+  w.write("v7.json", bad.dump());
+  check_error(w.run("eval --table v7.json --input X.csv"), "unknown format version 7");
+  bad = doc;
+  bad["nodes_mm"][3] = 0.1;
+  w.write("nonmono.json", bad.dump());
+  check_error(w.run("eval --table nonmono.json --input X.csv"), "non-monotone grid");
+  w.write("broken.json", "{\"format\": ");
+  check_error(w.run("eval --table broken.json --input X.csv"), "not valid JSON");
+
+  check_error(w.run("identify --model simplified --range 0,4 --subdivisions 0 -o U.json"), "--subdivisions");
+  check_error(w.run("identify --model simplified --range 4,0 --subdivisions 4 -o U.json"), "greater than the start");
+  check_error(w.run("identify --model simplified --range 0,4 -o U.json"), "missing required option --subdivisions");
+  check_error(w.run("identify --model magic --range 0,4 --subdivisions 4 -o U.json"), "unknown model 'magic'");
+  CHECK_FALSE(fs::exists(w / "U.json"));
+  check_error(w.run("eval --table T.json --input X.csv --frobnicate 3"), "unknown option --frobnicate");
+  check_error(w.run("transmogrify"), "unknown verb 'transmogrify'");
+  w.write("badp.json", R"({"KA_N_per_mm": 40, "KM_N_per_mm": 150, "dtr_max_mm": 2.95, "C_N_per_degC": 5.7,
+    "Mf0_degC": 12.7, "Ms0_degC": 17.9, "As0_degC": 17.9, "Af0_degC": 21.5, "T_degC": 15})");
+  check_error(w.run("eval --model simplified --params badp.json --input X.csv"), "T_degC");
+  check_error(w.run("calibrate --data X.csv -o P.json"), "--temperature");
+  w.write("Fbig.csv", "force_N\n1e6\n");
+  check_error(w.run("invert --table T.json --input Fbig.csv"), "line 2: force 1e+06 N cannot be reached");
+  w.write("few.csv", "displacement_mm,force_N\n0,0\n1,1\n");
+  check_error(w.run("fit --data few.csv --subdivisions 8 -o F.json"), "too few");
+  w.write("fot.csv", "alpha_mm,beta_mm,force_alpha_N,force_alpha_beta_N\n1,0,10,0\n2,0,20,0\n2,1,20,15\n3,0,30,0\n");
+  check_error(w.run("identify --fot fot.csv -o F.json"), "missing node (alpha 3 mm, beta 1 mm)");
+}
