@@ -34,7 +34,13 @@ InterpolationStencil EverettTable::stencil(double a, double b) const noexcept {
   InterpolationStencil st;
   double s = 0.0, t = 0.0;
   int i = 0, j = 0;
-  locate(a, b, i, j, s, t);
+  const double lo = grid_.lo, hi = grid_.hi;
+  a = a < lo ? lo : (a > hi ? hi : a);
+  b = b < lo ? lo : (b > a ? a : b);
+  cell_of(a, b, i, j, s, t);
+  s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+  t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+  if (j == i && t > s) t = s;
   if (j < i) {
     st.node = {Grid::index(i - 1, j - 1), Grid::index(i - 1, j), Grid::index(i, j - 1), Grid::index(i, j)};
     st.weight = {(1.0 - s) * (1.0 - t), (1.0 - s) * t, s * (1.0 - t), s * t};

@@ -34,41 +34,44 @@ class EverettTable {
 
   // F(a, b) with a, b clamped to the grid and b clamped to <= a. Continuous.
   [[nodiscard]] double value(double a, double b) const noexcept {
-    double s = 0.0, t = 0.0;
+    const double lo = grid_.lo, hi = grid_.hi;
+    a = a < lo ? lo : (a > hi ? hi : a);
+    b = b < lo ? lo : (b > a ? a : b);
+    return value_in_range(a, b);
+  }
+
+  // F(a, b) for lo <= b <= a <= hi (the memory stack guarantees it): no clamping.
+  [[nodiscard]] double value_in_range(double a, double b) const noexcept {
     int i = 0, j = 0;
-    locate(a, b, i, j, s, t);
-    const double* v = values_.data();
+    double s = 0.0, t = 0.0;
+    cell_of(a, b, i, j, s, t);
+    const double* r1 = values_.data() + Grid::index(i - 1, 0);
+    const double* r2 = values_.data() + Grid::index(i, 0);
     if (j < i) {  // rectangle, Eq. 8: bilinear in the four corners
-      const std::size_t r1 = Grid::index(i - 1, 0), r2 = Grid::index(i, 0);
-      const double f00 = v[r1 + static_cast<std::size_t>(j - 1)], f01 = v[r1 + static_cast<std::size_t>(j)];
-      const double f10 = v[r2 + static_cast<std::size_t>(j - 1)], f11 = v[r2 + static_cast<std::size_t>(j)];
+      const double f00 = r1[j - 1], f01 = r1[j], f10 = r2[j - 1], f11 = r2[j];
       return (1.0 - s) * ((1.0 - t) * f00 + t * f01) + s * ((1.0 - t) * f10 + t * f11);
     }
     // triangle on the diagonal, Eq. 9: linear through (δ_{i-1},δ_{i-1}), (δ_i,δ_{i-1}), (δ_i,δ_i)
-    const double f1 = v[Grid::index(i - 1, i - 1)], f2 = v[Grid::index(i, i - 1)], f3 = v[Grid::index(i, i)];
-    return f1 + (f2 - f1) * s + (f3 - f2) * t;
+    const double f1 = r1[i - 1], f2 = r2[i - 1], f3 = r2[i];
+    return f1 + (f2 - f1) * s + (f3 - f2) * (t < s ? t : s);
   }
 
   // The same interpolation as value(), as weights on nodes (for linear identification).
   [[nodiscard]] InterpolationStencil stencil(double a, double b) const noexcept;
 
  private:
-  void locate(double a, double b, int& i, int& j, double& s, double& t) const noexcept {
-    const double lo = grid_.lo, hi = grid_.hi;
-    a = a < lo ? lo : (a > hi ? hi : a);
-    b = b < lo ? lo : (b > a ? a : b);
-    const double u = (a - lo) * inv_step_, w = (b - lo) * inv_step_;
-    i = static_cast<int>(u);
-    if (static_cast<double>(i) < u || i == 0) ++i;  // ceil, at least 1
-    if (i > grid_.n) i = grid_.n;
-    j = static_cast<int>(w);
-    if (static_cast<double>(j) < w || j == 0) ++j;
-    if (j > i) j = i;
+  // Cell of (a, b), lo <= b <= a <= hi: column i with a in [δ_{i-1}, δ_i], row j <= i with b in
+  // [δ_{j-1}, δ_j], and the local coordinates s, t in [0, 1] (t <= s in a triangle).
+  void cell_of(double a, double b, int& i, int& j, double& s, double& t) const noexcept {
+    // floor + 1: a point on a node line may be read from either neighbouring cell, where both
+    // interpolations agree (F is continuous), so the cheaper floor is as good as a ceiling.
+    const double u = (a - grid_.lo) * inv_step_, w = (b - grid_.lo) * inv_step_;
+    i = static_cast<int>(u) + 1;
+    i = i > grid_.n ? grid_.n : i;
+    j = static_cast<int>(w) + 1;
+    j = j > i ? i : j;
     s = u - static_cast<double>(i - 1);
     t = w - static_cast<double>(j - 1);
-    s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
-    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    if (j == i && t > s) t = s;
   }
 
   Grid grid_;
