@@ -1,0 +1,166 @@
+#include <doctest/doctest.h>
+
+#include <array>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "hystlab/protocols/can_protocol.hpp"
+#include "hystlab/protocols/modbus_crc.hpp"
+#include "hystlab/protocols/register_map.hpp"
+
+using namespace hystlab::protocols;
+
+namespace {
+std::string slurp(const std::string& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+MapEntry entry(ValueType t, WordOrder w = WordOrder::big, double scale = 1, double offset = 0) {
+  MapEntry e;
+  e.table = ModbusTable::holding_register;
+  e.type = t;
+  e.word_order = w;
+  e.scale = scale;
+  e.offset = offset;
+  return e;
+}
+std::array<std::uint16_t, 2> enc(const MapEntry& e, double v) {
+  std::array<std::uint16_t, 2> w{0xDEAD, 0xBEEF};
+  REQUIRE_FALSE(encode(e, v, w));
+  return w;
+}
+double dec(const MapEntry& e, std::array<std::uint16_t, 2> w) {
+  double v = 0;
+  REQUIRE_FALSE(decode(e, w, v));
+  return v;
+}
+}  // namespace
+
+TEST_CASE("register encoding: every type and word order, byte for byte") {
+  CHECK(enc(entry(ValueType::uint16), 4660)[0] == 0x1234);
+  CHECK(enc(entry(ValueType::int16), -2)[0] == 0xFFFE);
+  CHECK(dec(entry(ValueType::int16), {0x8000, 0}) == -32768);
+  CHECK(enc(entry(ValueType::int32), -2) == std::array<std::uint16_t, 2>{0xFFFF, 0xFFFE});
+  CHECK(enc(entry(ValueType::int32, WordOrder::swapped), -2) == std::array<std::uint16_t, 2>{0xFFFE, 0xFFFF});
+  CHECK(enc(entry(ValueType::uint32), 0x12345678) == std::array<std::uint16_t, 2>{0x1234, 0x5678});
+  CHECK(enc(entry(ValueType::uint32, WordOrder::swapped), 0x12345678) == std::array<std::uint16_t, 2>{0x5678, 0x1234});
+  // 1.5f = 0x3FC00000
+  CHECK(enc(entry(ValueType::float32), 1.5) == std::array<std::uint16_t, 2>{0x3FC0, 0x0000});
+  CHECK(enc(entry(ValueType::float32, WordOrder::swapped), 1.5) == std::array<std::uint16_t, 2>{0x0000, 0x3FC0});
+  CHECK(dec(entry(ValueType::float32), {0xC020, 0x0000}) == -2.5);
+  CHECK(dec(entry(ValueType::float32, WordOrder::swapped), {0x0000, 0xC020}) == -2.5);
+  // scaled integers: 12.345 mm in µm
+  CHECK(enc(entry(ValueType::int32, WordOrder::swapped, 0.001), 12.345) == std::array<std::uint16_t, 2>{12345, 0});
+  CHECK(dec(entry(ValueType::int32, WordOrder::swapped, 0.001), {12345, 0}) == doctest::Approx(12.345));
+  CHECK(enc(entry(ValueType::uint16, WordOrder::big, 0.1, 100), 150)[0] == 500);  // (150-100)/0.1
+  CHECK(dec(entry(ValueType::uint16, WordOrder::big, 0.1, 100), {500, 0}) == doctest::Approx(150));
+}
+
+TEST_CASE("register encoding: range and finiteness are typed errors") {
+  std::array<std::uint16_t, 2> w{};
+  CHECK(encode(entry(ValueType::uint16), -1, w) == ProtocolError::out_of_range);
+  CHECK(encode(entry(ValueType::int16), 40000, w) == ProtocolError::out_of_range);
+  CHECK(encode(entry(ValueType::int32, WordOrder::big, 0.001), 3e6, w) == ProtocolError::out_of_range);
+  CHECK(encode(entry(ValueType::float32), NAN, w) == ProtocolError::not_finite);
+  MapEntry lim = entry(ValueType::float32);
+  lim.max = 10;
+  double v = 0;
+  CHECK(decode(lim, std::array<std::uint16_t, 2>{0x4130, 0}, v) == ProtocolError::out_of_range);  // 11.0
+  CHECK(decode(entry(ValueType::float32), std::array<std::uint16_t, 2>{0x7FC0, 0}, v) == ProtocolError::not_finite);
+  CHECK(decode(entry(ValueType::int32), std::array<std::uint16_t, 1>{1}, v) == ProtocolError::wrong_length);
+}
+
+TEST_CASE("register maps: the shipped maps load, with their read blocks") {
+  const RegisterMap a = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  CHECK(a.slave_id() == 1);
+  REQUIRE(a.find(Signal::force_N));
+  CHECK(a.find(Signal::force_N)->address == 2);
+  REQUIRE(a.measurement_blocks().size() == 1);
+  CHECK(a.measurement_blocks()[0].count == 12);
+  const RegisterMap b = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json"));
+  CHECK(b.find(Signal::displacement_mm)->word_order == WordOrder::swapped);
+  CHECK(b.measurement_blocks()[0].start == 3000);
+  const RegisterMap s = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json"));
+  CHECK(s.kind() == RigKind::shaker);
+}
+
+TEST_CASE("register maps: a bad map is rejected with the field named") {
+  const auto base = nlohmann::json::parse(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  auto expect = [&](auto mutate, const char* needle) {
+    auto j = base;
+    mutate(j);
+    CAPTURE(needle);
+    CHECK_THROWS_WITH_AS((void)RegisterMap::from_json(j.dump()), doctest::Contains(needle), MapError);
+  };
+  expect([](auto& j) { j["signals"]["force_N"]["address"] = 1; }, "overlaps");
+  expect([](auto& j) { j["signals"]["force_N"]["type"] = "float64"; }, "signals.force_N.type");
+  expect([](auto& j) { j["signals"].erase("sample_counter"); }, "missing required signal 'signals.sample_counter'");
+  expect([](auto& j) { j["signals"]["force_N"]["scale"] = 0; }, "signals.force_N.scale must not be 0");
+  expect([](auto& j) { j["signals"]["torque"] = j["signals"]["force_N"]; }, "unknown signal 'signals.torque'");
+  expect([](auto& j) { j["signals"]["enable"]["type"] = "uint16"; }, "does not fit table 'coil'");
+  expect([](auto& j) { j["signals"]["setpoint_mm"]["table"] = "input_register"; }, "writable table");
+  expect([](auto& j) { j["signals"]["force_N"]["word_order"] = "little"; }, "signals.force_N.word_order");
+  expect([](auto& j) { j["version"] = 9; }, "unknown version 9");
+  CHECK_THROWS_WITH_AS((void)RegisterMap::from_json("{oops"), doctest::Contains("not valid JSON"), MapError);
+}
+
+TEST_CASE("CAN: every frame encodes byte for byte and decodes back") {
+  can_frame f{};
+  REQUIRE_FALSE(can::encode(can::Command{1.5, 2.5, true, false, true, 2}, 5, f));
+  CHECK(f.can_id == 0x205);
+  CHECK(f.can_dlc == 8);
+  const std::uint8_t cmd[8] = {0xDC, 0x05, 0, 0, 0xFA, 0x00, 0x05, 0x02};  // 1500 µm, 250 (0.01 mm/s), flags 101b, mode 2
+  CHECK(std::memcmp(f.data, cmd, 8) == 0);
+  can::Message m;
+  REQUIRE_FALSE(can::decode(f, 5, m));
+  CHECK(std::get<can::Command>(m).setpoint_mm == doctest::Approx(1.5));
+  CHECK(std::get<can::Command>(m).estop);
+
+  REQUIRE_FALSE(can::encode(can::StatusA{-0.002, 157.5}, 1, f));
+  const std::uint8_t sa[8] = {0xFE, 0xFF, 0xFF, 0xFF, 0x3C, 0x67, 0x02, 0x00};  // -2 µm, 157500 mN
+  CHECK(f.can_id == 0x181);
+  CHECK(std::memcmp(f.data, sa, 8) == 0);
+  REQUIRE_FALSE(can::decode(f, 1, m));
+  CHECK(std::get<can::StatusA>(m).force_N == doctest::Approx(157.5));
+
+  REQUIRE_FALSE(can::encode(can::StatusC{0x01020304}, 1, f));
+  CHECK(f.can_dlc == 4);
+  CHECK(f.data[0] == 0x04);
+  CHECK(f.data[3] == 0x01);
+  REQUIRE_FALSE(can::encode(can::ShakerStatus{-1.0, 2.0, 0.5, -0.5}, 3, f));
+  REQUIRE_FALSE(can::decode(f, 3, m));
+  CHECK(std::get<can::ShakerStatus>(m).mass_displacement_mm == doctest::Approx(-0.5));
+}
+
+TEST_CASE("CAN: malformed frames are typed decode errors") {
+  can_frame f{};
+  REQUIRE_FALSE(can::encode(can::StatusA{1, 2}, 1, f));
+  can::Message m;
+  can_frame g = f;
+  g.can_dlc = 7;
+  CHECK(can::decode(g, 1, m) == ProtocolError::wrong_length);
+  g = f;
+  g.can_id = 0x123;
+  CHECK(can::decode(g, 1, m) == ProtocolError::unknown_id);
+  CHECK(can::decode(f, 2, m) == ProtocolError::unknown_id);  // another node's frame
+  g = f;
+  g.can_id |= CAN_RTR_FLAG;
+  CHECK(can::decode(g, 1, m) == ProtocolError::unknown_id);
+  REQUIRE_FALSE(can::encode(can::Command{}, 1, f));
+  f.data[6] = 0x80;
+  CHECK(can::decode(f, 1, m) == ProtocolError::reserved_bits);
+  f.data[6] = 0;
+  f.data[7] = 9;
+  CHECK(can::decode(f, 1, m) == ProtocolError::out_of_range);
+  CHECK(can::encode(can::Command{0, 1000.0}, 1, f) == ProtocolError::out_of_range);  // ramp > 655.35
+  CHECK(can::encode(can::StatusA{}, 0, f) == ProtocolError::out_of_range);
+}
+
+TEST_CASE("Modbus CRC-16 matches the standard's example") {
+  const std::uint8_t frame[] = {0x01, 0x03, 0x00, 0x00, 0x00, 0x0A};  // read 10 holding registers from slave 1
+  CHECK(crc16_modbus(frame) == 0xCDC5);  // sent as C5 CD
+}
