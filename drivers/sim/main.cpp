@@ -1,0 +1,209 @@
+// hystlab-sim: a simulated load frame or shaker that speaks the real protocols over real sockets.
+#include <poll.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "can_endpoint.hpp"
+#include "control_channel.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/preisach_model.hpp"
+#include "hystlab/models/simplified_sma.hpp"
+#include "hystlab/protocols/default_maps.hpp"
+#include "modbus_endpoint.hpp"
+
+namespace {
+using namespace hystlab;
+
+const char* kHelp = R"(usage: hystlab-sim [options]
+
+A simulated rig that speaks hystlab's real protocols over real sockets.
+  --rig load_frame|shaker        which rig (default load_frame)
+  --transport tcp|rtu|can        Modbus TCP (default), Modbus RTU on a new pty, or CAN on --can-fd
+  --address A  --port P          TCP address and port (default 127.0.0.1:1502; port 0: any free port)
+  --map M.json                   register map (default: the shipped map for the rig)
+  --can-fd N  --can-node N  --can-rate HZ   CAN: inherited fd carrying struct can_frame, node id, status rate
+  --time-scale S                 simulated seconds per wall-clock second (default 1)
+  --sample-rate HZ               simulated samples per simulated second (default 1000)
+  --seed N  --noise N  --drift N_PER_S      load cell noise (1 sigma, N) and drift
+  --params P.json | --table T.json          the specimen (default: Table 1, corners smoothed)
+  --corner-width MM              corner smoothing width of the specimen (default 0.05; 0: none)
+  --fault SPEC                   start with a fault: drop, delay=MS, exception=CODE, crc, freeze, overload, can-silent
+  --control-port P               text control channel on 127.0.0.1 (default 0: any free port)
+  --duration S                   stop after S wall-clock seconds (default: run until SIGTERM or 'quit')
+On start it prints one line per endpoint ("modbus-tcp 127.0.0.1:1502", "control 127.0.0.1:40123") and "ready".
+)";
+
+volatile sig_atomic_t g_stop = 0;
+void on_signal(int) { g_stop = 1; }
+
+struct Args {
+  std::string rig = "load_frame", transport = "tcp", address = "127.0.0.1", map, params, table;
+  int port = 1502, can_fd = -1, can_node = 1, control_port = 0;
+  double time_scale = 1, sample_rate = 1000, can_rate = 1000, noise = 0.05, drift = 0, corner = 0.05, duration = 0;
+  std::uint64_t seed = 1;
+  std::vector<std::string> faults;
+};
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open '" + path + "'");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+Args parse(int argc, char** argv) {
+  Args a;
+  for (int k = 1; k < argc; ++k) {
+    const std::string o = argv[k];
+    if (o == "--help" || o == "-h") {
+      std::cout << kHelp;
+      std::exit(0);
+    }
+    if (k + 1 >= argc) throw std::runtime_error("option " + o + " needs a value (see --help)");
+    const std::string v = argv[++k];
+    auto num = [&] {
+      try {
+        std::size_t used = 0;
+        const double d = std::stod(v, &used);
+        if (used != v.size()) throw std::invalid_argument(v);
+        return d;
+      } catch (...) {
+        throw std::runtime_error("option " + o + ": '" + v + "' is not a number");
+      }
+    };
+    if (o == "--rig") a.rig = v;
+    else if (o == "--transport") a.transport = v;
+    else if (o == "--address") a.address = v;
+    else if (o == "--port") a.port = static_cast<int>(num());
+    else if (o == "--map") a.map = v;
+    else if (o == "--can-fd") a.can_fd = static_cast<int>(num());
+    else if (o == "--can-node") a.can_node = static_cast<int>(num());
+    else if (o == "--can-rate") a.can_rate = num();
+    else if (o == "--time-scale") a.time_scale = num();
+    else if (o == "--sample-rate") a.sample_rate = num();
+    else if (o == "--seed") a.seed = static_cast<std::uint64_t>(num());
+    else if (o == "--noise") a.noise = num();
+    else if (o == "--drift") a.drift = num();
+    else if (o == "--params") a.params = v;
+    else if (o == "--table") a.table = v;
+    else if (o == "--corner-width") a.corner = num();
+    else if (o == "--fault") a.faults.push_back(v);
+    else if (o == "--control-port") a.control_port = static_cast<int>(num());
+    else if (o == "--duration") a.duration = num();
+    else throw std::runtime_error("unknown option " + o + " (see --help)");
+  }
+  if (a.rig != "load_frame" && a.rig != "shaker") throw std::runtime_error("--rig must be load_frame or shaker");
+  if (a.transport != "tcp" && a.transport != "rtu" && a.transport != "can") throw std::runtime_error("--transport must be tcp, rtu or can");
+  if (a.transport == "can" && a.can_fd < 0) throw std::runtime_error("--transport can needs --can-fd");
+  if (!(a.time_scale > 0) || !(a.sample_rate > 0) || !(a.can_rate > 0)) throw std::runtime_error("rates and time scale must be > 0");
+  return a;
+}
+
+std::unique_ptr<models::HysteresisModel> specimen(const Args& a) {
+  if (!a.table.empty()) return std::make_unique<models::PreisachModel>(models::table_from_json(read_file(a.table)).table);
+  const models::SmaParameters p = a.params.empty() ? models::table1_parameters() : models::params_from_json(read_file(a.params));
+  return std::make_unique<models::SimplifiedSmaModel>(p);
+}
+
+sim::SimRig make_rig(const Args& a) {
+  if (a.rig == "shaker") return sim::SimRig(std::make_unique<sim::ShakerSim>(*specimen(a), sim::ShakerParams{}));
+  sim::LoadFrameParams p;
+  p.noise_N = a.noise;
+  p.drift_N_per_s = a.drift;
+  p.corner_width_mm = a.corner;
+  p.seed = a.seed;
+  return sim::SimRig(std::make_unique<sim::LoadFrameSim>(specimen(a), p));
+}
+
+int run(const Args& a) {
+  sim::SimRig rig = make_rig(a);
+  sim::Faults faults;
+  for (const auto& f : a.faults)
+    if (const std::string err = faults.apply(f); !err.empty()) throw std::runtime_error(err);
+  std::optional<sim::ModbusEndpoint> modbus;
+  std::optional<sim::CanEndpoint> can;
+  if (a.transport == "can") {
+    can.emplace(a.can_fd, a.can_node, a.can_rate);
+  } else {
+    const std::string text = a.map.empty() ? (a.rig == "shaker" ? protocols::kDefaultShakerMap : protocols::kDefaultLoadFrameMap) : read_file(a.map);
+    protocols::RegisterMap map = protocols::RegisterMap::from_json(text);
+    if (map.kind() != rig.kind()) throw std::runtime_error("the map is for another kind of rig than --rig " + a.rig);
+    modbus.emplace(a.transport == "tcp" ? sim::ModbusEndpoint::Transport::tcp : sim::ModbusEndpoint::Transport::rtu,
+                   a.address, a.port, std::move(map));
+    std::cout << modbus->where() << "\n";
+  }
+  sim::ControlChannel control(a.control_port);
+  std::cout << "control 127.0.0.1:" << control.port() << "\nready" << std::endl;
+
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  auto wall = [&] { return std::chrono::duration<double>(clock::now() - t0).count(); };
+  const double sample_dt = 1.0 / a.sample_rate;
+  double sim_due = 0;  // simulated time owed to the physics
+  double last = 0;
+  bool was_dropping = false;
+  std::vector<int> fds;
+  std::vector<pollfd> pfds;
+  while (!g_stop && (a.duration <= 0 || wall() < a.duration)) {
+    const double now = wall();
+    sim_due += (now - last) * a.time_scale;
+    last = now;
+    for (int guard = 0; sim_due >= sample_dt && guard < 100000; ++guard) {
+      rig.step(sample_dt);
+      sim_due -= sample_dt;
+    }
+    const sim::SignalValues m = rig.measurements(faults);
+    if (!faults.freeze) {
+      if (modbus) modbus->publish(m);
+    }
+    if (faults.drop && !was_dropping && modbus) modbus->drop_clients();
+    was_dropping = faults.drop;
+    if (can) can->maybe_send(now, m, rig.kind(), faults.freeze ? sim::Faults{.can_silent = true} : faults);
+    fds.clear();
+    if (modbus) modbus->fds(fds);
+    if (can) fds.push_back(can->fd());
+    control.fds(fds);
+    pfds.clear();
+    for (int fd : fds) pfds.push_back(pollfd{fd, POLLIN, 0});
+    if (poll(pfds.data(), pfds.size(), 1) <= 0) continue;
+    for (const pollfd& p : pfds) {
+      if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;
+      if (control.owns(p.fd)) {
+        std::ostringstream status;
+        status << "t=" << rig.time_s();
+        if (control.handle(p.fd, faults, status.str())) g_stop = 1;
+      } else if (can && p.fd == can->fd()) {
+        can->receive(rig);
+      } else if (modbus) {
+        modbus->handle(p.fd, faults, rig);
+      }
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  signal(SIGTERM, on_signal);
+  signal(SIGINT, on_signal);
+  signal(SIGPIPE, SIG_IGN);
+  try {
+    return run(parse(argc, argv));
+  } catch (const std::exception& e) {
+    std::cerr << "hystlab-sim: error: " << e.what() << "\n";
+    return 2;
+  }
+}

@@ -1,0 +1,188 @@
+#include "modbus_endpoint.hpp"
+
+#include <arpa/inet.h>
+#include <modbus/modbus.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <pty.h>
+#include <sys/socket.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <thread>
+
+#include "hystlab/protocols/modbus_crc.hpp"
+
+namespace hystlab::sim {
+using protocols::ModbusTable;
+
+namespace {
+int table_size(const protocols::RegisterMap& m, ModbusTable t) {
+  int n = 0;
+  for (const auto& e : m.entries())
+    if (e.table == t) n = std::max(n, e.address + e.width());
+  return n;
+}
+}  // namespace
+
+ModbusEndpoint::ModbusEndpoint(Transport t, const std::string& address, int port, protocols::RegisterMap map)
+    : transport_(t), map_(std::move(map)), address_(address), port_(port) {
+  mapping_ = modbus_mapping_new(table_size(map_, ModbusTable::coil), table_size(map_, ModbusTable::discrete_input),
+                                table_size(map_, ModbusTable::holding_register), table_size(map_, ModbusTable::input_register));
+  if (!mapping_) throw std::runtime_error("hystlab-sim: cannot allocate the register map");
+  if (t == Transport::tcp) {
+    ctx_ = modbus_new_tcp(address.c_str(), port);
+    if (!ctx_) throw std::runtime_error("hystlab-sim: bad TCP address " + address);
+    listen_fd_ = modbus_tcp_listen(ctx_, 16);
+    if (listen_fd_ < 0)
+      throw std::runtime_error("hystlab-sim: cannot listen on " + address + ":" + std::to_string(port) + ": " + modbus_strerror(errno));
+    sockaddr_in sa{};
+    socklen_t len = sizeof sa;
+    getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&sa), &len);
+    port_ = ntohs(sa.sin_port);
+  } else {
+    if (openpty(&pty_master_, &pty_slave_, nullptr, nullptr, nullptr) != 0)
+      throw std::runtime_error("hystlab-sim: cannot open a pseudo-terminal");
+    termios tio{};
+    tcgetattr(pty_slave_, &tio);
+    cfmakeraw(&tio);  // no echo or line editing before the client sets its own modes
+    tcsetattr(pty_slave_, TCSANOW, &tio);
+    pty_path_ = ttyname(pty_slave_);
+    ctx_ = modbus_new_rtu(pty_path_.c_str(), 115200, 'N', 8, 1);
+    modbus_set_socket(ctx_, pty_master_);  // a master has no path: drive its fd directly
+  }
+  modbus_set_slave(ctx_, map_.slave_id());
+}
+
+ModbusEndpoint::~ModbusEndpoint() {
+  drop_clients();
+  if (listen_fd_ >= 0) close(listen_fd_);
+  if (pty_slave_ >= 0) close(pty_slave_);
+  if (pty_master_ >= 0) close(pty_master_);
+  if (ctx_) modbus_free(ctx_);
+  if (mapping_) modbus_mapping_free(mapping_);
+}
+
+std::string ModbusEndpoint::where() const {
+  return transport_ == Transport::tcp ? "modbus-tcp " + address_ + ":" + std::to_string(port_) : "modbus-rtu " + pty_path_;
+}
+
+void ModbusEndpoint::fds(std::vector<int>& out) const {
+  if (transport_ == Transport::rtu) {
+    out.push_back(pty_master_);
+    return;
+  }
+  out.push_back(listen_fd_);
+  out.insert(out.end(), clients_.begin(), clients_.end());
+}
+
+void ModbusEndpoint::drop_clients() {
+  for (int fd : clients_) close(fd);
+  clients_.clear();
+}
+
+void ModbusEndpoint::handle(int fd, const Faults& faults, SimRig& rig) {
+  if (fd == listen_fd_) {
+    const int c = accept(listen_fd_, nullptr, nullptr);
+    if (c < 0) return;
+    if (faults.drop) {
+      close(c);
+      return;
+    }
+    const int one = 1;
+    setsockopt(c, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    clients_.push_back(c);
+    return;
+  }
+  serve(fd, faults, rig);
+}
+
+void ModbusEndpoint::serve(int fd, const Faults& faults, SimRig& rig) {
+  std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+  modbus_set_socket(ctx_, fd);
+  const int rc = modbus_receive(ctx_, query);
+  if (rc == -1) {
+    if (transport_ == Transport::tcp) {
+      close(fd);
+      clients_.erase(std::remove(clients_.begin(), clients_.end(), fd), clients_.end());
+    } else {
+      modbus_flush(ctx_);
+    }
+    return;
+  }
+  if (rc == 0) return;  // not for us (RTU: another slave)
+  if (faults.delay_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(faults.delay_ms));
+  if (faults.exception > 0) {
+    modbus_reply_exception(ctx_, query, static_cast<unsigned>(faults.exception));
+    return;
+  }
+  if (faults.crc && transport_ == Transport::rtu) {
+    reply_with_bad_crc(query, rc);
+    return;
+  }
+  modbus_reply(ctx_, query, rc, mapping_);
+  const int fn = query[modbus_get_header_length(ctx_)];
+  if (fn == 0x05 || fn == 0x06 || fn == 0x0F || fn == 0x10) rig.apply(written_commands());
+}
+
+// An RTU answer of the right shape whose CRC is wrong (fault injection).
+void ModbusEndpoint::reply_with_bad_crc(const std::uint8_t* q, int length) {
+  std::vector<std::uint8_t> a{q[0], q[1]};
+  const int fn = q[1];
+  const int addr = (q[2] << 8) | q[3], count = (q[4] << 8) | q[5];
+  if (fn == 0x03 || fn == 0x04) {
+    a.push_back(static_cast<std::uint8_t>(2 * count));
+    const std::uint16_t* tab = fn == 0x03 ? mapping_->tab_registers : mapping_->tab_input_registers;
+    for (int k = 0; k < count; ++k) {
+      const std::uint16_t w = tab[addr + k];
+      a.push_back(static_cast<std::uint8_t>(w >> 8));
+      a.push_back(static_cast<std::uint8_t>(w & 0xFF));
+    }
+  } else {
+    a.insert(a.end(), q + 2, q + std::min(6, length - 2));  // writes echo address and quantity
+  }
+  const std::uint16_t crc = protocols::crc16_modbus(a) ^ 0xFFFFU;
+  a.push_back(static_cast<std::uint8_t>(crc & 0xFF));
+  a.push_back(static_cast<std::uint8_t>(crc >> 8));
+  (void)!write(pty_master_, a.data(), a.size());
+}
+
+SignalValues ModbusEndpoint::written_commands() const {
+  SignalValues v;
+  v.fill(std::numeric_limits<double>::quiet_NaN());
+  for (const auto& e : map_.entries()) {
+    if (!protocols::is_command(e.signal)) continue;
+    std::uint16_t words[2] = {0, 0};
+    if (e.table == ModbusTable::coil) words[0] = mapping_->tab_bits[e.address];
+    else
+      for (int k = 0; k < e.width(); ++k) words[k] = mapping_->tab_registers[e.address + k];
+    double value = 0;
+    if (!protocols::decode(e, std::span<const std::uint16_t>(words, 2), value)) v[static_cast<std::size_t>(e.signal)] = value;
+  }
+  return v;
+}
+
+void ModbusEndpoint::publish(const SignalValues& m) {
+  for (const auto& e : map_.entries()) {
+    const double value = m[static_cast<std::size_t>(e.signal)];
+    if (protocols::is_command(e.signal) || std::isnan(value)) continue;
+    std::uint16_t words[2] = {0, 0};
+    if (protocols::encode(e, value, words)) continue;  // out of the type's range: keep the last value
+    switch (e.table) {
+      case ModbusTable::coil: mapping_->tab_bits[e.address] = static_cast<std::uint8_t>(words[0]); break;
+      case ModbusTable::discrete_input: mapping_->tab_input_bits[e.address] = static_cast<std::uint8_t>(words[0]); break;
+      case ModbusTable::holding_register:
+        for (int k = 0; k < e.width(); ++k) mapping_->tab_registers[e.address + k] = words[k];
+        break;
+      case ModbusTable::input_register:
+        for (int k = 0; k < e.width(); ++k) mapping_->tab_input_registers[e.address + k] = words[k];
+        break;
+    }
+  }
+}
+
+}  // namespace hystlab::sim

@@ -1,0 +1,241 @@
+#include "hystlab/drivers/modbus_rig.hpp"
+
+#include <modbus/modbus.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+namespace hystlab::drivers {
+namespace {
+using protocols::ModbusTable;
+using protocols::Signal;
+
+RigError classify(int err) {
+  if (err == ETIMEDOUT) return RigError::timeout;
+  if (err >= EMBXILFUN && err <= EMBXGTAR) return RigError::exception_response;
+  if (err == EMBBADCRC) return RigError::crc_error;
+  if (err == EMBBADDATA || err == EMBBADEXC || err == EMBUNKEXC || err == EMBMDATA || err == EMBBADSLAVE)
+    return RigError::protocol_error;
+  return RigError::connection_lost;  // ECONNRESET, EPIPE, ECONNREFUSED, EBADF, EIO, ...
+}
+
+void set_timeout(modbus_t* ctx, double s, bool byte) {
+  const auto sec = static_cast<uint32_t>(s);
+  const auto usec = static_cast<uint32_t>(std::lround((s - sec) * 1e6));
+  if (byte) modbus_set_byte_timeout(ctx, sec, usec);
+  else modbus_set_response_timeout(ctx, sec, usec);
+}
+
+double micros_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+ModbusRig::ModbusRig(ModbusRigConfig config) : cfg_(std::move(config)) {
+  for (const auto& b : cfg_.map.measurement_blocks()) block_words_.emplace_back(b.count, 0);
+  if (cfg_.slave == 0) cfg_.slave = cfg_.map.slave_id();
+}
+
+ModbusRig::~ModbusRig() { disconnect(); }
+
+std::string ModbusRig::describe() const {
+  return cfg_.name + (cfg_.transport == ModbusRigConfig::Transport::tcp
+                          ? " (modbus tcp " + cfg_.host + ":" + std::to_string(cfg_.port) + ")"
+                          : " (modbus rtu " + cfg_.device + ")");
+}
+
+void ModbusRig::disconnect() noexcept {
+  if (ctx_) {
+    modbus_close(ctx_);
+    modbus_free(ctx_);
+    ctx_ = nullptr;
+  }
+  connected_ = false;
+}
+
+std::error_code ModbusRig::connect(double now_s) noexcept {
+  disconnect();
+  last_now_ = now_s;
+  ctx_ = cfg_.transport == ModbusRigConfig::Transport::tcp
+             ? modbus_new_tcp(cfg_.host.c_str(), cfg_.port)
+             : modbus_new_rtu(cfg_.device.c_str(), cfg_.baud, cfg_.parity, cfg_.data_bits, cfg_.stop_bits);
+  if (!ctx_) return fail(errno, "create context");
+  modbus_set_slave(ctx_, cfg_.slave);
+  set_timeout(ctx_, cfg_.response_timeout_s, false);
+  set_timeout(ctx_, cfg_.byte_timeout_s, true);
+  if (modbus_connect(ctx_) == -1) {
+    const int err = errno;
+    modbus_free(ctx_);
+    ctx_ = nullptr;
+    backoff_ = backoff_ > 0 ? std::min(backoff_ * 2, cfg_.reconnect_max_s) : cfg_.reconnect_min_s;
+    next_attempt_ = now_s + backoff_;
+    return fail(err == ETIMEDOUT ? ECONNREFUSED : err, "connect");
+  }
+  connected_ = true;
+  backoff_ = 0;
+  return {};
+}
+
+std::error_code ModbusRig::ensure_connected(double now_s) noexcept {
+  last_now_ = now_s;
+  if (connected_) return {};
+  if (now_s < next_attempt_) return RigError::not_connected;
+  health_.record_reconnect();
+  return connect(now_s);
+}
+
+std::error_code ModbusRig::fail(int err, const char* op) noexcept {
+  const RigError kind = classify(err);
+  health_.record_error(kind);
+  if (kind == RigError::connection_lost && ctx_) {
+    modbus_close(ctx_);
+    connected_ = false;
+    next_attempt_ = last_now_ + (backoff_ = backoff_ > 0 ? std::min(backoff_ * 2, cfg_.reconnect_max_s) : cfg_.reconnect_min_s);
+  } else if (ctx_ && (kind == RigError::timeout || kind == RigError::crc_error || kind == RigError::protocol_error)) {
+    modbus_flush(ctx_);  // a late or broken answer must not be taken for the next one
+  }
+  ++episode_count_;
+  if (episode_ != static_cast<int>(kind)) {  // once per episode, not once per poll
+    spdlog::warn("{}: {} failed: {} ({}); further errors are counted until it recovers", describe(), op,
+                 make_error_code(kind).message(), modbus_strerror(err));
+    episode_ = static_cast<int>(kind);
+  }
+  return kind;
+}
+
+void ModbusRig::succeed() noexcept {
+  if (episode_ != 0) {
+    spdlog::info("{}: recovered after {} failed transactions", describe(), episode_count_);
+    episode_ = 0;
+    episode_count_ = 0;
+  }
+}
+
+std::error_code ModbusRig::read_blocks(double now_s) noexcept {
+  if (auto ec = ensure_connected(now_s)) return ec;
+  const auto& blocks = cfg_.map.measurement_blocks();
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const auto& blk = blocks[b];
+    auto& w = block_words_[b];
+    const auto t0 = std::chrono::steady_clock::now();
+    int rc = -1;
+    if (blk.table == ModbusTable::input_register) rc = modbus_read_input_registers(ctx_, blk.start, blk.count, w.data());
+    else if (blk.table == ModbusTable::holding_register) rc = modbus_read_registers(ctx_, blk.start, blk.count, w.data());
+    else {
+      std::uint8_t bits[2000];
+      rc = blk.table == ModbusTable::coil ? modbus_read_bits(ctx_, blk.start, blk.count, bits)
+                                          : modbus_read_input_bits(ctx_, blk.start, blk.count, bits);
+      for (int k = 0; k < blk.count && rc > 0; ++k) w[static_cast<std::size_t>(k)] = bits[k];
+    }
+    if (rc == -1) return fail(errno, "read");
+    if (rc != blk.count) return fail(EMBBADDATA, "read");
+    health_.record_transaction(false, micros_since(t0));
+  }
+  succeed();
+  return {};
+}
+
+std::error_code ModbusRig::value_of(Signal s, double& v) const noexcept {
+  const protocols::MapEntry* e = cfg_.map.find(s);
+  if (!e) return RigError::unsupported;
+  const auto& blocks = cfg_.map.measurement_blocks();
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    if (blocks[b].table == e->table && e->address >= blocks[b].start &&
+        e->address + e->width() <= blocks[b].start + blocks[b].count) {
+      const auto& w = block_words_[b];
+      const auto ec = protocols::decode(*e, std::span(w).subspan(e->address - blocks[b].start), v);
+      if (ec == protocols::ProtocolError::out_of_range || ec == protocols::ProtocolError::not_finite) return RigError::out_of_range;
+      return ec ? make_error_code(RigError::protocol_error) : std::error_code{};
+    }
+  return RigError::unsupported;
+}
+
+std::error_code ModbusRig::check_stale(double now_s, std::uint32_t counter) noexcept {
+  if (counter != last_counter_ || counter_changed_at_ < 0) {
+    last_counter_ = counter;
+    counter_changed_at_ = now_s;
+    return {};
+  }
+  if (now_s - counter_changed_at_ > cfg_.stale_after_s) {
+    health_.record_error(RigError::stale_data);
+    return RigError::stale_data;
+  }
+  return {};
+}
+
+std::error_code ModbusRig::read_sample(double now_s, RigSample& out) noexcept {
+  if (cfg_.map.kind() != protocols::RigKind::load_frame) return RigError::unsupported;
+  if (auto ec = read_blocks(now_s)) return ec;
+  double d = 0, f = 0, c = 0, st = 0, fc = 0, hb = 0, n = 0;
+  for (auto [sig, dst] : {std::pair{Signal::displacement_mm, &d}, {Signal::force_N, &f}, {Signal::status_word, &st},
+                          {Signal::fault_code, &fc}, {Signal::heartbeat, &hb}, {Signal::sample_counter, &n}})
+    if (auto ec = value_of(sig, *dst)) {
+      health_.record_error(static_cast<RigError>(ec.value()));
+      return ec;
+    }
+  if (cfg_.map.find(Signal::command_mm)) (void)value_of(Signal::command_mm, c);
+  out = RigSample{now_s, c, d, f, static_cast<std::uint16_t>(st), static_cast<std::uint16_t>(fc),
+                  static_cast<std::uint32_t>(hb), static_cast<std::uint32_t>(n)};
+  return check_stale(now_s, out.sample_counter);
+}
+
+std::error_code ModbusRig::read_shaker(double now_s, ShakerSample& out) noexcept {
+  if (cfg_.map.kind() != protocols::RigKind::shaker) return RigError::unsupported;
+  if (auto ec = read_blocks(now_s)) return ec;
+  double v[8] = {};
+  const Signal sigs[8] = {Signal::base_accel_m_s2, Signal::mass_accel_m_s2, Signal::base_displacement_mm,
+                          Signal::mass_displacement_mm, Signal::status_word, Signal::fault_code, Signal::heartbeat,
+                          Signal::sample_counter};
+  for (int k = 0; k < 8; ++k)
+    if (auto ec = value_of(sigs[k], v[k])) return ec;
+  out = ShakerSample{now_s, v[0], v[1], v[2], v[3], static_cast<std::uint16_t>(v[4]), static_cast<std::uint16_t>(v[5]),
+                     static_cast<std::uint32_t>(v[6]), static_cast<std::uint32_t>(v[7])};
+  return check_stale(now_s, out.sample_counter);
+}
+
+std::error_code ModbusRig::write_signals(std::initializer_list<Write> writes) noexcept {
+  if (auto ec = ensure_connected(last_now_)) return ec;
+  std::map<int, std::uint16_t> regs;  // holding registers, written in contiguous runs
+  std::vector<std::pair<int, bool>> coils;
+  for (const Write& w : writes) {
+    const protocols::MapEntry* e = cfg_.map.find(w.signal);
+    if (!e) return RigError::unsupported;
+    if ((e->min && w.value < *e->min) || (e->max && w.value > *e->max)) return RigError::out_of_range;
+    std::uint16_t words[2];
+    if (protocols::encode(*e, w.value, words)) return RigError::out_of_range;
+    if (e->table == ModbusTable::coil) coils.emplace_back(e->address, words[0] != 0);
+    else
+      for (int k = 0; k < e->width(); ++k) regs[e->address + k] = words[k];
+  }
+  for (auto it = regs.begin(); it != regs.end();) {
+    std::vector<std::uint16_t> run{it->second};
+    const int start = it->first;
+    for (++it; it != regs.end() && it->first == start + static_cast<int>(run.size()); ++it) run.push_back(it->second);
+    const auto t0 = std::chrono::steady_clock::now();
+    if (modbus_write_registers(ctx_, start, static_cast<int>(run.size()), run.data()) == -1) return fail(errno, "write");
+    health_.record_transaction(true, micros_since(t0));
+  }
+  for (const auto& [addr, on] : coils) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (modbus_write_bit(ctx_, addr, on ? 1 : 0) == -1) return fail(errno, "write");
+    health_.record_transaction(true, micros_since(t0));
+  }
+  succeed();
+  return {};
+}
+
+std::error_code ModbusRig::arm(bool enable) noexcept { return write_signals({{Signal::enable, enable ? 1.0 : 0.0}}); }
+std::error_code ModbusRig::hold(bool on) noexcept { return write_signals({{Signal::hold, on ? 1.0 : 0.0}}); }
+std::error_code ModbusRig::estop(bool on) noexcept { return write_signals({{Signal::estop, on ? 1.0 : 0.0}}); }
+std::error_code ModbusRig::command(double setpoint_mm, double rate) noexcept {
+  return write_signals({{Signal::setpoint_mm, setpoint_mm}, {Signal::ramp_rate_mm_s, rate}});
+}
+std::error_code ModbusRig::command_shaker(double f, double a, bool enable) noexcept {
+  return write_signals({{Signal::drive_frequency_hz, f}, {Signal::drive_amplitude_mm, a}, {Signal::shaker_enable, enable ? 1.0 : 0.0}});
+}
+
+}  // namespace hystlab::drivers

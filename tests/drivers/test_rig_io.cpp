@@ -1,0 +1,232 @@
+// The drivers against hystlab-sim over real sockets: loopback TCP, an RTU pty, a CAN socketpair.
+#include <doctest/doctest.h>
+#include <sys/socket.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "hystlab/drivers/can_rig.hpp"
+#include "hystlab/drivers/modbus_rig.hpp"
+#include "hystlab/protocols/default_maps.hpp"
+#include "sim_process.hpp"
+
+using namespace hystlab::drivers;
+using hystlab::test::SimProcess;
+using hystlab::test::steady_now;
+namespace protocols = hystlab::protocols;
+
+namespace {
+std::string slurp(const std::string& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+ModbusRigConfig tcp_config(int port, const std::string& map_text = protocols::kDefaultLoadFrameMap) {
+  ModbusRigConfig c;
+  c.port = port;
+  c.map = protocols::RegisterMap::from_json(map_text);
+  c.response_timeout_s = 0.05;
+  c.stale_after_s = 0.2;
+  c.reconnect_min_s = 0.02;
+  return c;
+}
+
+void sleep_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
+
+// Reads until ok (or gives up after ~2 s); returns the last error.
+std::error_code read_until_ok(Rig& rig, RigSample& s) {
+  std::error_code ec;
+  for (int k = 0; k < 100; ++k) {
+    if (!(ec = rig.read_sample(steady_now(), s))) return ec;
+    sleep_ms(20);
+  }
+  return ec;
+}
+
+// Drives to a setpoint and returns the sample once the displacement is there.
+RigSample move_to(Rig& rig, double mm) {
+  REQUIRE_FALSE(rig.command(mm, 20.0));
+  RigSample s;
+  for (int k = 0; k < 300; ++k) {
+    REQUIRE_FALSE(rig.read_sample(steady_now(), s));
+    if (std::fabs(s.displacement_mm - mm) < 0.01) break;
+    sleep_ms(5);
+  }
+  return s;
+}
+}  // namespace
+
+TEST_CASE("modbus tcp: samples, commands and the specimen's force through the default map") {
+  SimProcess sim({"--port", "0", "--time-scale", "10", "--noise", "0"});
+  ModbusRig rig(tcp_config(sim.modbus_port));
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  RigSample s;
+  REQUIRE_FALSE(rig.read_sample(steady_now(), s));
+  CHECK((s.status_word & protocols::status::ready) != 0);
+  const auto first = s.sample_counter;
+  REQUIRE_FALSE(rig.arm(true));
+  const RigSample at2 = move_to(rig, 2.0);
+  CHECK(at2.displacement_mm == doctest::Approx(2.0).epsilon(0.01));
+  CHECK(at2.force_N > 40.0);  // on the forward transformation plateau of Table 1
+  CHECK(at2.force_N < 60.0);
+  CHECK(at2.sample_counter > first);
+  CHECK((at2.status_word & protocols::status::enabled) != 0);
+  const IoHealthSnapshot h = rig.health();
+  CHECK(h.reads > 2);
+  CHECK(h.writes >= 2);
+  CHECK(h.total_errors() == 0);
+  CHECK(h.max_transaction_us > 0);
+  // Out-of-range commands never reach the wire.
+  CHECK(rig.command(500.0, 1.0) == RigError::out_of_range);
+  // E-stop is passed through and shows in the status word.
+  REQUIRE_FALSE(rig.estop(true));
+  sleep_ms(20);
+  REQUIRE_FALSE(rig.read_sample(steady_now(), s));
+  CHECK((s.status_word & protocols::status::estop) != 0);
+}
+
+TEST_CASE("modbus tcp: every injected fault is its typed error, and the driver recovers") {
+  SimProcess sim({"--port", "0", "--noise", "0"});
+  ModbusRig rig(tcp_config(sim.modbus_port));
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  RigSample s;
+  REQUIRE_FALSE(rig.read_sample(steady_now(), s));
+
+  struct Case {
+    const char* fault;
+    RigError expected;
+  };
+  for (const Case c : {Case{"fault delay 200", RigError::timeout}, Case{"fault exception 4", RigError::exception_response},
+                       Case{"fault overload", RigError::out_of_range}, Case{"fault drop", RigError::connection_lost}}) {
+    CAPTURE(c.fault);
+    REQUIRE(sim.control(c.fault).rfind("ok", 0) == 0);
+    sleep_ms(10);
+    const std::error_code ec = rig.read_sample(steady_now(), s);
+    CHECK(ec == c.expected);
+    REQUIRE(sim.control("clear").rfind("ok", 0) == 0);
+    CHECK_FALSE(read_until_ok(rig, s));
+  }
+  // Freeze: the sample counter stops; after stale_after_s the driver says so.
+  REQUIRE(sim.control("fault freeze").rfind("ok", 0) == 0);
+  std::error_code ec;
+  for (int k = 0; k < 40 && ec != RigError::stale_data; ++k) {
+    ec = rig.read_sample(steady_now(), s);
+    sleep_ms(20);
+  }
+  CHECK(ec == RigError::stale_data);
+  REQUIRE(sim.control("clear").rfind("ok", 0) == 0);
+  CHECK_FALSE(read_until_ok(rig, s));
+  const IoHealthSnapshot h = rig.health();
+  CHECK(h.errors_of(RigError::timeout) >= 1);
+  CHECK(h.errors_of(RigError::exception_response) >= 1);
+  CHECK(h.errors_of(RigError::connection_lost) >= 1);
+  CHECK(h.errors_of(RigError::stale_data) >= 1);
+  CHECK(h.reconnects >= 1);
+  CHECK(sim.control("fault warp").rfind("error unknown fault 'warp'", 0) == 0);
+}
+
+TEST_CASE("modbus tcp: the second vendor map (scaled integers, swapped words) end to end") {
+  const std::string map = slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json");
+  SimProcess sim({"--port", "0", "--time-scale", "10", "--noise", "0", "--map", HYSTLAB_MAPS "/vendor_b_load_frame.json"});
+  ModbusRig rig(tcp_config(sim.modbus_port, map));
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.arm(true));
+  const RigSample s = move_to(rig, 1.25);
+  CHECK(s.displacement_mm == doctest::Approx(1.25).epsilon(0.01));
+  CHECK(s.force_N > 30.0);
+  // A map with another slave id gets no answer from this device.
+  ModbusRigConfig wrong = tcp_config(sim.modbus_port);
+  wrong.slave = 5;
+  wrong.map = protocols::RegisterMap::from_json(map);
+  ModbusRig other(wrong);
+  REQUIRE_FALSE(other.connect(steady_now()));
+  RigSample t;
+  const auto ec = other.read_sample(steady_now(), t);
+  CHECK((!ec || ec == RigError::timeout));  // TCP servers may ignore the unit id; RTU would not answer
+}
+
+TEST_CASE("modbus rtu on a pty: samples, a CRC error, and recovery") {
+  SimProcess sim({"--transport", "rtu", "--noise", "0", "--corner-width", "0"});
+  REQUIRE_FALSE(sim.rtu_path.empty());
+  ModbusRigConfig c = tcp_config(0);
+  c.transport = ModbusRigConfig::Transport::rtu;
+  c.device = sim.rtu_path;
+  ModbusRig rig(c);
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  RigSample s;
+  REQUIRE_FALSE(read_until_ok(rig, s));
+  CHECK((s.status_word & protocols::status::ready) != 0);
+  REQUIRE_FALSE(rig.arm(true));
+  const RigSample at = move_to(rig, 0.5);
+  CHECK(at.force_N == doctest::Approx(20.0).epsilon(0.05));  // austenite line: 40 N/mm
+  REQUIRE(sim.control("fault crc").rfind("ok", 0) == 0);
+  sleep_ms(10);
+  CHECK(rig.read_sample(steady_now(), s) == RigError::crc_error);
+  REQUIRE(sim.control("clear").rfind("ok", 0) == 0);
+  CHECK_FALSE(read_until_ok(rig, s));
+  REQUIRE(sim.control("fault exception 2").rfind("ok", 0) == 0);
+  sleep_ms(10);
+  CHECK(rig.read_sample(steady_now(), s) == RigError::exception_response);
+  REQUIRE(sim.control("clear").rfind("ok", 0) == 0);
+  CHECK_FALSE(read_until_ok(rig, s));
+}
+
+TEST_CASE("can over a socketpair: the real driver code, a silent rig, recovery") {
+  int sv[2];
+  REQUIRE(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv) == 0);
+  SimProcess sim({"--transport", "can", "--can-fd", "3", "--can-rate", "500", "--time-scale", "10", "--noise", "0"}, sv[1]);
+  close(sv[1]);
+  CanRig rig(std::make_unique<FdCanChannel>(sv[0], "socketpair"), CanRigConfig{1, 100, 20, 0.5, "sim over can"});
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.arm(true));
+  const RigSample s = move_to(rig, 1.5);
+  CHECK(s.displacement_mm == doctest::Approx(1.5).epsilon(0.01));
+  CHECK(s.force_N > 40.0);
+  REQUIRE(sim.control("fault can-silent").rfind("ok", 0) == 0);
+  sleep_ms(30);
+  RigSample t;
+  std::error_code ec;
+  ec = rig.read_sample(steady_now(), t);  // what was queued before the fault is still the newest sample
+  if (!ec) ec = rig.read_sample(steady_now(), t);
+  CHECK(ec == RigError::timeout);
+  REQUIRE(sim.control("clear").rfind("ok", 0) == 0);
+  CHECK_FALSE(read_until_ok(rig, t));
+  CHECK(rig.health().errors_of(RigError::timeout) >= 1);
+}
+
+TEST_CASE("can: opening a real interface fails with a message that says why") {
+  try {
+    (void)open_socketcan("hystlabnope0");
+    FAIL("opening a CAN interface that does not exist must throw");
+  } catch (const std::system_error& e) {
+    const std::string what = e.what();
+    CAPTURE(what);
+    CHECK(what.find("cannot open CAN interface 'hystlabnope0'") != std::string::npos);
+    // On this machine's kernel (no AF_CAN) the reason is named explicitly.
+    if (e.code().value() == EAFNOSUPPORT) CHECK(what.find("no SocketCAN support") != std::string::npos);
+  }
+}
+
+TEST_CASE("shaker over modbus: base excitation moves the mass") {
+  SimProcess sim({"--rig", "shaker", "--port", "0"});
+  ModbusRigConfig c = tcp_config(sim.modbus_port, protocols::kDefaultShakerMap);
+  ModbusRig rig(c);
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.command_shaker(10.0, 0.5, true));
+  double base_max = 0, mass_max = 0;
+  ShakerSample s;
+  for (int k = 0; k < 150; ++k) {
+    REQUIRE_FALSE(rig.read_shaker(steady_now(), s));
+    base_max = std::max(base_max, std::fabs(s.base_displacement_mm));
+    mass_max = std::max(mass_max, std::fabs(s.mass_displacement_mm));
+    sleep_ms(2);
+  }
+  CHECK(base_max == doctest::Approx(0.5).epsilon(0.05));
+  CHECK(mass_max > 0.1);
+  RigSample r;
+  CHECK(rig.read_sample(steady_now(), r) == RigError::unsupported);
+}
