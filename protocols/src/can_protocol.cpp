@@ -92,7 +92,8 @@ std::error_code encode(const Message& m, int node, can_frame& f) noexcept {
 }
 
 std::error_code decode(const can_frame& f, int node, Message& out) noexcept {
-  if (f.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_ERR_FLAG)) return ProtocolError::unknown_id;
+  // Anything beyond an 11-bit identifier (extended, RTR and error flags, stray high bits) is not ours.
+  if (f.can_id & ~static_cast<canid_t>(CAN_SFF_MASK)) return ProtocolError::unknown_id;
   const std::uint32_t id = f.can_id & CAN_SFF_MASK;
   if (node < 1 || node > 127 || (id & 0x7FU) != static_cast<std::uint32_t>(node)) return ProtocolError::unknown_id;
   auto need = [&](int dlc) { return f.can_dlc == dlc; };

@@ -148,6 +148,9 @@ TEST_CASE("CAN: malformed frames are typed decode errors") {
   CHECK(can::decode(g, 1, m) == ProtocolError::unknown_id);
   CHECK(can::decode(f, 2, m) == ProtocolError::unknown_id);  // another node's frame
   g = f;
+  g.can_id = 0x00EA1181;  // stray bits above the 11-bit identifier (found by the fuzzer)
+  CHECK(can::decode(g, 1, m) == ProtocolError::unknown_id);
+  g = f;
   g.can_id |= CAN_RTR_FLAG;
   CHECK(can::decode(g, 1, m) == ProtocolError::unknown_id);
   REQUIRE_FALSE(can::encode(can::Command{}, 1, f));
