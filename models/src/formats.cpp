@@ -38,6 +38,9 @@ std::string text_or_empty(const json& j, const char* name) {
 }
 }  // namespace
 
+TableDocument parse_table(std::string_view text);
+SmaParameters parse_params(std::string_view text);
+
 json table_to_json(const EverettTable& t, const TableProvenance& p) {
   const Grid& g = t.grid();
   json nodes = json::array(), rows = json::array();
@@ -61,6 +64,14 @@ json table_to_json(const EverettTable& t, const TableProvenance& p) {
 }
 
 TableDocument table_from_json(std::string_view text) {
+  try {
+    return parse_table(text);
+  } catch (const nlohmann::json::exception& e) {  // a number too large, a field of the wrong type, ...
+    throw FormatError(std::string("table: malformed (") + e.what() + ")");
+  }
+}
+
+TableDocument parse_table(std::string_view text) {
   const std::string what = "table";
   const json j = parse(text, what);
   const json& fmt = field(j, "format", what);
@@ -134,6 +145,14 @@ json params_to_json(const SmaParameters& p, const std::string& source) {
 }
 
 SmaParameters params_from_json(std::string_view text) {
+  try {
+    return parse_params(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw FormatError(std::string("parameters: malformed (") + e.what() + ")");
+  }
+}
+
+SmaParameters parse_params(std::string_view text) {
   const std::string what = "parameters";
   const json j = parse(text, what);
   if (const auto m = j.find("model"); m != j.end() && (!m->is_string() || m->get<std::string>() != kParamsModel))

@@ -87,6 +87,14 @@ MapEntry parse_entry(Signal s, const json& j) {
 int MapEntry::width() const noexcept { return type == ValueType::int32 || type == ValueType::uint32 || type == ValueType::float32 ? 2 : 1; }
 
 RegisterMap RegisterMap::from_json(std::string_view text) {
+  try {
+    return parse_map(text);
+  } catch (const json::exception& e) {  // a number too large, a field of the wrong type, ...
+    fail(std::string("malformed (") + e.what() + ")");
+  }
+}
+
+RegisterMap RegisterMap::parse_map(std::string_view text) {
   json j;
   try {
     j = json::parse(text.begin(), text.end());
@@ -94,10 +102,10 @@ RegisterMap RegisterMap::from_json(std::string_view text) {
     fail(std::string("not valid JSON (") + e.what() + ")");
   }
   if (!j.is_object()) fail("the document is not a JSON object");
-  if (j.value("format", std::string()) != "hystlab-modbus-map") fail("'format' must be \"hystlab-modbus-map\"");
+  if (!j.contains("format") || j["format"] != "hystlab-modbus-map") fail("'format' must be \"hystlab-modbus-map\"");
   if (!j.contains("version") || j["version"] != 1) fail("unknown version " + j.value("version", json()).dump() + " (this hystlab reads version 1)");
   RegisterMap m;
-  m.name_ = j.value("name", std::string("unnamed"));
+  m.name_ = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : "unnamed";
   if (j.contains("rig"))
     m.kind_ = pick<RigKind>(j["rig"], "rig", {{"load_frame", RigKind::load_frame}, {"shaker", RigKind::shaker}});
   if (j.contains("slave_id")) {

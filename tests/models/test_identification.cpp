@@ -161,6 +161,10 @@ TEST_CASE("table format: round trip and errors naming the field") {
   bad = j;
   bad["rows"][3][1] = "x";
   CHECK_THROWS_WITH((void)table_from_json(bad.dump()), doctest::Contains("rows[3][1]"));
+  CHECK_THROWS_AS((void)table_from_json(R"({"format": "hystlab-everett-table", "version": 1, "range_mm": [0, 1e999]})"), FormatError);
+  bad = j;
+  bad["units"] = {{"displacement", 5}};
+  CHECK_THROWS_AS((void)table_from_json(bad.dump()), FormatError);
   bad = j;
   bad["format"] = "other";
   CHECK_THROWS_WITH((void)table_from_json(bad.dump()), doctest::Contains("'format'"));

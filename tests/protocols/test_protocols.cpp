@@ -106,6 +106,11 @@ TEST_CASE("register maps: a bad map is rejected with the field named") {
   expect([](auto& j) { j["signals"]["force_N"]["word_order"] = "little"; }, "signals.force_N.word_order");
   expect([](auto& j) { j["version"] = 9; }, "unknown version 9");
   CHECK_THROWS_WITH_AS((void)RegisterMap::from_json("{oops"), doctest::Contains("not valid JSON"), MapError);
+  // found by the fuzzer: numbers too large for a double, fields of the wrong type
+  CHECK_THROWS_AS((void)RegisterMap::from_json(R"({"format": "hystlab-modbus-map", "version": 6e666})"), MapError);
+  CHECK_THROWS_AS((void)RegisterMap::from_json(R"({"format": 3, "version": 1})"), MapError);
+  expect([](auto& j) { j["name"] = 7; j["signals"]["force_N"]["unit"] = 3; j["signals"]["force_N"]["address"] = "two"; },
+         "signals.force_N.address");
 }
 
 TEST_CASE("CAN: every frame encodes byte for byte and decodes back") {

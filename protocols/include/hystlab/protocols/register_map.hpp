@@ -59,6 +59,7 @@ class RegisterMap {
   [[nodiscard]] const std::vector<ReadBlock>& measurement_blocks() const noexcept { return blocks_; }
 
  private:
+  static RegisterMap parse_map(std::string_view text);
   std::string name_;
   RigKind kind_ = RigKind::load_frame;
   int slave_id_ = 1;
