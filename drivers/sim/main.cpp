@@ -156,8 +156,9 @@ int run(const Args& a) {
   bool was_dropping = false;
   std::vector<int> fds;
   std::vector<pollfd> pfds;
-  while (!g_stop && (a.duration <= 0 || wall() < a.duration)) {
-    const double now = wall();
+  // Brings the physics up to now and publishes it: before every wait, and again right before
+  // answering, so an answer never carries values older than the request.
+  auto advance = [&](double now) {
     sim_due += (now - last) * a.time_scale;
     last = now;
     for (int guard = 0; sim_due >= sample_dt && guard < 100000; ++guard) {
@@ -165,9 +166,15 @@ int run(const Args& a) {
       sim_due -= sample_dt;
     }
     const sim::SignalValues m = rig.measurements(faults);
-    if (!faults.freeze) {
-      if (modbus) modbus->publish(m);
-    }
+    if (modbus && !faults.freeze) modbus->publish(m);
+    return m;
+  };
+  // CAN sends cyclic frames, so it wakes every millisecond; Modbus only answers, so it sleeps
+  // until a request comes (or 50 ms pass, to keep the physics' catch-up short).
+  const int wait_ms = can ? 1 : 50;
+  while (!g_stop && (a.duration <= 0 || wall() < a.duration)) {
+    const double now = wall();
+    const sim::SignalValues m = advance(now);
     if (faults.drop && !was_dropping && modbus) modbus->drop_clients();
     was_dropping = faults.drop;
     if (can) can->maybe_send(now, m, rig.kind(), faults.freeze ? sim::Faults{.can_silent = true} : faults);
@@ -177,7 +184,8 @@ int run(const Args& a) {
     control.fds(fds);
     pfds.clear();
     for (int fd : fds) pfds.push_back(pollfd{fd, POLLIN, 0});
-    if (poll(pfds.data(), pfds.size(), 1) <= 0) continue;
+    if (poll(pfds.data(), pfds.size(), wait_ms) <= 0) continue;
+    if (modbus) advance(wall());
     for (const pollfd& p : pfds) {
       if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;
       if (control.owns(p.fd)) {
