@@ -9,6 +9,7 @@
 
 #include "hystlab/drivers/can_rig.hpp"
 #include "hystlab/drivers/modbus_rig.hpp"
+#include "hystlab/drivers/rig_factory.hpp"
 #include "hystlab/protocols/default_maps.hpp"
 #include "sim_process.hpp"
 
@@ -229,4 +230,30 @@ TEST_CASE("shaker over modbus: base excitation moves the mass") {
   CHECK(mass_max > 0.1);
   RigSample r;
   CHECK(rig.read_sample(steady_now(), r) == RigError::unsupported);
+}
+
+TEST_CASE("rigs from configuration: a simulated rig is only a different address") {
+  SimProcess sim({"--port", "0", "--noise", "0"});
+  const nlohmann::json cfg = {{"name", "frame A"}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"},
+                              {"port", sim.modbus_port}, {"map", "default"}, {"response_timeout_ms", 50}};
+  const auto rig = make_rig(cfg, "rigs[0]");
+  REQUIRE_FALSE(rig->connect(steady_now()));
+  RigSample s;
+  CHECK_FALSE(rig->read_sample(steady_now(), s));
+  CHECK(rig->describe().find("frame A") != std::string::npos);
+  auto bad = [&](nlohmann::json j, const char* needle) {
+    CAPTURE(needle);
+    CHECK_THROWS_WITH_AS((void)make_rig(j, "rigs[1]"), doctest::Contains(needle), RigConfigError);
+  };
+  bad({{"transport", "modbus-udp"}}, "rigs[1].transport must be");
+  bad({{"transport", "modbus-tcp"}, {"port", 70000}}, "rigs[1].port must be an integer from 1 to 65535");
+  bad({{"transport", "modbus-rtu"}}, "rigs[1].device is required");
+  bad({{"transport", "modbus-tcp"}, {"map", "no/such/map.json"}}, "rigs[1].map names a file that cannot be opened");
+  bad({{"transport", "modbus-tcp"}, {"map", {{"format", "x"}}}}, "rigs[1].map is not usable");
+  bad({{"transport", "modbus-tcp"}, {"rig", "shaker"}, {"map", nlohmann::json::parse(protocols::kDefaultLoadFrameMap)}},
+      "is for another kind of rig");
+  bad({{"transport", "can"}}, "exactly one is required");
+  bad({{"transport", "modbus-tcp"}, {"baudrate", 9600}}, "rigs[1].baudrate is not a known field");
+  CHECK_THROWS_WITH_AS((void)make_rig({{"transport", "can"}, {"can_interface", "hystlabnope0"}}),
+                       doctest::Contains("cannot open CAN interface"), std::system_error);
 }
