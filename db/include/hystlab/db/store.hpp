@@ -1,0 +1,77 @@
+#pragma once
+// The hystlab store: one SQLite file holding rigs, campaigns with their events, runs, samples,
+// FOT nodes, tables and I/O statistics. One Store per thread (WAL: readers never block the writer).
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "hystlab/db/sqlite.hpp"
+
+namespace hystlab::db {
+
+inline constexpr std::int64_t kBlockSize = 1024;  // samples per summary block
+
+struct SampleRow {
+  std::int64_t run_id = 0, seq = 0;
+  double t = 0, cmd = 0, disp = 0, force = 0;
+  std::int64_t status = 0;
+};
+
+struct Bucket {  // min/max of one stretch of a run: no peak is lost by decimation
+  double t_min = 0, t_max = 0, disp_min = 0, disp_max = 0, force_min = 0, force_max = 0;
+  std::int64_t n = 0;
+};
+
+struct CampaignRow {
+  std::int64_t id = 0, rig_id = 0;
+  std::string kind, plan, state, created_at, updated_at;
+};
+
+struct EventRow {
+  std::int64_t id = 0;
+  std::string at, kind, from_state, to_state, detail;
+};
+
+class Store {
+ public:
+  explicit Store(const std::string& path, bool synchronous_full = true);  // opens and migrates
+  [[nodiscard]] Database& database() noexcept { return db_; }
+
+  std::int64_t upsert_rig(const std::string& name, const std::string& config_json, const std::string& now);
+  std::int64_t create_campaign(std::int64_t rig_id, const std::string& kind, const std::string& plan_json,
+                               const std::string& now);
+  // Updates the state and records the transition as an event, in one transaction.
+  void transition(std::int64_t campaign_id, const std::string& to, const std::string& reason, const std::string& now);
+  std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s);
+  void end_run(std::int64_t run_id, const std::string& state, const std::string& now);
+  std::int64_t add_fot_node(std::int64_t run_id, double alpha, double beta, double f_alpha, double f_alpha_beta, double t);
+  std::int64_t add_table(std::optional<std::int64_t> campaign_id, std::optional<std::int64_t> run_id,
+                         const std::string& method, int n, double lo, double hi, const std::string& now,
+                         const std::string& accuracy_json, const std::string& document_json);
+  // At start-up: every campaign left arming, running or paused by a crash becomes interrupted.
+  int mark_interrupted(const std::string& now);
+
+  // Inserts rows and their block summaries; the caller holds the transaction.
+  void insert_samples(std::span<const SampleRow> rows);
+
+  [[nodiscard]] std::optional<CampaignRow> campaign(std::int64_t id);
+  [[nodiscard]] std::vector<CampaignRow> campaigns();
+  [[nodiscard]] std::vector<EventRow> events(std::int64_t campaign_id);
+  [[nodiscard]] std::int64_t sample_count(std::int64_t run_id);
+  [[nodiscard]] std::int64_t max_seq(std::int64_t run_id);  // -1 when none
+  // Decimated overview of [t0, t1] in at most `buckets` buckets (blocks when the range is long,
+  // raw samples when it is short).
+  [[nodiscard]] std::vector<Bucket> overview(std::int64_t run_id, double t0, double t1, int buckets);
+  void for_each_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1,
+                       const std::function<void(const SampleRow&)>& f);
+  [[nodiscard]] std::string integrity_check();
+
+ private:
+  Database db_;
+  Statement insert_sample_, upsert_block_;
+};
+
+}  // namespace hystlab::db

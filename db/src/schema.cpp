@@ -1,0 +1,71 @@
+#include "hystlab/db/schema.hpp"
+
+#include <string>
+
+namespace hystlab::db {
+namespace {
+// Migration k takes the file from version k to k + 1. Append only; never edit a shipped step.
+constexpr const char* kMigrations[] = {
+    R"sql(
+CREATE TABLE rigs(
+  id INTEGER PRIMARY KEY, name TEXT NOT NULL UNIQUE, config TEXT NOT NULL, created_at TEXT NOT NULL);
+CREATE TABLE campaigns(
+  id INTEGER PRIMARY KEY, rig_id INTEGER NOT NULL REFERENCES rigs(id), kind TEXT NOT NULL,
+  plan TEXT NOT NULL, state TEXT NOT NULL, created_at TEXT NOT NULL, updated_at TEXT NOT NULL);
+CREATE INDEX campaigns_by_state ON campaigns(state);
+CREATE TABLE runs(
+  id INTEGER PRIMARY KEY, campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
+  started_at TEXT NOT NULL, wall_anchor_unix REAL NOT NULL, monotonic_anchor_s REAL NOT NULL,
+  ended_at TEXT, state TEXT NOT NULL);
+CREATE TABLE events(
+  id INTEGER PRIMARY KEY, campaign_id INTEGER REFERENCES campaigns(id), run_id INTEGER REFERENCES runs(id),
+  at TEXT NOT NULL, t REAL, kind TEXT NOT NULL, from_state TEXT, to_state TEXT, detail TEXT);
+CREATE INDEX events_by_campaign ON events(campaign_id, id);
+-- Samples are clustered by run and sequence: a run's samples are one contiguous range.
+CREATE TABLE samples(
+  run_id INTEGER NOT NULL, seq INTEGER NOT NULL, t REAL NOT NULL, cmd REAL, disp REAL, force REAL,
+  status INTEGER, PRIMARY KEY(run_id, seq)) WITHOUT ROWID;
+-- min/max per block of 1024 samples, written with them: overviews read 1/1024 of the rows.
+CREATE TABLE sample_blocks(
+  run_id INTEGER NOT NULL, block INTEGER NOT NULL, n INTEGER NOT NULL, t_min REAL, t_max REAL,
+  disp_min REAL, disp_max REAL, force_min REAL, force_max REAL, PRIMARY KEY(run_id, block)) WITHOUT ROWID;
+CREATE TABLE fot_nodes(
+  id INTEGER PRIMARY KEY, run_id INTEGER NOT NULL REFERENCES runs(id), alpha REAL NOT NULL, beta REAL NOT NULL,
+  force_alpha REAL NOT NULL, force_alpha_beta REAL NOT NULL, t REAL);
+CREATE INDEX fot_nodes_by_run ON fot_nodes(run_id, id);
+CREATE TABLE tables(
+  id INTEGER PRIMARY KEY, campaign_id INTEGER REFERENCES campaigns(id), run_id INTEGER REFERENCES runs(id),
+  method TEXT NOT NULL, n INTEGER NOT NULL, range_lo REAL NOT NULL, range_hi REAL NOT NULL,
+  created_at TEXT NOT NULL, accuracy TEXT, document TEXT NOT NULL);
+CREATE TABLE transmissibility(
+  id INTEGER PRIMARY KEY, run_id INTEGER NOT NULL REFERENCES runs(id), frequency_hz REAL NOT NULL,
+  base_amplitude_mm REAL, mass_amplitude_mm REAL, ratio REAL, phase_rad REAL);
+CREATE TABLE io_stats(
+  id INTEGER PRIMARY KEY, rig_id INTEGER REFERENCES rigs(id), at TEXT NOT NULL, stats TEXT NOT NULL);
+)sql",
+};
+constexpr int kMigrationCount = static_cast<int>(sizeof kMigrations / sizeof kMigrations[0]);
+static_assert(kMigrationCount == kSchemaVersion);
+}  // namespace
+
+int schema_version(Database& db) {
+  Statement st(db, "PRAGMA user_version");
+  st.step();
+  return static_cast<int>(st.column_int(0));
+}
+
+void migrate(Database& db) {
+  const int v = schema_version(db);
+  if (v > kSchemaVersion)
+    throw DbError("database '" + db.path() + "' has schema version " + std::to_string(v) + ", newer than this hystlab (" +
+                      std::to_string(kSchemaVersion) + "): refusing to touch it",
+                  0);
+  for (int k = v; k < kSchemaVersion; ++k) {
+    Transaction tx(db);
+    db.exec(kMigrations[k]);
+    db.exec("PRAGMA user_version=" + std::to_string(k + 1));
+    tx.commit();
+  }
+}
+
+}  // namespace hystlab::db

@@ -1,0 +1,231 @@
+#include "hystlab/db/store.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "hystlab/db/schema.hpp"
+
+namespace hystlab::db {
+namespace {
+Database& migrated(Database& db) {
+  migrate(db);
+  return db;
+}
+
+struct BlockDelta {
+  std::int64_t n = 0;
+  double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min, d_min = t_min, d_max = -t_min,
+         f_min = t_min, f_max = -t_min;
+  void add(const SampleRow& r) {
+    ++n;
+    t_min = std::min(t_min, r.t), t_max = std::max(t_max, r.t);
+    d_min = std::min(d_min, r.disp), d_max = std::max(d_max, r.disp);
+    f_min = std::min(f_min, r.force), f_max = std::max(f_max, r.force);
+  }
+};
+
+void merge(Bucket& b, double t0, double t1, double d0, double d1, double f0, double f1, std::int64_t n) {
+  if (b.n == 0) b = Bucket{t0, t1, d0, d1, f0, f1, 0};
+  b.t_min = std::min(b.t_min, t0), b.t_max = std::max(b.t_max, t1);
+  b.disp_min = std::min(b.disp_min, d0), b.disp_max = std::max(b.disp_max, d1);
+  b.force_min = std::min(b.force_min, f0), b.force_max = std::max(b.force_max, f1);
+  b.n += n;
+}
+}  // namespace
+
+Store::Store(const std::string& path, bool synchronous_full)
+    : db_(path, synchronous_full),
+      insert_sample_(migrated(db_), "INSERT INTO samples(run_id, seq, t, cmd, disp, force, status) VALUES(?,?,?,?,?,?,?)"),
+      upsert_block_(db_,
+                    "INSERT INTO sample_blocks(run_id, block, n, t_min, t_max, disp_min, disp_max, force_min, force_max) "
+                    "VALUES(?,?,?,?,?,?,?,?,?) ON CONFLICT(run_id, block) DO UPDATE SET n = n + excluded.n, "
+                    "t_min = min(t_min, excluded.t_min), t_max = max(t_max, excluded.t_max), "
+                    "disp_min = min(disp_min, excluded.disp_min), disp_max = max(disp_max, excluded.disp_max), "
+                    "force_min = min(force_min, excluded.force_min), force_max = max(force_max, excluded.force_max)") {}
+
+std::int64_t Store::upsert_rig(const std::string& name, const std::string& config, const std::string& now) {
+  Statement st(db_, "INSERT INTO rigs(name, config, created_at) VALUES(?,?,?) "
+                    "ON CONFLICT(name) DO UPDATE SET config = excluded.config RETURNING id");
+  st.bind(1, name).bind(2, config).bind(3, now);
+  st.step();
+  return st.column_int(0);
+}
+
+std::int64_t Store::create_campaign(std::int64_t rig, const std::string& kind, const std::string& plan, const std::string& now) {
+  Transaction tx(db_);
+  Statement st(db_, "INSERT INTO campaigns(rig_id, kind, plan, state, created_at, updated_at) VALUES(?,?,?,'queued',?,?)");
+  st.bind(1, rig).bind(2, kind).bind(3, plan).bind(4, now).bind(5, now);
+  st.step();
+  const std::int64_t id = db_.last_insert_rowid();
+  Statement ev(db_, "INSERT INTO events(campaign_id, at, kind, to_state, detail) VALUES(?,?,'state',?,'submitted')");
+  ev.bind(1, id).bind(2, now).bind(3, std::string_view("queued"));
+  ev.step();
+  tx.commit();
+  return id;
+}
+
+void Store::transition(std::int64_t id, const std::string& to, const std::string& reason, const std::string& now) {
+  Transaction tx(db_);
+  Statement cur(db_, "SELECT state FROM campaigns WHERE id = ?");
+  cur.bind(1, id);
+  if (!cur.step()) throw DbError("no campaign " + std::to_string(id), 0);
+  const std::string from = cur.column_text(0);
+  Statement up(db_, "UPDATE campaigns SET state = ?, updated_at = ? WHERE id = ?");
+  up.bind(1, to).bind(2, now).bind(3, id);
+  up.step();
+  Statement ev(db_, "INSERT INTO events(campaign_id, at, kind, from_state, to_state, detail) VALUES(?,?,'state',?,?,?)");
+  ev.bind(1, id).bind(2, now).bind(3, from).bind(4, to).bind(5, reason);
+  ev.step();
+  tx.commit();
+}
+
+std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, double wall, double mono) {
+  Statement st(db_, "INSERT INTO runs(campaign_id, started_at, wall_anchor_unix, monotonic_anchor_s, state) VALUES(?,?,?,?,'running')");
+  st.bind(1, campaign).bind(2, now).bind(3, wall).bind(4, mono);
+  st.step();
+  return db_.last_insert_rowid();
+}
+
+void Store::end_run(std::int64_t run, const std::string& state, const std::string& now) {
+  Statement st(db_, "UPDATE runs SET state = ?, ended_at = ? WHERE id = ?");
+  st.bind(1, state).bind(2, now).bind(3, run);
+  st.step();
+}
+
+std::int64_t Store::add_fot_node(std::int64_t run, double a, double b, double fa, double fab, double t) {
+  Statement st(db_, "INSERT INTO fot_nodes(run_id, alpha, beta, force_alpha, force_alpha_beta, t) VALUES(?,?,?,?,?,?)");
+  st.bind(1, run).bind(2, a).bind(3, b).bind(4, fa).bind(5, fab).bind(6, t);
+  st.step();
+  return db_.last_insert_rowid();
+}
+
+std::int64_t Store::add_table(std::optional<std::int64_t> campaign, std::optional<std::int64_t> run, const std::string& method,
+                              int n, double lo, double hi, const std::string& now, const std::string& accuracy,
+                              const std::string& document) {
+  Statement st(db_, "INSERT INTO tables(campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy, document) "
+                    "VALUES(?,?,?,?,?,?,?,?,?)");
+  campaign ? st.bind(1, *campaign) : st.bind_null(1);
+  run ? st.bind(2, *run) : st.bind_null(2);
+  st.bind(3, method).bind(4, n).bind(5, lo).bind(6, hi).bind(7, now).bind(8, accuracy).bind(9, document);
+  st.step();
+  return db_.last_insert_rowid();
+}
+
+int Store::mark_interrupted(const std::string& now) {
+  std::vector<std::int64_t> ids;
+  {
+    Statement st(db_, "SELECT id FROM campaigns WHERE state IN ('arming', 'running', 'paused')");
+    while (st.step()) ids.push_back(st.column_int(0));
+  }
+  for (auto id : ids) transition(id, "interrupted", "the daemon stopped without finishing it", now);
+  Statement runs(db_, "UPDATE runs SET state = 'interrupted', ended_at = ? WHERE state = 'running'");
+  runs.bind(1, now);
+  runs.step();
+  return static_cast<int>(ids.size());
+}
+
+void Store::insert_samples(std::span<const SampleRow> rows) {
+  std::map<std::pair<std::int64_t, std::int64_t>, BlockDelta> blocks;
+  for (const SampleRow& r : rows) {
+    insert_sample_.reset();
+    insert_sample_.bind(1, r.run_id).bind(2, r.seq).bind(3, r.t).bind(4, r.cmd).bind(5, r.disp).bind(6, r.force).bind(7, r.status);
+    insert_sample_.step();
+    blocks[{r.run_id, r.seq / kBlockSize}].add(r);
+  }
+  for (const auto& [key, b] : blocks) {
+    upsert_block_.reset();
+    upsert_block_.bind(1, key.first).bind(2, key.second).bind(3, b.n).bind(4, b.t_min).bind(5, b.t_max);
+    upsert_block_.bind(6, b.d_min).bind(7, b.d_max).bind(8, b.f_min).bind(9, b.f_max);
+    upsert_block_.step();
+  }
+}
+
+std::optional<CampaignRow> Store::campaign(std::int64_t id) {
+  Statement st(db_, "SELECT id, rig_id, kind, plan, state, created_at, updated_at FROM campaigns WHERE id = ?");
+  st.bind(1, id);
+  if (!st.step()) return std::nullopt;
+  return CampaignRow{st.column_int(0), st.column_int(1), st.column_text(2), st.column_text(3), st.column_text(4), st.column_text(5), st.column_text(6)};
+}
+
+std::vector<CampaignRow> Store::campaigns() {
+  std::vector<CampaignRow> out;
+  Statement st(db_, "SELECT id, rig_id, kind, plan, state, created_at, updated_at FROM campaigns ORDER BY id");
+  while (st.step())
+    out.push_back({st.column_int(0), st.column_int(1), st.column_text(2), st.column_text(3), st.column_text(4), st.column_text(5), st.column_text(6)});
+  return out;
+}
+
+std::vector<EventRow> Store::events(std::int64_t campaign) {
+  std::vector<EventRow> out;
+  Statement st(db_, "SELECT id, at, kind, from_state, to_state, detail FROM events WHERE campaign_id = ? ORDER BY id");
+  st.bind(1, campaign);
+  while (st.step()) out.push_back({st.column_int(0), st.column_text(1), st.column_text(2), st.column_text(3), st.column_text(4), st.column_text(5)});
+  return out;
+}
+
+std::int64_t Store::sample_count(std::int64_t run) {
+  Statement st(db_, "SELECT coalesce(sum(n), 0) FROM sample_blocks WHERE run_id = ?");
+  st.bind(1, run);
+  st.step();
+  return st.column_int(0);
+}
+
+std::int64_t Store::max_seq(std::int64_t run) {
+  Statement st(db_, "SELECT coalesce(max(seq), -1) FROM samples WHERE run_id = ?");
+  st.bind(1, run);
+  st.step();
+  return st.column_int(0);
+}
+
+std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int buckets) {
+  std::vector<Bucket> out(static_cast<std::size_t>(std::max(1, buckets)));
+  const double span = t1 > t0 ? t1 - t0 : 1.0;
+  auto slot = [&](double t) {
+    const auto k = static_cast<long>((t - t0) / span * static_cast<double>(out.size()));
+    return static_cast<std::size_t>(std::clamp<long>(k, 0, static_cast<long>(out.size()) - 1));
+  };
+  Statement blocks(db_, "SELECT block, n, t_min, t_max, disp_min, disp_max, force_min, force_max FROM sample_blocks "
+                        "WHERE run_id = ? AND t_max >= ? AND t_min <= ? ORDER BY block");
+  blocks.bind(1, run).bind(2, t0).bind(3, t1);
+  std::int64_t first = -1, last = -1, total = 0;
+  std::vector<Bucket> from_blocks(out.size());
+  while (blocks.step()) {
+    const std::int64_t b = blocks.column_int(0);
+    if (first < 0) first = b;
+    last = b;
+    total += blocks.column_int(1);
+    const double tm = 0.5 * (blocks.column_double(2) + blocks.column_double(3));
+    merge(from_blocks[slot(tm)], blocks.column_double(2), blocks.column_double(3), blocks.column_double(4),
+          blocks.column_double(5), blocks.column_double(6), blocks.column_double(7), blocks.column_int(1));
+  }
+  if (first < 0) return {};
+  const std::int64_t nblocks = last - first + 1;
+  // At least two blocks per bucket (or too many raw rows to read): the block summaries answer.
+  if (nblocks >= 2 * static_cast<std::int64_t>(out.size()) || total > 2'000'000) {
+    std::erase_if(from_blocks, [](const Bucket& b) { return b.n == 0; });
+    return from_blocks;
+  }
+  for_each_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const SampleRow& r) {
+    if (r.t >= t0 && r.t <= t1) merge(out[slot(r.t)], r.t, r.t, r.disp, r.disp, r.force, r.force, 1);
+  });
+  std::erase_if(out, [](const Bucket& b) { return b.n == 0; });
+  return out;
+}
+
+void Store::for_each_sample(std::int64_t run, std::int64_t seq0, std::int64_t seq1, const std::function<void(const SampleRow&)>& f) {
+  Statement st(db_, "SELECT seq, t, cmd, disp, force, status FROM samples WHERE run_id = ? AND seq BETWEEN ? AND ? ORDER BY seq");
+  st.bind(1, run).bind(2, seq0).bind(3, seq1);
+  while (st.step())
+    f(SampleRow{run, st.column_int(0), st.column_double(1), st.column_double(2), st.column_double(3), st.column_double(4), st.column_int(5)});
+}
+
+std::string Store::integrity_check() {
+  Statement st(db_, "PRAGMA integrity_check");
+  std::string out;
+  while (st.step()) out += (out.empty() ? "" : "; ") + st.column_text(0);
+  return out;
+}
+
+}  // namespace hystlab::db
