@@ -20,6 +20,11 @@ SampleWriter::~SampleWriter() {
   thread_.join();
 }
 
+void SampleWriter::post(std::function<void(Store&)> job) {
+  std::lock_guard lk(mu_);
+  jobs_.push_back(std::move(job));
+}
+
 void SampleWriter::flush() {
   std::unique_lock lk(mu_);
   const std::uint64_t ticket = ++flush_requested_;
@@ -86,6 +91,20 @@ void SampleWriter::run() {
       if (batch.size() < opt_.max_batch) ring_.drain(batch, opt_.max_batch - batch.size());
       if (batch.empty()) break;
       ok = write_batch(batch, store);
+    }
+    std::deque<std::function<void(Store&)>> jobs;
+    {
+      std::lock_guard lk(mu_);
+      jobs.swap(jobs_);
+    }
+    for (auto& job : jobs) {
+      try {
+        job(store);
+      } catch (const std::exception& e) {
+        errors_.fetch_add(1);
+        std::lock_guard lk(mu_);
+        last_error_ = e.what();
+      }
     }
     {
       std::lock_guard lk(mu_);

@@ -94,6 +94,13 @@ void Store::end_run(std::int64_t run, const std::string& state, const std::strin
   st.step();
 }
 
+std::int64_t Store::add_event(std::int64_t campaign, const std::string& kind, const std::string& detail, const std::string& now) {
+  Statement st(db_, "INSERT INTO events(campaign_id, at, kind, detail) VALUES(?,?,?,?)");
+  st.bind(1, campaign).bind(2, now).bind(3, kind).bind(4, detail);
+  st.step();
+  return db_.last_insert_rowid();
+}
+
 std::int64_t Store::add_fot_node(std::int64_t run, double a, double b, double fa, double fab, double t) {
   Statement st(db_, "INSERT INTO fot_nodes(run_id, alpha, beta, force_alpha, force_alpha_beta, t) VALUES(?,?,?,?,?,?)");
   st.bind(1, run).bind(2, a).bind(3, b).bind(4, fa).bind(5, fab).bind(6, t);

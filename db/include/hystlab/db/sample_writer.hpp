@@ -5,6 +5,8 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -45,7 +47,10 @@ class SampleWriter {
     dropped_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
-  // Blocks until every row pushed before the call is committed (not for the acquisition thread).
+  // Other writes (events, FOT nodes, evaluations) run on the writer thread after the samples
+  // queued before them, so the caller never waits on the disk. Brief lock, no I/O.
+  void post(std::function<void(Store&)> job);
+  // Blocks until every row pushed (and job posted) before the call is done (not for the acquisition thread).
   void flush();
   [[nodiscard]] WriterStats stats() const;
 
@@ -64,6 +69,7 @@ class SampleWriter {
   bool stop_ = false;
   std::uint64_t flush_requested_ = 0, flush_done_ = 0;
   std::string last_error_;
+  std::deque<std::function<void(Store&)>> jobs_;
   std::thread thread_;
 };
 

@@ -1,0 +1,41 @@
+#pragma once
+// Campaign plans (JSON, validated at submission; an error names the field and the reason).
+//   {"kind": "fot", "range_mm": [0, 4], "subdivisions": 12, "ramp_rate_mm_s": 0.5, "dwell_s": 0.2,
+//    "sample_rate_hz": 1000, "repeats": 1, "training_cycles": 2,
+//    "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 300, "rate_mm_s": 5}}
+//   {"kind": "waveform", "points_mm": [0, 2, 1, 3, 0], "ramp_rate_mm_s": 0.5, ...}
+// Times are rig time (a simulated rig's time scale is applied by the daemon).
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace hystlab::daemon {
+
+struct PlanError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+struct Limits {
+  double displacement_min_mm = -1.0, displacement_max_mm = 10.0;
+  double force_max_N = 1000.0;  // |force|
+  double rate_max_mm_s = 20.0;  // measured |velocity|
+  double safe_position_mm = 0.0, safe_rate_mm_s = 1.0;
+};
+
+struct Plan {
+  std::string kind;  // "fot" or "waveform"
+  // fot
+  double lo_mm = 0, hi_mm = 0;
+  int subdivisions = 0, repeats = 1, training_cycles = 0;
+  // waveform
+  std::vector<double> points_mm;
+  // common
+  double ramp_rate_mm_s = 0.5, dwell_s = 0.0, sample_rate_hz = 1000.0;
+  Limits limits;
+  nlohmann::json source;  // the plan as submitted
+};
+
+[[nodiscard]] Plan parse_plan(const nlohmann::json& j);  // throws PlanError
+
+}  // namespace hystlab::daemon

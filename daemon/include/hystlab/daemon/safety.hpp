@@ -1,0 +1,45 @@
+#pragma once
+// The safety envelope, independent of the plan's input: displacement, force and rate limits on
+// every sample, and a watchdog on fresh samples. Pure: the runner acts on what they say.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "hystlab/daemon/plan.hpp"
+
+namespace hystlab::daemon {
+
+class SafetyEnvelope {
+ public:
+  explicit SafetyEnvelope(Limits limits) : l_(limits) {}
+  // A reason to trip, or nothing. dt: rig seconds since the previous sample.
+  [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double dt_s);
+  [[nodiscard]] const Limits& limits() const noexcept { return l_; }
+
+ private:
+  Limits l_;
+  double prev_x_ = 0;
+  bool have_prev_ = false;
+};
+
+// No fresh sample (a read error, or a sample counter that did not move) for hold_after periods:
+// hold; for fail_after periods: fail.
+class Watchdog {
+ public:
+  enum class Verdict { ok, hold, fail };
+  Watchdog(int hold_after, int fail_after) : hold_(hold_after), fail_(fail_after) {}
+  Verdict fresh() noexcept {
+    missed_ = 0;
+    return Verdict::ok;
+  }
+  Verdict missed() noexcept {
+    ++missed_;
+    return missed_ >= fail_ ? Verdict::fail : missed_ >= hold_ ? Verdict::hold : Verdict::ok;
+  }
+  [[nodiscard]] int missed_periods() const noexcept { return missed_; }
+
+ private:
+  int hold_, fail_, missed_ = 0;
+};
+
+}  // namespace hystlab::daemon

@@ -1,0 +1,52 @@
+#pragma once
+// The input a campaign drives: a list of segments (ramp to a target at a rate, then dwell),
+// stepped by measured displacement and the time passed in. Pure: no I/O, no clock.
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "hystlab/daemon/plan.hpp"
+
+namespace hystlab::daemon {
+
+enum class SegmentKind { preamble, training, rise, descent, waypoint, safe };
+
+struct Segment {
+  double target_mm = 0, rate_mm_s = 0, dwell_s = 0;
+  SegmentKind kind = SegmentKind::waypoint;
+  int row = 0;  // FOT row i (δ_i) for rise and descent segments
+};
+
+// MODELS.md §1's identification input: (training cycles to the top), then for each repeat and
+// each i = 1..n: rise to δ_i, descend to δmin. Starts with a preamble to δmin.
+[[nodiscard]] std::vector<Segment> fot_schedule(const Plan& plan);
+[[nodiscard]] std::vector<Segment> waveform_schedule(const Plan& plan);
+
+struct SetpointCommand {
+  double target_mm, rate_mm_s;
+};
+
+class Sequencer {
+ public:
+  Sequencer(std::vector<Segment> segments, double tolerance_mm);
+  // Feed the time (rig seconds) and measured displacement; returns a command when a new
+  // segment starts.
+  std::optional<SetpointCommand> step(double now_s, double displacement_mm);
+  [[nodiscard]] bool done() const noexcept { return index_ >= segments_.size(); }
+  [[nodiscard]] std::size_t index() const noexcept { return index_; }
+  [[nodiscard]] std::size_t size() const noexcept { return segments_.size(); }
+  [[nodiscard]] const Segment* current() const noexcept { return done() ? nullptr : &segments_[index_]; }
+  // Restart at segment k (memory-aware resume re-takes the segment in progress).
+  void restart_at(std::size_t k) noexcept;
+  // Prepends segments before the current one (the wipe-out preamble on resume).
+  void insert_before_current(const std::vector<Segment>& extra);
+
+ private:
+  std::vector<Segment> segments_;
+  double tol_;
+  std::size_t index_ = 0;
+  bool started_ = false, dwelling_ = false;
+  double dwell_until_ = 0;
+};
+
+}  // namespace hystlab::daemon

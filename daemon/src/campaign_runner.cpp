@@ -1,0 +1,245 @@
+#include "hystlab/daemon/campaign_runner.hpp"
+
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "hystlab/daemon/online_fot.hpp"
+#include "hystlab/daemon/safety.hpp"
+#include "hystlab/daemon/sequencer.hpp"
+#include "hystlab/models/accuracy.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/lsq_fit.hpp"
+#include "hystlab/models/online_table_builder.hpp"
+#include "hystlab/models/preisach_model.hpp"
+#include "run_finish.hpp"
+
+namespace hystlab::daemon {
+namespace {
+using drivers::RigError;
+
+double mono_now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+double wall_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+void sleep_until(double t) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(t);
+  ts.tv_nsec = static_cast<long>((t - static_cast<double>(ts.tv_sec)) * 1e9);
+  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+}
+
+// The loop's state: everything one tick needs, in one place.
+struct Loop {
+  const Plan& plan;
+  RunnerContext& ctx;
+  std::int64_t campaign, run;
+  Sequencer seq;
+  SafetyEnvelope safety;
+  Watchdog watchdog;
+  std::shared_ptr<models::OnlineTableBuilder> builder;
+  std::unique_ptr<OnlineFot> fot;
+  RunSeries series;
+  RunnerResult result;
+  std::int64_t next_seq = 0;
+  std::uint32_t last_counter = 0;
+  bool have_counter = false, paused = false, watchdog_holding = false;
+  double pause_started = 0, prev_t = 0;
+
+  void state(const std::string& to, const std::string& reason) {
+    const std::string now = ctx.now_iso();
+    const auto id = campaign;
+    ctx.writer.post([id, to, reason, now](db::Store& s) { s.transition(id, to, reason, now); });
+    if (ctx.on_state) ctx.on_state(to);
+  }
+  bool collecting() const {
+    const Segment* s = seq.current();
+    return s && (s->kind == SegmentKind::rise || s->kind == SegmentKind::descent);
+  }
+};
+
+// Drives to the safe position at the safe rate, sampling, for a bounded time.
+void go_safe(Loop& L, double wall0) {
+  const Limits& l = L.plan.limits;
+  (void)L.ctx.rig.hold(false);
+  (void)L.ctx.rig.command(l.safe_position_mm, l.safe_rate_mm_s);
+  drivers::RigSample s;
+  const double deadline = mono_now() + 5.0 + 2.0 * (l.displacement_max_mm - l.displacement_min_mm) / l.safe_rate_mm_s / L.ctx.time_scale;
+  while (mono_now() < deadline) {
+    if (!L.ctx.rig.read_sample((mono_now() - wall0) * L.ctx.time_scale, s)) {
+      L.ctx.writer.try_push({L.run, L.next_seq++, s.time_s, s.command_mm, s.displacement_mm, s.force_N, s.status_word});
+      if (std::fabs(s.displacement_mm - l.safe_position_mm) < 0.01 * (l.displacement_max_mm - l.displacement_min_mm)) break;
+    }
+    sleep_until(mono_now() + 1.0 / L.plan.sample_rate_hz);
+  }
+  (void)L.ctx.rig.hold(true);
+}
+
+// Handles pause/resume/abort; returns false when the campaign ends here.
+bool handle_control(Loop& L, double t, double wall0) {
+  const auto c = L.ctx.next_control();
+  if (!c) return true;
+  if (*c == Control::pause && !L.paused) {
+    (void)L.ctx.rig.hold(true);
+    L.paused = true;
+    L.pause_started = t;
+    L.state("paused", "operator");
+  } else if (*c == Control::resume && L.paused) {
+    L.paused = false;
+    const Segment* cur = L.seq.current();
+    if (L.plan.kind == "fot" && cur && t - L.pause_started > L.ctx.resume_preamble_after_s) {
+      // Memory-aware resume: the specimen drifted while held; wipe its memory at δmin and
+      // re-take the row that was in progress.
+      const std::size_t k = cur->kind == SegmentKind::descent ? L.seq.index() - 1 : L.seq.index();
+      L.seq.restart_at(k);
+      L.seq.insert_before_current({{L.plan.lo_mm, L.plan.ramp_rate_mm_s, L.plan.dwell_s, SegmentKind::preamble, 0}});
+      L.state("running", "resumed after a long pause: wipe-out preamble to δmin, row re-taken");
+    } else {
+      L.seq.restart_at(L.seq.index());  // re-issue the current segment's command
+      L.state("running", "resumed");
+    }
+    (void)L.ctx.rig.hold(false);
+  } else if (*c == Control::abort) {
+    L.result.reason = "aborted by the operator";
+    go_safe(L, wall0);
+    L.result.state = "aborted";
+    return false;
+  }
+  return true;
+}
+
+// One sample: store it, check safety, step the input and the online fit. False when it ends.
+bool on_sample(Loop& L, const drivers::RigSample& s, double wall0) {
+  L.ctx.writer.try_push({L.run, L.next_seq++, s.time_s, s.command_mm, s.displacement_mm, s.force_N, s.status_word});
+  L.series.add(s.displacement_mm, s.force_N);
+  ++L.result.samples;
+  if (auto trip = L.safety.check(s.displacement_mm, s.force_N, s.time_s - L.prev_t)) {
+    L.prev_t = s.time_s;
+    L.result.reason = "safety trip: " + *trip;
+    go_safe(L, wall0);
+    L.result.state = "aborted";
+    return false;
+  }
+  L.prev_t = s.time_s;
+  if ((s.status_word & 0x8U) != 0) {  // the rig's own e-stop
+    L.result.reason = "e-stop pressed on the rig";
+    L.result.state = "aborted";
+    return false;
+  }
+  if (L.paused) return true;
+  if (const auto cmd = L.seq.step(s.time_s, s.displacement_mm)) {
+    if (auto ec = L.ctx.rig.command(cmd->target_mm, cmd->rate_mm_s)) {
+      L.result.reason = "command refused: " + ec.message();
+      L.result.state = "failed";
+      return false;
+    }
+  }
+  if (L.fot) {
+    L.fot->feed(s.time_s, s.displacement_mm, s.force_N, L.collecting());
+    if (L.fot->take_descent_completed()) post_evaluation(L.ctx.writer, L.campaign, *L.builder, L.series, L.ctx.now_iso());
+  }
+  return true;
+}
+
+// A failed read: the watchdog decides between waiting, holding and failing.
+bool on_missed(Loop& L, std::error_code ec) {
+  const auto v = L.watchdog.missed();
+  if (v == Watchdog::Verdict::hold && !L.watchdog_holding) {
+    L.watchdog_holding = true;
+    (void)L.ctx.rig.hold(true);
+  }
+  if (v == Watchdog::Verdict::fail) {
+    (void)L.ctx.rig.hold(true);
+    L.result.reason = "watchdog: no fresh sample for " + std::to_string(L.watchdog.missed_periods()) +
+                      " periods (" + ec.message() + "); holding rather than guessing";
+    L.result.state = "failed";
+    return false;
+  }
+  return true;
+}
+}  // namespace
+
+RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerContext& ctx) {
+  const std::vector<Segment> schedule = plan.kind == "fot" ? fot_schedule(plan) : waveform_schedule(plan);
+  const double tol = std::max(0.002 * (plan.hi_mm - plan.lo_mm), 0.002);
+  Loop L{plan, ctx, campaign_id, 0, Sequencer(schedule, tol), SafetyEnvelope(plan.limits),
+         Watchdog(ctx.watchdog_hold_periods, ctx.watchdog_fail_periods), nullptr, nullptr, {}, {}};
+  L.state("arming", "started by the daemon");
+  const double wall0 = mono_now();
+  if (auto ec = ctx.rig.connect(0.0); ec && ec != RigError::not_connected) {
+    L.result.state = "failed";
+    L.result.reason = "cannot connect to the rig: " + ec.message();
+    L.state("failed", L.result.reason);
+    return L.result;
+  }
+  (void)ctx.rig.hold(false);
+  if (auto ec = ctx.rig.arm(true)) {
+    L.result.state = "failed";
+    L.result.reason = "cannot arm the rig: " + ec.message();
+    L.state("failed", L.result.reason);
+    return L.result;
+  }
+  L.run = L.result.run_id = ctx.store.add_run(campaign_id, ctx.now_iso(), wall_now(), wall0);
+  if (plan.kind == "fot") {
+    const models::Grid g = models::Grid::make(plan.lo_mm, plan.hi_mm, plan.subdivisions);
+    L.builder = std::make_shared<models::OnlineTableBuilder>(g);
+    const double band = std::min(0.05 * g.step(), 0.02);
+    L.fot = std::make_unique<OnlineFot>(g, band, [&L](const models::FotNode& n, double t) {
+      if (L.builder->add(n)) return;
+      ++L.result.nodes;
+      const auto run = L.run;
+      L.ctx.writer.post([run, n, t](db::Store& s) { s.add_fot_node(run, n.alpha, n.beta, n.force_alpha, n.force_alpha_beta, t); });
+    });
+  }
+  L.state("running", "armed");
+  const double period = 1.0 / plan.sample_rate_hz;
+  double next = mono_now();
+  drivers::RigSample s;
+  bool going = true;
+  while (going) {
+    next += period;
+    sleep_until(next);
+    const double now = mono_now();
+    if (now - next > period) ++L.result.missed_deadlines;  // counted, never hidden
+    if (ctx.stop && ctx.stop->load()) {
+      (void)ctx.rig.hold(true);
+      L.result.state = "interrupted";
+      L.result.reason = "the daemon is stopping";
+      break;
+    }
+    const double t = (now - wall0) * ctx.time_scale;
+    going = handle_control(L, t, wall0);
+    if (!going) break;
+    if (const auto ec = ctx.rig.read_sample(t, s)) {
+      going = on_missed(L, ec);
+      continue;
+    }
+    const bool fresh = !L.have_counter || s.sample_counter != L.last_counter;
+    L.have_counter = true;
+    L.last_counter = s.sample_counter;
+    if (!fresh) {
+      going = on_missed(L, drivers::RigError::stale_data);
+      continue;
+    }
+    L.watchdog.fresh();
+    if (L.watchdog_holding) {  // the link is back: recover
+      L.watchdog_holding = false;
+      (void)ctx.rig.hold(false);
+      L.seq.restart_at(L.seq.index());
+    }
+    going = on_sample(L, s, wall0) && !L.seq.done();
+    if (going == false && L.result.state.empty()) L.result.state = "completed";
+  }
+  L.result.dropped = ctx.writer.stats().dropped_full;
+  finish_run(L.result, campaign_id, plan, L.builder.get(), L.fot.get(), L.series, ctx);
+  L.state(L.result.state, L.result.reason.empty() ? "finished" : L.result.reason);
+  return L.result;
+}
+
+}  // namespace hystlab::daemon

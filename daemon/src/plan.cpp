@@ -1,0 +1,98 @@
+#include "hystlab/daemon/plan.hpp"
+
+#include <cmath>
+
+namespace hystlab::daemon {
+namespace {
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::string& field, const std::string& why) { throw PlanError("plan: " + field + " " + why); }
+
+double number(const json& j, const char* f, double def, double lo, double hi) {
+  if (!j.contains(f)) return def;
+  if (!j[f].is_number() || !std::isfinite(j[f].get<double>())) fail(f, "must be a number");
+  const double v = j[f].get<double>();
+  if (v < lo || v > hi) fail(f, "must be between " + std::to_string(lo) + " and " + std::to_string(hi));
+  return v;
+}
+
+std::pair<double, double> pair_of(const json& j, const std::string& f) {
+  if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number()) fail(f, "must be [low, high]");
+  const double a = j[0].get<double>(), b = j[1].get<double>();
+  if (!std::isfinite(a) || !std::isfinite(b) || !(b > a)) fail(f, "must be [low, high] with low < high");
+  return {a, b};
+}
+
+Limits parse_limits(const json& j, double lo, double hi) {
+  Limits l;
+  l.displacement_min_mm = lo - 0.5;
+  l.displacement_max_mm = hi + 0.5;
+  if (j.is_null()) return l;
+  if (!j.is_object()) fail("limits", "must be an object");
+  for (const auto& [k, _] : j.items())
+    if (k != "displacement_mm" && k != "force_N" && k != "rate_mm_s" && k != "safe_position_mm" && k != "safe_rate_mm_s")
+      fail("limits." + k, "is not a known field");
+  if (j.contains("displacement_mm")) std::tie(l.displacement_min_mm, l.displacement_max_mm) = pair_of(j["displacement_mm"], "limits.displacement_mm");
+  l.force_max_N = number(j, "force_N", l.force_max_N, 1e-6, 1e7);
+  l.rate_max_mm_s = number(j, "rate_mm_s", l.rate_max_mm_s, 1e-6, 1e4);
+  l.safe_position_mm = number(j, "safe_position_mm", lo, -1e4, 1e4);
+  l.safe_rate_mm_s = number(j, "safe_rate_mm_s", l.safe_rate_mm_s, 1e-6, 1e3);
+  if (l.safe_position_mm < l.displacement_min_mm || l.safe_position_mm > l.displacement_max_mm)
+    fail("limits.safe_position_mm", "must lie inside limits.displacement_mm");
+  return l;
+}
+}  // namespace
+
+Plan parse_plan(const json& j) {
+  if (!j.is_object()) fail("", "must be a JSON object");
+  Plan p;
+  p.source = j;
+  if (!j.contains("kind") || !j["kind"].is_string()) fail("kind", "is required: \"fot\" or \"waveform\"");
+  p.kind = j["kind"].get<std::string>();
+  static const char* common[] = {"kind", "ramp_rate_mm_s", "dwell_s", "sample_rate_hz", "limits", "name"};
+  auto known = [&](const std::vector<std::string>& extra) {
+    for (const auto& [k, _] : j.items()) {
+      bool ok = std::find(std::begin(common), std::end(common), k) != std::end(common);
+      for (const auto& e : extra) ok = ok || e == k;
+      if (!ok) fail(k, "is not a field of a " + p.kind + " plan");
+    }
+  };
+  p.ramp_rate_mm_s = number(j, "ramp_rate_mm_s", 0.5, 1e-4, 1e3);
+  p.dwell_s = number(j, "dwell_s", 0.0, 0.0, 3600.0);
+  p.sample_rate_hz = number(j, "sample_rate_hz", 1000.0, 1.0, 10000.0);
+  if (p.kind == "fot") {
+    known({"range_mm", "subdivisions", "repeats", "training_cycles"});
+    if (!j.contains("range_mm")) fail("range_mm", "is required");
+    std::tie(p.lo_mm, p.hi_mm) = pair_of(j["range_mm"], "range_mm");
+    if (!j.contains("subdivisions") || !j["subdivisions"].is_number_integer() || j["subdivisions"] < 1 || j["subdivisions"] > 200)
+      fail("subdivisions", "must be an integer from 1 to 200");
+    p.subdivisions = j["subdivisions"].get<int>();
+    p.repeats = static_cast<int>(number(j, "repeats", 1, 1, 100));
+    p.training_cycles = static_cast<int>(number(j, "training_cycles", 0, 0, 1000));
+    p.limits = parse_limits(j.value("limits", json()), p.lo_mm, p.hi_mm);
+    if (p.lo_mm < p.limits.displacement_min_mm || p.hi_mm > p.limits.displacement_max_mm)
+      fail("range_mm", "must lie inside limits.displacement_mm");
+  } else if (p.kind == "waveform") {
+    known({"points_mm"});
+    if (!j.contains("points_mm") || !j["points_mm"].is_array() || j["points_mm"].size() < 2)
+      fail("points_mm", "must be an array of at least two displacements");
+    for (std::size_t k = 0; k < j["points_mm"].size(); ++k) {
+      const json& v = j["points_mm"][k];
+      if (!v.is_number() || !std::isfinite(v.get<double>())) fail("points_mm[" + std::to_string(k) + "]", "must be a number");
+      p.points_mm.push_back(v.get<double>());
+    }
+    const auto [mn, mx] = std::minmax_element(p.points_mm.begin(), p.points_mm.end());
+    p.lo_mm = *mn;
+    p.hi_mm = *mx;
+    p.limits = parse_limits(j.value("limits", json()), p.lo_mm, p.hi_mm);
+    for (std::size_t k = 0; k < p.points_mm.size(); ++k)
+      if (p.points_mm[k] < p.limits.displacement_min_mm || p.points_mm[k] > p.limits.displacement_max_mm)
+        fail("points_mm[" + std::to_string(k) + "]", "lies outside limits.displacement_mm");
+  } else {
+    fail("kind", "must be \"fot\" or \"waveform\" (got \"" + p.kind + "\")");
+  }
+  if (p.ramp_rate_mm_s > p.limits.rate_max_mm_s) fail("ramp_rate_mm_s", "is above limits.rate_mm_s");
+  return p;
+}
+
+}  // namespace hystlab::daemon

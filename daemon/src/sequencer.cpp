@@ -1,0 +1,61 @@
+#include "hystlab/daemon/sequencer.hpp"
+
+#include <cmath>
+
+namespace hystlab::daemon {
+
+std::vector<Segment> fot_schedule(const Plan& p) {
+  std::vector<Segment> s;
+  s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::preamble, 0});
+  for (int c = 0; c < p.training_cycles; ++c) {  // stabilise the specimen on its major loop
+    s.push_back({p.hi_mm, p.ramp_rate_mm_s, 0.0, SegmentKind::training, 0});
+    s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::training, 0});
+  }
+  for (int r = 0; r < p.repeats; ++r)
+    for (int i = 1; i <= p.subdivisions; ++i) {
+      const double top = i == p.subdivisions ? p.hi_mm : p.lo_mm + (p.hi_mm - p.lo_mm) * i / p.subdivisions;
+      s.push_back({top, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::rise, i});
+      s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::descent, i});
+    }
+  return s;
+}
+
+std::vector<Segment> waveform_schedule(const Plan& p) {
+  std::vector<Segment> s;
+  for (double x : p.points_mm) s.push_back({x, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::waypoint, 0});
+  return s;
+}
+
+Sequencer::Sequencer(std::vector<Segment> segments, double tolerance_mm) : segments_(std::move(segments)), tol_(tolerance_mm) {}
+
+std::optional<SetpointCommand> Sequencer::step(double now, double x) {
+  if (done()) return std::nullopt;
+  const Segment& seg = segments_[index_];
+  if (!started_) {
+    started_ = true;
+    dwelling_ = false;
+    return SetpointCommand{seg.target_mm, seg.rate_mm_s};
+  }
+  if (!dwelling_ && std::fabs(x - seg.target_mm) <= tol_) {
+    dwelling_ = true;
+    dwell_until_ = now + seg.dwell_s;
+  }
+  if (dwelling_ && now >= dwell_until_) {
+    ++index_;
+    started_ = false;
+    return step(now, x);
+  }
+  return std::nullopt;
+}
+
+void Sequencer::restart_at(std::size_t k) noexcept {
+  index_ = k;
+  started_ = dwelling_ = false;
+}
+
+void Sequencer::insert_before_current(const std::vector<Segment>& extra) {
+  segments_.insert(segments_.begin() + static_cast<std::ptrdiff_t>(index_), extra.begin(), extra.end());
+  started_ = dwelling_ = false;
+}
+
+}  // namespace hystlab::daemon

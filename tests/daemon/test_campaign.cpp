@@ -1,0 +1,261 @@
+// Campaigns end to end: the runner drives hystlab-sim over real sockets, stores into a real
+// SQLite file through the writer thread, and fits the table online.
+#include <doctest/doctest.h>
+#include <sys/socket.h>
+
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <mutex>
+#include <thread>
+
+#include "../drivers/sim_process.hpp"
+#include "hystlab/daemon/campaign_runner.hpp"
+#include "hystlab/daemon/online_fot.hpp"
+#include "hystlab/drivers/can_rig.hpp"
+#include "hystlab/drivers/rig_factory.hpp"
+#include "hystlab/models/fot_identification.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/online_table_builder.hpp"
+#include "hystlab/models/simplified_sma.hpp"
+
+namespace fs = std::filesystem;
+using namespace hystlab;
+using hystlab::test::SimProcess;
+
+namespace {
+struct Bench {  // a db file, a writer, and a campaign row
+  Bench(std::size_t capacity = 1U << 17) {
+    char tmpl[] = "/tmp/hystlab-campaign-XXXXXX";
+    dir = mkdtemp(tmpl);
+    path = (dir / "hystlab.db").string();
+    store = std::make_unique<db::Store>(path);
+    writer = std::make_unique<db::SampleWriter>(path, db::WriterOptions{capacity, 0.1, 50'000, true});
+    rig_id = store->upsert_rig("sim", "{}", "t");
+  }
+  ~Bench() {
+    writer.reset();
+    store.reset();
+    fs::remove_all(dir);
+  }
+  std::int64_t submit(const nlohmann::json& plan) { return store->create_campaign(rig_id, plan["kind"], plan.dump(), "t"); }
+  fs::path dir;
+  std::string path;
+  std::unique_ptr<db::Store> store;
+  std::unique_ptr<db::SampleWriter> writer;
+  std::int64_t rig_id = 0;
+};
+
+struct Controls {  // what the HTTP threads will do: queue commands for the acquisition thread
+  std::mutex mu;
+  std::deque<daemon::Control> q;
+  void push(daemon::Control c) {
+    std::lock_guard lk(mu);
+    q.push_back(c);
+  }
+  std::optional<daemon::Control> pop() {
+    std::lock_guard lk(mu);
+    if (q.empty()) return std::nullopt;
+    auto c = q.front();
+    q.pop_front();
+    return c;
+  }
+};
+
+nlohmann::json fot_plan(int n, double rate = 0.1) {
+  return {{"kind", "fot"}, {"range_mm", {0.0, 4.0}}, {"subdivisions", n}, {"ramp_rate_mm_s", rate}, {"sample_rate_hz", 1000},
+          {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 50}}}};
+}
+
+std::unique_ptr<drivers::Rig> tcp_rig(int port) {
+  return drivers::make_rig({{"transport", "modbus-tcp"}, {"port", port}, {"response_timeout_ms", 50}, {"reconnect_min_ms", 10},
+                            {"reconnect_max_ms", 20}, {"stale_after_ms", 5000}});
+}
+
+daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale) {
+  daemon::RunnerContext ctx{rig, *b.writer, *b.store};
+  ctx.time_scale = scale;
+  ctx.now_iso = [] { return std::string("2026-11-23T00:00:00Z"); };
+  if (c) ctx.next_control = [c] { return c->pop(); };
+  return ctx;
+}
+}  // namespace
+
+TEST_CASE("fot campaign n = 12: the online table equals the offline one and the specimen's") {
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0.05", "--corner-width", "0"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  const auto plan = daemon::parse_plan(fot_plan(12));
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 200);
+  const daemon::RunnerResult r = daemon::run_campaign(id, plan, ctx);
+  b.writer->flush();
+  CAPTURE(r.reason);
+  REQUIRE(r.state == "completed");
+  CHECK(r.nodes == 78);
+  REQUIRE(r.table_id);
+  CHECK(r.lsq_table_id);
+  CHECK(b.store->campaign(id)->state == "completed");
+  // Offline: the same identification over the samples as stored.
+  const models::Grid g = models::Grid::make(0, 4, 12);
+  models::OnlineTableBuilder offline(g);
+  daemon::OnlineFot fot(g, std::min(0.05 * g.step(), 0.02), [&](const models::FotNode& n, double) { (void)offline.add(n); });
+  b.store->for_each_sample(r.run_id, 0, 1LL << 40, [&](const db::SampleRow& s) { fot.feed(s.t, s.disp, s.force, true); });
+  fot.finish();
+  REQUIRE(offline.complete());
+  db::Statement st(b.store->database(), "SELECT document FROM tables WHERE id = ?");
+  st.bind(1, *r.table_id);
+  REQUIRE(st.step());
+  const models::EverettTable online = models::table_from_json(st.column_text(0)).table;
+  const models::EverettTable off = offline.table();
+  for (std::size_t k = 0; k < online.values().size(); ++k) CHECK(online.values()[k] == doctest::Approx(off.values()[k]).epsilon(1e-12));
+  // Against the virtual identification of the simulator's specimen (Table 1): within the noise.
+  models::SimplifiedSmaModel sma(models::table1_parameters());
+  const models::EverettTable virt = models::identify_virtual(sma, g);
+  double worst = 0;
+  for (std::size_t k = 0; k < virt.values().size(); ++k) worst = std::max(worst, std::fabs(online.values()[k] - virt.values()[k]));
+  CHECK(worst < 2.0);  // N, on a 157 N range (noise 0.05 N, a sample every 0.02 mm)
+  CHECK(b.store->sample_count(r.run_id) == static_cast<std::int64_t>(r.samples) + 0 * static_cast<std::int64_t>(r.dropped));
+  // Every transition is stored with its reason.
+  const auto ev = b.store->events(id);
+  std::vector<std::string> states;
+  for (const auto& e : ev)
+    if (e.kind == "state") states.push_back(e.to_state);
+  CHECK(states == std::vector<std::string>{"queued", "arming", "running", "completed"});
+  std::size_t fits = 0;
+  for (const auto& e : ev) fits += e.kind == "fit" ? 1U : 0U;
+  CHECK(fits >= 12);  // one evaluation after each descent
+}
+
+TEST_CASE("safety: a force-limit trip aborts to the safe position, with the reason stored") {
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  auto j = fot_plan(4, 0.2);
+  j["limits"]["force_N"] = 60;
+  const auto plan = daemon::parse_plan(j);
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 200);
+  const auto r = daemon::run_campaign(id, plan, ctx);
+  b.writer->flush();
+  CHECK(r.state == "aborted");
+  CHECK(r.reason.find("force") != std::string::npos);
+  drivers::RigSample s;
+  REQUIRE_FALSE(rig->read_sample(0, s));
+  CHECK(std::fabs(s.displacement_mm - 0.0) < 0.05);  // back at the safe position
+  CHECK(b.store->events(id).back().detail.find("safety trip") != std::string::npos);
+}
+
+TEST_CASE("operator: pause, a long pause's memory-aware resume, then abort") {
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  const auto plan = daemon::parse_plan(fot_plan(6, 0.1));
+  const auto id = b.submit(plan.source);
+  Controls c;
+  auto ctx = context(*rig, b, &c, 200);
+  std::vector<std::string> seen;
+  std::mutex mu;
+  ctx.on_state = [&](const std::string& s) {
+    std::lock_guard lk(mu);
+    seen.push_back(s);
+  };
+  std::thread operator_thread([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    c.push(daemon::Control::pause);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // 20 rig-seconds: longer than the threshold
+    c.push(daemon::Control::resume);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    c.push(daemon::Control::abort);
+  });
+  const auto r = daemon::run_campaign(id, plan, ctx);
+  operator_thread.join();
+  b.writer->flush();
+  CHECK(r.state == "aborted");
+  CHECK(seen == std::vector<std::string>{"arming", "running", "paused", "running", "aborted"});
+  bool preamble = false;
+  for (const auto& e : b.store->events(id)) preamble |= e.detail.find("wipe-out preamble") != std::string::npos;
+  CHECK(preamble);
+}
+
+TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers") {
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  const auto plan = daemon::parse_plan(fot_plan(4, 0.2));
+  {
+    const auto id = b.submit(plan.source);
+    auto ctx = context(*rig, b, nullptr, 200);
+    ctx.watchdog_fail_periods = 200;
+    std::thread fault([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      sim.control("fault drop");
+    });
+    const auto r = daemon::run_campaign(id, plan, ctx);
+    fault.join();
+    CHECK(r.state == "failed");
+    CHECK(r.reason.find("watchdog") != std::string::npos);
+    sim.control("clear");
+  }
+  {
+    const auto id = b.submit(plan.source);
+    auto ctx = context(*rig, b, nullptr, 200);
+    ctx.watchdog_fail_periods = 2000;
+    std::thread fault([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      sim.control("fault drop");
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      sim.control("clear");
+    });
+    const auto r = daemon::run_campaign(id, plan, ctx);
+    fault.join();
+    CAPTURE(r.reason);
+    CHECK(r.state == "completed");
+    CHECK(rig->health().errors_of(drivers::RigError::connection_lost) >= 1);
+  }
+}
+
+TEST_CASE("a full writer queue is counted and never blocks acquisition") {
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
+  Bench b(64);  // far smaller than 100 ms of samples
+  auto rig = tcp_rig(sim.modbus_port);
+  const auto plan = daemon::parse_plan(fot_plan(3, 0.4));
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 200);
+  const auto r = daemon::run_campaign(id, plan, ctx);
+  b.writer->flush();
+  CHECK(r.state == "completed");
+  CHECK(r.dropped > 0);
+  CHECK(b.writer->stats().dropped_full == r.dropped);
+}
+
+TEST_CASE("fot campaign over CAN (socketpair)") {
+  int sv[2];
+  REQUIRE(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv) == 0);
+  SimProcess sim({"--transport", "can", "--can-fd", "3", "--can-rate", "2000", "--time-scale", "100", "--noise", "0"}, sv[1]);
+  close(sv[1]);
+  drivers::CanRig rig(std::make_unique<drivers::FdCanChannel>(sv[0], "socketpair"), drivers::CanRigConfig{});
+  Bench b;
+  const auto plan = daemon::parse_plan(fot_plan(4, 0.2));
+  const auto id = b.submit(plan.source);
+  auto ctx = context(rig, b, nullptr, 100);
+  const auto r = daemon::run_campaign(id, plan, ctx);
+  CAPTURE(r.reason);
+  CHECK(r.state == "completed");
+  CHECK(r.nodes == 10);
+}
+
+TEST_CASE("plans: an error names the field and the reason") {
+  auto bad = [](nlohmann::json j, const char* needle) {
+    CAPTURE(needle);
+    CHECK_THROWS_WITH_AS((void)daemon::parse_plan(j), doctest::Contains(needle), daemon::PlanError);
+  };
+  bad({{"kind", "fot"}, {"subdivisions", 4}}, "range_mm is required");
+  bad({{"kind", "fot"}, {"range_mm", {4, 0}}, {"subdivisions", 4}}, "range_mm must be [low, high]");
+  bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 0}}, "subdivisions must be an integer");
+  bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"limits", {{"displacement_mm", {0, 3}}}}}, "range_mm must lie inside");
+  bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"speed", 3}}, "speed is not a field");
+  bad({{"kind", "sweep"}}, "kind must be");
+  bad({{"kind", "waveform"}, {"points_mm", {0, "x"}}}, "points_mm[1] must be a number");
+  bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"ramp_rate_mm_s", 30}}, "ramp_rate_mm_s is above limits.rate_mm_s");
+}
