@@ -15,6 +15,9 @@ int run_invert(const Args& args);
 int run_check(const Args& args);
 int run_compare(const Args& args);
 int run_demo(const Args& args);
+int run_campaign_cmd(const Args& args);
+int run_tables_cmd(const Args& args);
+int run_runs_cmd(const Args& args);
 
 // True (and the help printed) when args ask for it.
 bool print_help_if_asked(const Args& args, const char* text);

@@ -30,6 +30,9 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
   check      wiping-out and congruency of a record, as numbers
   compare    accuracy of a table or model against a record
   demo       the paper's §3.3 study on Table 1, with a report and plots
+  campaign   submit, list, show, pause, resume, abort campaigns of hystlabd (on its db file)
+  tables     list and export the tables hystlabd identified
+  runs       export a run's samples as CSV
 )";
 
 int dispatch(const std::string& verb, const Args& args) {
@@ -41,6 +44,9 @@ int dispatch(const std::string& verb, const Args& args) {
   if (verb == "check") return run_check(args);
   if (verb == "compare") return run_compare(args);
   if (verb == "demo") return run_demo(args);
+  if (verb == "campaign") return run_campaign_cmd(args);
+  if (verb == "tables") return run_tables_cmd(args);
+  if (verb == "runs") return run_runs_cmd(args);
   throw CliError("unknown verb '" + verb + "' (hystlab --help lists them)");
 }
 }  // namespace

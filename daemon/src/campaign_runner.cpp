@@ -190,6 +190,17 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
     const models::Grid g = models::Grid::make(plan.lo_mm, plan.hi_mm, plan.subdivisions);
     L.builder = std::make_shared<models::OnlineTableBuilder>(g);
     const double band = std::min(0.05 * g.step(), 0.02);
+    for (const models::FotNode& n : ctx.prior_nodes) (void)L.builder->add(n);
+    if (!ctx.prior_nodes.empty()) {  // resume: drive only the rows not yet complete
+      std::vector<Segment> rest{schedule.front()};
+      for (const Segment& seg : schedule) {
+        if (seg.kind != SegmentKind::rise && seg.kind != SegmentKind::descent) continue;
+        bool row_done = true;
+        for (int j = 0; j < seg.row; ++j) row_done = row_done && L.builder->identified(seg.row, j);
+        if (!row_done) rest.push_back(seg);
+      }
+      L.seq = Sequencer(rest, tol);
+    }
     L.fot = std::make_unique<OnlineFot>(g, band, [&L](const models::FotNode& n, double t) {
       if (L.builder->add(n)) return;
       ++L.result.nodes;

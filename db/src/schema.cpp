@@ -43,6 +43,13 @@ CREATE TABLE transmissibility(
 CREATE TABLE io_stats(
   id INTEGER PRIMARY KEY, rig_id INTEGER REFERENCES rigs(id), at TEXT NOT NULL, stats TEXT NOT NULL);
 )sql",
+    // 2: operator commands for the daemon (written by the CLI; the daemon marks them handled).
+    R"sql(
+CREATE TABLE commands(
+  id INTEGER PRIMARY KEY, campaign_id INTEGER NOT NULL REFERENCES campaigns(id), command TEXT NOT NULL,
+  created_at TEXT NOT NULL, handled_at TEXT);
+CREATE INDEX commands_pending ON commands(handled_at, id);
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof kMigrations / sizeof kMigrations[0]);
 static_assert(kMigrationCount == kSchemaVersion);

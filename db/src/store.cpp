@@ -133,6 +133,44 @@ int Store::mark_interrupted(const std::string& now) {
   return static_cast<int>(ids.size());
 }
 
+std::int64_t Store::add_command(std::int64_t campaign, const std::string& command, const std::string& now) {
+  Statement st(db_, "INSERT INTO commands(campaign_id, command, created_at) VALUES(?,?,?)");
+  st.bind(1, campaign).bind(2, command).bind(3, now);
+  st.step();
+  return db_.last_insert_rowid();
+}
+
+std::vector<Store::Command> Store::take_commands(const std::string& now) {
+  Transaction tx(db_);
+  std::vector<Command> out;
+  {
+    Statement st(db_, "SELECT id, campaign_id, command FROM commands WHERE handled_at IS NULL ORDER BY id");
+    while (st.step()) out.push_back({st.column_int(0), st.column_int(1), st.column_text(2)});
+  }
+  Statement up(db_, "UPDATE commands SET handled_at = ? WHERE handled_at IS NULL");
+  up.bind(1, now);
+  up.step();
+  tx.commit();
+  return out;
+}
+
+std::vector<std::int64_t> Store::queued_campaigns(std::int64_t rig) {
+  std::vector<std::int64_t> out;
+  Statement st(db_, "SELECT id FROM campaigns WHERE rig_id = ? AND state = 'queued' ORDER BY id");
+  st.bind(1, rig);
+  while (st.step()) out.push_back(st.column_int(0));
+  return out;
+}
+
+std::vector<std::tuple<double, double, double, double>> Store::fot_nodes_of_campaign(std::int64_t campaign) {
+  std::vector<std::tuple<double, double, double, double>> out;
+  Statement st(db_, "SELECT alpha, beta, force_alpha, force_alpha_beta FROM fot_nodes JOIN runs ON runs.id = fot_nodes.run_id "
+                    "WHERE runs.campaign_id = ? ORDER BY fot_nodes.id");
+  st.bind(1, campaign);
+  while (st.step()) out.emplace_back(st.column_double(0), st.column_double(1), st.column_double(2), st.column_double(3));
+  return out;
+}
+
 void Store::insert_samples(std::span<const SampleRow> rows) {
   std::map<std::pair<std::int64_t, std::int64_t>, BlockDelta> blocks;
   for (const SampleRow& r : rows) {

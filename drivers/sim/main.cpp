@@ -41,6 +41,7 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --fault SPEC                   start with a fault: drop, delay=MS, exception=CODE, crc, freeze, overload, can-silent
   --control-port P               text control channel on 127.0.0.1 (default 0: any free port)
   --duration S                   stop after S wall-clock seconds (default: run until SIGTERM or 'quit')
+  --exit-with-parent 1           stop when the process that started it is gone (a supervising daemon)
 On start it prints one line per endpoint ("modbus-tcp 127.0.0.1:1502", "control 127.0.0.1:40123") and "ready".
 )";
 
@@ -51,6 +52,7 @@ struct Args {
   std::string rig = "load_frame", transport = "tcp", address = "127.0.0.1", map, params, table;
   int port = 1502, can_fd = -1, can_node = 1, control_port = 0;
   double time_scale = 1, sample_rate = 1000, can_rate = 1000, noise = 0.05, drift = 0, corner = 0.05, duration = 0;
+  bool exit_with_parent = false;
   std::uint64_t seed = 1;
   std::vector<std::string> faults;
 };
@@ -102,6 +104,7 @@ Args parse(int argc, char** argv) {
     else if (o == "--fault") a.faults.push_back(v);
     else if (o == "--control-port") a.control_port = static_cast<int>(num());
     else if (o == "--duration") a.duration = num();
+    else if (o == "--exit-with-parent") a.exit_with_parent = num() != 0;
     else throw std::runtime_error("unknown option " + o + " (see --help)");
   }
   if (a.rig != "load_frame" && a.rig != "shaker") throw std::runtime_error("--rig must be load_frame or shaker");
@@ -172,7 +175,9 @@ int run(const Args& a) {
   // CAN sends cyclic frames, so it wakes every millisecond; Modbus only answers, so it sleeps
   // until a request comes (or 50 ms pass, to keep the physics' catch-up short).
   const int wait_ms = can ? 1 : 50;
+  const pid_t parent = getppid();
   while (!g_stop && (a.duration <= 0 || wall() < a.duration)) {
+    if (a.exit_with_parent && getppid() != parent) break;  // the supervisor died (even by kill -9)
     const double now = wall();
     const sim::SignalValues m = advance(now);
     if (faults.drop && !was_dropping && modbus) modbus->drop_clients();

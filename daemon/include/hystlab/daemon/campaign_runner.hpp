@@ -12,6 +12,8 @@
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/drivers/rig.hpp"
+#include "hystlab/models/fot_node.hpp"
+#include <vector>
 
 namespace hystlab::daemon {
 
@@ -29,6 +31,9 @@ struct RunnerContext {
   int watchdog_hold_periods = 20, watchdog_fail_periods = 500;
   std::function<std::string()> now_iso;                 // wall-clock stamps for the records
   std::function<void(const std::string&)> on_state;     // observers (logs, tests)
+  // Resuming an interrupted campaign: the nodes its earlier runs measured. Rows they complete
+  // are not driven again; the rest follow a wipe-out preamble to δmin.
+  std::vector<models::FotNode> prior_nodes;
 };
 
 struct RunnerResult {

@@ -6,6 +6,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "hystlab/db/sqlite.hpp"
@@ -54,6 +55,16 @@ class Store {
                          const std::string& accuracy_json, const std::string& document_json);
   // At start-up: every campaign left arming, running or paused by a crash becomes interrupted.
   int mark_interrupted(const std::string& now);
+
+  // Operator commands (pause, resume, abort) queued for the daemon.
+  std::int64_t add_command(std::int64_t campaign_id, const std::string& command, const std::string& now);
+  struct Command {
+    std::int64_t id, campaign_id;
+    std::string command;
+  };
+  [[nodiscard]] std::vector<Command> take_commands(const std::string& now);  // marks them handled
+  [[nodiscard]] std::vector<std::int64_t> queued_campaigns(std::int64_t rig_id);
+  [[nodiscard]] std::vector<std::tuple<double, double, double, double>> fot_nodes_of_campaign(std::int64_t campaign_id);
 
   // Inserts rows and their block summaries; the caller holds the transaction.
   void insert_samples(std::span<const SampleRow> rows);

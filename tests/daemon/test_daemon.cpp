@@ -1,0 +1,157 @@
+// hystlabd as a user runs it: a real process with its supervised simulator, driven through the
+// CLI on its db file; stopped by SIGTERM, and killed with SIGKILL mid-campaign.
+#include <doctest/doctest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include "hystlab/db/store.hpp"
+#include "hystlab/models/fot_identification.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/simplified_sma.hpp"
+
+extern char** environ;
+namespace fs = std::filesystem;
+using namespace hystlab;
+
+namespace {
+struct Dir {
+  Dir() {
+    char tmpl[] = "/tmp/hystlabd-XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~Dir() { fs::remove_all(path); }
+  fs::path path;
+  std::string db() const { return (path / "hystlab.db").string(); }
+  void write(const std::string& name, const std::string& text) const { std::ofstream(path / name) << text; }
+};
+
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  std::vector<std::string> a = args;
+  std::vector<char*> argv;
+  for (auto& s : a) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  REQUIRE(posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ) == 0);
+  posix_spawn_file_actions_destroy(&fa);
+  return pid;
+}
+
+int wait_exit(pid_t pid) {
+  int st = 0;
+  waitpid(pid, &st, 0);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -WTERMSIG(st);
+}
+
+int cli(const std::string& args) {
+  const std::string cmd = std::string("'") + HYSTLAB_CLI + "' " + args + " > /dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+std::string state_of(const std::string& db, std::int64_t id) { return db::Store(db).campaign(id)->state; }
+
+// Polls until pred holds (or a few seconds pass).
+template <class F>
+bool eventually(F pred, int ms = 20000) {
+  for (int k = 0; k < ms / 50; ++k) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
+const char* kConfig = R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 100, "noise_N": 0.05, "corner_width_mm": 0}}]})";
+const char* kPlan = R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 12, "ramp_rate_mm_s": 0.1, "sample_rate_hz": 1000,
+                        "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 400, "rate_mm_s": 50}})";
+}  // namespace
+
+TEST_CASE("hystlabd: a bad config is refused at start, naming the field") {
+  Dir d;
+  d.write("bad.json", R"({"rigs": [{"name": "x", "transport": "modbus-tcp", "port": 99999}]})");
+  CHECK(wait_exit(spawn({HYSTLABD, "--config", (d.path / "bad.json").string(), "--db", d.db()}, d.path / "log")) == 2);
+  std::ifstream in(d.path / "log");
+  const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(log.find("port must be an integer from 1 to 65535") != std::string::npos);
+  d.write("bad2.json", R"({"rigz": []})");
+  CHECK(wait_exit(spawn({HYSTLABD, "--config", (d.path / "bad2.json").string(), "--db", d.db()}, d.path / "log2")) == 2);
+}
+
+TEST_CASE("hystlabd: SIGTERM holds, marks the campaign interrupted, exits 0") {
+  Dir d;
+  d.write("cfg.json", kConfig);
+  d.write("plan.json", kPlan);
+  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db()}, d.path / "log");
+  REQUIRE(eventually([&] { return fs::exists(d.db()); }));
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "running"; }));
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+  CHECK(state_of(d.db(), 1) == "interrupted");
+}
+
+TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and resume completes the table") {
+  Dir d;
+  d.write("cfg.json", kConfig);
+  d.write("plan.json", kPlan);
+  pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db()}, d.path / "log");
+  REQUIRE(eventually([&] { return fs::exists(d.db()); }));
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  std::int64_t committed = -1;
+  REQUIRE(eventually([&] {  // well into the campaign: some rows of the table measured
+    db::Store s(d.db());
+    db::Statement st(s.database(), "SELECT count(*) FROM fot_nodes");
+    st.step();
+    return st.column_int(0) >= 30;
+  }));
+  {
+    db::Store s(d.db());  // what a reader sees was committed: it must survive the kill
+    committed = s.max_seq(1);
+  }
+  kill(pid, SIGKILL);
+  wait_exit(pid);
+  {
+    db::Store s(d.db());
+    CHECK(s.integrity_check() == "ok");
+    CHECK(s.max_seq(1) >= committed);
+    CHECK(s.sample_count(1) == s.max_seq(1) + 1);  // no holes
+    CHECK(s.campaign(1)->state == "running");      // as the crash left it
+  }
+  pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db()}, d.path / "log2");
+  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "interrupted"; }));
+  REQUIRE(cli("campaign resume 1 --db " + d.db()) == 0);
+  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "completed"; }, 40000));
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+  db::Store s(d.db());
+  db::Statement st(s.database(), "SELECT document FROM tables WHERE campaign_id = 1 AND method = 'fot'");
+  REQUIRE(st.step());
+  const models::EverettTable t = models::table_from_json(st.column_text(0)).table;
+  models::SimplifiedSmaModel sma(models::table1_parameters());
+  const models::EverettTable virt = models::identify_virtual(sma, models::Grid::make(0, 4, 12));
+  double worst = 0, ss = 0;
+  for (std::size_t k = 0; k < t.values().size(); ++k) {
+    const double e = t.values()[k] - virt.values()[k];
+    worst = std::max(worst, std::fabs(e));
+    ss += e * e;
+  }
+  // Sharp corners in the simulator: the resumed table is the specimen's, within the noise.
+  CHECK(std::sqrt(ss / static_cast<double>(t.values().size())) < 0.5);
+  CHECK(worst < 2.0);
+  bool preamble = false;
+  for (const auto& e : s.events(1)) preamble |= e.detail.find("wipe-out preamble") != std::string::npos;
+  CHECK(preamble);
+}
