@@ -1,6 +1,7 @@
 // hystlab campaign / tables / runs: the daemon's records, read and commanded through the db file
 // (until the HTTP API lands). Commands are queued for hystlabd, which acts on them within 0.1 s.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "cli_support.hpp"
@@ -18,7 +19,8 @@ const char* kCampaignHelp = R"(usage: hystlab campaign submit --plan P.json [--r
 Campaigns run on hystlabd's rigs one after another. submit validates the plan (an error names the
 field) and queues it; pause holds the rig; resume continues (after a long pause, or for an
 interrupted campaign, with a wipe-out preamble and the rows not yet measured); abort drives to
-the safe position. The rig defaults to the only one the daemon has.
+the safe position. The rig defaults to the only one the daemon has. A waveform plan may give "points_csv": a CSV
+file (beside the plan) whose displacement_mm column is the input, e.g. a random validation path.
 )";
 const char* kTablesHelp = R"(usage: hystlab tables list [--db hystlab.db]
        hystlab tables export ID [-o T.json] [--db hystlab.db]
@@ -70,6 +72,12 @@ int run_campaign_cmd(const Args& args) {
       j = nlohmann::json::parse(read_file(path));
     } catch (const nlohmann::json::exception& e) {
       throw CliError(path + ": not valid JSON (" + e.what() + ")");
+    }
+    if (j.is_object() && j.contains("points_csv")) {  // a waveform from a CSV: its points go into the stored plan
+      if (!j["points_csv"].is_string()) throw CliError(path + ": points_csv must be a file name");
+      const std::filesystem::path csv = std::filesystem::path(path).parent_path() / j["points_csv"].get<std::string>();
+      j["points_mm"] = Csv::load(csv.string()).column("displacement_mm");
+      j.erase("points_csv");
     }
     const daemon::Plan plan = daemon::parse_plan(j);
     db::Store store(opt.get("db", "hystlab.db"));

@@ -166,6 +166,7 @@ bool on_missed(Loop& L, std::error_code ec) {
 }  // namespace
 
 RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerContext& ctx) {
+  if (plan.kind == "sine") return run_sine_campaign(campaign_id, plan, ctx);
   const std::vector<Segment> schedule = plan.kind == "fot" ? fot_schedule(plan) : waveform_schedule(plan);
   const double tol = std::max(0.002 * (plan.hi_mm - plan.lo_mm), 0.002);
   Loop L{plan, ctx, campaign_id, 0, Sequencer(schedule, tol), SafetyEnvelope(plan.limits),
@@ -213,11 +214,14 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
   double next = mono_now();
   drivers::RigSample s;
   bool going = true;
+  double prev_tick = 0;
   while (going) {
     next += period;
     sleep_until(next);
     const double now = mono_now();
     if (now - next > period) ++L.result.missed_deadlines;  // counted, never hidden
+    if (ctx.loop_periods_us && prev_tick > 0) ctx.loop_periods_us->push_back(static_cast<float>((now - prev_tick) * 1e6));
+    prev_tick = now;
     if (ctx.stop && ctx.stop->load()) {
       (void)ctx.rig.hold(true);
       L.result.state = "interrupted";

@@ -46,7 +46,8 @@ struct RigWorker {
     json cfg = entry.driver;
     if (entry.simulated) {
       if (!sim) sim = std::make_unique<SimChild>(entry.sim);
-      cfg = json{{"name", entry.name}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", sim->ensure_running()}};
+      cfg = json{{"name", entry.name}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", sim->ensure_running()},
+                 {"rig", entry.sim.rig}};
       entry.time_scale = entry.sim.time_scale;
     }
     cfg["name"] = entry.name;

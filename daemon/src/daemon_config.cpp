@@ -49,10 +49,12 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
       const json& s = r["simulate"];
       if (!s.is_object()) fail(where + ".simulate", "must be an object");
       for (const auto& [f, _] : s.items())
-        if (f != "time_scale" && f != "noise_N" && f != "corner_width_mm") fail(where + ".simulate." + f, "is not a known field");
+        if (f != "time_scale" && f != "noise_N" && f != "corner_width_mm" && f != "rig") fail(where + ".simulate." + f, "is not a known field");
       e.simulated = true;
       e.sim.time_scale = positive(s, "time_scale", 10.0, where + ".simulate");
       e.sim.noise_N = s.contains("noise_N") && s["noise_N"] == 0 ? 0.0 : positive(s, "noise_N", 0.05, where + ".simulate");
+      e.sim.rig = s.value("rig", std::string("load_frame"));
+      if (e.sim.rig != "load_frame" && e.sim.rig != "shaker") fail(where + ".simulate.rig", "must be \"load_frame\" or \"shaker\"");
       e.sim.corner_width_mm = s.contains("corner_width_mm") && s["corner_width_mm"] == 0 ? 0.0 : positive(s, "corner_width_mm", 0.05, where + ".simulate");
       r.erase("simulate");
     }  // driver fields are checked by make_rig when the daemon creates the rigs, before anything runs

@@ -41,6 +41,36 @@ Limits parse_limits(const json& j, double lo, double hi) {
     fail("limits.safe_position_mm", "must lie inside limits.displacement_mm");
   return l;
 }
+void parse_sine(const json& j, Plan& p) {
+  if (j.contains("frequencies_hz") == j.contains("sweep")) fail("frequencies_hz", "or sweep: exactly one is required");
+  if (j.contains("frequencies_hz")) {
+    if (!j["frequencies_hz"].is_array() || j["frequencies_hz"].empty()) fail("frequencies_hz", "must be a non-empty array");
+    for (std::size_t k = 0; k < j["frequencies_hz"].size(); ++k) {
+      const json& v = j["frequencies_hz"][k];
+      if (!v.is_number() || !(v.get<double>() > 0) || v.get<double>() > 1000)
+        fail("frequencies_hz[" + std::to_string(k) + "]", "must be a frequency above 0 and at most 1000 Hz");
+      p.frequencies_hz.push_back(v.get<double>());
+    }
+  } else {
+    const json& s = j["sweep"];
+    if (!s.is_object()) fail("sweep", "must be an object");
+    const double a = number(s, "from_hz", 0, 1e-3, 1000), b = number(s, "to_hz", 0, 1e-3, 1000);
+    if (!(b > a)) fail("sweep.to_hz", "must be above sweep.from_hz");
+    const int n = static_cast<int>(number(s, "steps", 10, 2, 1000));
+    const bool log = s.value("spacing", std::string("log")) == "log";
+    for (int k = 0; k < n; ++k)
+      p.frequencies_hz.push_back(log ? a * std::pow(b / a, k / double(n - 1)) : a + (b - a) * k / double(n - 1));
+  }
+  if (!j.contains("amplitude_mm")) fail("amplitude_mm", "is required");
+  p.amplitude_mm = number(j, "amplitude_mm", 0, 1e-4, 100);
+  p.settle_cycles = static_cast<int>(number(j, "settle_cycles", 10, 0, 100000));
+  p.measured_cycles = static_cast<int>(number(j, "measured_cycles", 10, 1, 100000));
+  for (double f : p.frequencies_hz)
+    if (f > p.sample_rate_hz / 8) fail("frequencies_hz", "must stay below sample_rate_hz / 8 (at least 8 samples a cycle)");
+  p.lo_mm = -p.amplitude_mm;
+  p.hi_mm = p.amplitude_mm;
+  p.limits = parse_limits(j.value("limits", json()), -10 * p.amplitude_mm - 1, 10 * p.amplitude_mm + 1);
+}
 }  // namespace
 
 Plan parse_plan(const json& j) {
@@ -88,8 +118,11 @@ Plan parse_plan(const json& j) {
     for (std::size_t k = 0; k < p.points_mm.size(); ++k)
       if (p.points_mm[k] < p.limits.displacement_min_mm || p.points_mm[k] > p.limits.displacement_max_mm)
         fail("points_mm[" + std::to_string(k) + "]", "lies outside limits.displacement_mm");
+  } else if (p.kind == "sine") {
+    known({"frequencies_hz", "sweep", "amplitude_mm", "settle_cycles", "measured_cycles"});
+    parse_sine(j, p);
   } else {
-    fail("kind", "must be \"fot\" or \"waveform\" (got \"" + p.kind + "\")");
+    fail("kind", "must be \"fot\", \"waveform\" or \"sine\" (got \"" + p.kind + "\")");
   }
   if (p.ramp_rate_mm_s > p.limits.rate_max_mm_s) fail("ramp_rate_mm_s", "is above limits.rate_mm_s");
   return p;

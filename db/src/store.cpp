@@ -101,6 +101,14 @@ std::int64_t Store::add_event(std::int64_t campaign, const std::string& kind, co
   return db_.last_insert_rowid();
 }
 
+std::int64_t Store::add_transmissibility(std::int64_t run, double f, double base, double mass, double ratio, double phase) {
+  Statement st(db_, "INSERT INTO transmissibility(run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad) "
+                    "VALUES(?,?,?,?,?,?)");
+  st.bind(1, run).bind(2, f).bind(3, base).bind(4, mass).bind(5, ratio).bind(6, phase);
+  st.step();
+  return db_.last_insert_rowid();
+}
+
 std::int64_t Store::add_fot_node(std::int64_t run, double a, double b, double fa, double fab, double t) {
   Statement st(db_, "INSERT INTO fot_nodes(run_id, alpha, beta, force_alpha, force_alpha_beta, t) VALUES(?,?,?,?,?,?)");
   st.bind(1, run).bind(2, a).bind(3, b).bind(4, fa).bind(5, fab).bind(6, t);

@@ -261,3 +261,24 @@ TEST_CASE("cli: every error is one line naming the problem, exit code 2") {
   w.write("fot.csv", "alpha_mm,beta_mm,force_alpha_N,force_alpha_beta_N\n1,0,10,0\n2,0,20,0\n2,1,20,15\n3,0,30,0\n");
   check_error(w.run("identify --fot fot.csv -o F.json"), "missing node (alpha 3 mm, beta 1 mm)");
 }
+
+TEST_CASE("cli: campaigns on the daemon's db: submit validates, a waveform CSV is inlined, commands are queued") {
+  Workdir w;
+  w.write("plan.json", R"({"kind": "waveform", "points_csv": "path.csv", "ramp_rate_mm_s": 0.5})");
+  w.write("path.csv", "displacement_mm\n0\n2.5\n1\n3\n0\n");
+  const Result ok = w.run("campaign submit --plan plan.json --db d.db");
+  CAPTURE(ok.err);
+  REQUIRE(ok.code == 0);
+  CHECK(ok.out.find("campaign 1 queued (waveform)") != std::string::npos);
+  const Result list = w.run("campaign list --db d.db");
+  CHECK(list.out.find("queued") != std::string::npos);
+  CHECK(w.run("campaign pause 1 --db d.db").code == 0);
+  const Result show = w.run("campaign show 1 --db d.db");
+  CHECK(show.out.find("\"points_mm\":[0.0,2.5,1.0,3.0,0.0]") != std::string::npos);
+  w.write("bad.json", R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 0})");
+  check_error(w.run("campaign submit --plan bad.json --db d.db"), "plan: subdivisions must be an integer");
+  check_error(w.run("campaign show 99 --db d.db"), "no campaign 99");
+  check_error(w.run("campaign pause x --db d.db"), "campaign ID must be a positive whole number");
+  check_error(w.run("tables export 5 --db d.db"), "no table 5");
+  check_error(w.run("runs export 3 --db d.db"), "no samples for run 3");
+}

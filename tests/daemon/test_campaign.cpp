@@ -259,3 +259,33 @@ TEST_CASE("plans: an error names the field and the reason") {
   bad({{"kind", "waveform"}, {"points_mm", {0, "x"}}}, "points_mm[1] must be a number");
   bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"ramp_rate_mm_s", 30}}, "ramp_rate_mm_s is above limits.rate_mm_s");
 }
+
+TEST_CASE("sine campaign on the simulated shaker: transmissibility per frequency, stored as it comes") {
+  SimProcess sim({"--rig", "shaker", "--port", "0"});
+  Bench b;
+  auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", sim.modbus_port}, {"rig", "shaker"}, {"stale_after_ms", 5000}});
+  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {10, 40, 60}}, {"amplitude_mm", 0.2},
+                                        {"settle_cycles", 10}, {"measured_cycles", 10}, {"sample_rate_hz", 1000}});
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 1.0);
+  const auto r = daemon::run_sine_campaign(id, plan, ctx);
+  CAPTURE(r.reason);
+  REQUIRE(r.state == "completed");
+  db::Statement st(b.store->database(), "SELECT frequency_hz, ratio FROM transmissibility WHERE run_id = ? ORDER BY frequency_hz");
+  st.bind(1, r.run_id);
+  std::vector<double> ratio;
+  while (st.step()) ratio.push_back(st.column_double(1));
+  REQUIRE(ratio.size() == 3);
+  // Mass on 4 springs of 40 N/mm (austenite, small motion): f_n ≈ 90 Hz; T = 1 / (1 - (f/f_n)²).
+  CHECK(ratio[0] == doctest::Approx(1.0 / (1 - std::pow(10.0 / 90.0, 2))).epsilon(0.05));
+  CHECK(ratio[1] == doctest::Approx(1.0 / (1 - std::pow(40.0 / 90.0, 2))).epsilon(0.08));
+  CHECK(ratio[2] > ratio[1]);
+  // A load frame cannot run it: refused with the reason.
+  SimProcess frame({"--port", "0"});
+  auto frame_rig = tcp_rig(frame.modbus_port);
+  const auto id2 = b.submit(plan.source);
+  auto ctx2 = context(*frame_rig, b, nullptr, 1.0);
+  const auto r2 = daemon::run_sine_campaign(id2, plan, ctx2);
+  CHECK(r2.state == "failed");
+  CHECK(r2.reason.find("not one") != std::string::npos);
+}

@@ -10,6 +10,7 @@
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/representation_checks.hpp"
 #include "hystlab/models/sma_calibration.hpp"
+#include "hystlab/models/sine_fit.hpp"
 #include "test_support.hpp"
 
 using namespace hystlab::models;
@@ -178,4 +179,21 @@ TEST_CASE("5d: wiping-out and congruency hold for a Preisach model and are measu
   const RepresentationReport rs = check_representation(x, ys);
   CHECK(rs.congruency.compared_pairs >= 1);
   CHECK(rs.congruency.max_deviation_norm > 1e-4);  // the simplified model's minor loops are not congruent
+}
+
+TEST_CASE("sine fit: amplitude and phase of a noisy sine over whole cycles") {
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::vector<double> t, y;
+  for (int k = 0; k < 2000; ++k) {
+    t.push_back(k * 1e-3);
+    y.push_back(0.3 + 1.5 * std::sin(2 * M_PI * 7.0 * t.back() + 0.4) + noise(rng));
+  }
+  const hystlab::models::SineFit f = hystlab::models::fit_sine(t, y, 7.0);
+  REQUIRE(f.ok);
+  CHECK(f.amplitude == doctest::Approx(1.5).epsilon(1e-3));
+  CHECK(f.phase_rad == doctest::Approx(0.4).epsilon(1e-2));
+  CHECK(f.offset == doctest::Approx(0.3).epsilon(1e-2));
+  CHECK(f.rms_residual == doctest::Approx(0.01).epsilon(0.1));
+  CHECK_FALSE(hystlab::models::fit_sine(std::span(t).first(3), std::span(y).first(3), 7.0).ok);
 }

@@ -34,6 +34,7 @@ struct RunnerContext {
   // Resuming an interrupted campaign: the nodes its earlier runs measured. Rows they complete
   // are not driven again; the rest follow a wipe-out preamble to δmin.
   std::vector<models::FotNode> prior_nodes;
+  std::vector<float>* loop_periods_us = nullptr;  // when set, every tick's period is recorded (benchmarks)
 };
 
 struct RunnerResult {
@@ -45,6 +46,8 @@ struct RunnerResult {
 };
 
 // Runs the campaign (already stored as 'queued') to its end state; never throws for rig errors.
+// fot and waveform plans drive a load frame; sine plans a shaker (run_sine_campaign).
 RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerContext& ctx);
+RunnerResult run_sine_campaign(std::int64_t campaign_id, const Plan& plan, RunnerContext& ctx);
 
 }  // namespace hystlab::daemon

@@ -21,6 +21,7 @@ struct ConfigError : std::invalid_argument {
 
 struct SimulatorOptions {
   double time_scale = 10.0, noise_N = 0.05, corner_width_mm = 0.05;
+  std::string rig = "load_frame";  // or "shaker"
 };
 
 struct RigEntry {

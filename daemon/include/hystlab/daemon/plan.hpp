@@ -4,6 +4,8 @@
 //    "sample_rate_hz": 1000, "repeats": 1, "training_cycles": 2,
 //    "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 300, "rate_mm_s": 5}}
 //   {"kind": "waveform", "points_mm": [0, 2, 1, 3, 0], "ramp_rate_mm_s": 0.5, ...}
+//   {"kind": "sine", "frequencies_hz": [5, 10, 20], "amplitude_mm": 0.2, "settle_cycles": 10, "measured_cycles": 10}
+//   {"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "steps": 12, "spacing": "log"}, "amplitude_mm": 0.2}
 // Times are rig time (a simulated rig's time scale is applied by the daemon).
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -24,12 +26,16 @@ struct Limits {
 };
 
 struct Plan {
-  std::string kind;  // "fot" or "waveform"
+  std::string kind;  // "fot", "waveform" or "sine"
   // fot
   double lo_mm = 0, hi_mm = 0;
   int subdivisions = 0, repeats = 1, training_cycles = 0;
   // waveform
   std::vector<double> points_mm;
+  // sine (shaker dwell or stepped sweep)
+  std::vector<double> frequencies_hz;
+  double amplitude_mm = 0;
+  int settle_cycles = 10, measured_cycles = 10;
   // common
   double ramp_rate_mm_s = 0.5, dwell_s = 0.0, sample_rate_hz = 1000.0;
   Limits limits;

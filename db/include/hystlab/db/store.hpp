@@ -49,6 +49,7 @@ class Store {
   std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s);
   void end_run(std::int64_t run_id, const std::string& state, const std::string& now);
   std::int64_t add_event(std::int64_t campaign_id, const std::string& kind, const std::string& detail, const std::string& now);
+  std::int64_t add_transmissibility(std::int64_t run_id, double f_hz, double base_mm, double mass_mm, double ratio, double phase);
   std::int64_t add_fot_node(std::int64_t run_id, double alpha, double beta, double f_alpha, double f_alpha_beta, double t);
   std::int64_t add_table(std::optional<std::int64_t> campaign_id, std::optional<std::int64_t> run_id,
                          const std::string& method, int n, double lo, double hi, const std::string& now,
