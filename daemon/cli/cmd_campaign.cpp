@@ -14,12 +14,12 @@ namespace {
 const char* kCampaignHelp = R"(usage: hystlab campaign submit --plan P.json [--rig NAME] [--db hystlab.db]
        hystlab campaign list [--db hystlab.db]
        hystlab campaign show ID [--db hystlab.db]
-       hystlab campaign pause|resume|abort ID [--db hystlab.db]
+       hystlab campaign pause|resume|abort|estop ID [--db hystlab.db]
 
 Campaigns run on hystlabd's rigs one after another. submit validates the plan (an error names the
 field) and queues it; pause holds the rig; resume continues (after a long pause, or for an
 interrupted campaign, with a wipe-out preamble and the rows not yet measured); abort drives to
-the safe position. The rig defaults to the only one the daemon has. A waveform plan may give "points_csv": a CSV
+the safe position; estop triggers the rig's e-stop at once (no motion). The rig defaults to the only one the daemon has. A waveform plan may give "points_csv": a CSV
 file (beside the plan) whose displacement_mm column is the input, e.g. a random validation path.
 )";
 const char* kTablesHelp = R"(usage: hystlab tables list [--db hystlab.db]
@@ -113,7 +113,7 @@ int run_campaign_cmd(const Args& args) {
     while (tables.step()) std::cout << "table " << tables.column_int(0) << ": " << tables.column_text(1) << ", n = " << tables.column_int(2) << "\n";
     return 0;
   }
-  if (verb != "pause" && verb != "resume" && verb != "abort") throw CliError("unknown campaign verb '" + verb + "' (see --help)");
+  if (verb != "pause" && verb != "resume" && verb != "abort" && verb != "estop") throw CliError("unknown campaign verb '" + verb + "' (see --help)");
   store.add_command(id, verb, now_iso8601());
   std::cout << verb << " sent to campaign " << id << " (" << row->state << ")\n";
   return 0;

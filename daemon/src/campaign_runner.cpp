@@ -105,6 +105,11 @@ bool handle_control(Loop& L, double t, double wall0) {
       L.state("running", "resumed");
     }
     (void)L.ctx.rig.hold(false);
+  } else if (*c == Control::estop) {
+    (void)L.ctx.rig.estop(true);  // passed straight to the rig: it holds where it is
+    L.result.reason = "e-stop by the operator";
+    L.result.state = "aborted";
+    return false;
   } else if (*c == Control::abort) {
     L.result.reason = "aborted by the operator";
     go_safe(L, wall0);

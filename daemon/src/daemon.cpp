@@ -109,7 +109,10 @@ void route_commands(db::Store& store, std::vector<std::unique_ptr<RigWorker>>& w
     bool routed = false;
     for (auto& w : workers)
       if (w->running_campaign == c.campaign_id) {
-        const Control k = c.command == "pause" ? Control::pause : c.command == "resume" ? Control::resume : Control::abort;
+        const Control k = c.command == "pause"    ? Control::pause
+                          : c.command == "resume" ? Control::resume
+                          : c.command == "estop"  ? Control::estop
+                                                  : Control::abort;
         std::lock_guard lk(w->mu);
         w->controls.push_back(k);
         routed = true;

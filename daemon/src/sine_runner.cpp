@@ -68,7 +68,11 @@ RunnerResult run_sine_campaign(std::int64_t campaign_id, const Plan& plan, Runne
       if (mono_now() - next > period) ++r.missed_deadlines;
       t = (mono_now() - wall0) * ctx.time_scale;
       if (ctx.stop && ctx.stop->load()) r.state = "interrupted", r.reason = "the daemon is stopping";
-      if (const auto c = ctx.next_control(); c && *c == Control::abort) r.state = "aborted", r.reason = "aborted by the operator";
+      if (const auto c = ctx.next_control(); c && (*c == Control::abort || *c == Control::estop)) {
+        if (*c == Control::estop) (void)ctx.rig.estop(true);
+        r.state = "aborted";
+        r.reason = *c == Control::estop ? "e-stop by the operator" : "aborted by the operator";
+      }
       if (!r.state.empty()) break;
       if (auto ec = ctx.rig.read_shaker(t, s); ec || s.sample_counter == last_counter) {
         if (watchdog.missed() == Watchdog::Verdict::fail)

@@ -18,6 +18,7 @@
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/online_table_builder.hpp"
 #include "hystlab/models/simplified_sma.hpp"
+#include "hystlab/protocols/signals.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystlab;
@@ -176,6 +177,27 @@ TEST_CASE("operator: pause, a long pause's memory-aware resume, then abort") {
   bool preamble = false;
   for (const auto& e : b.store->events(id)) preamble |= e.detail.find("wipe-out preamble") != std::string::npos;
   CHECK(preamble);
+}
+
+TEST_CASE("operator e-stop: passed to the rig at once, the campaign aborted") {
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  const auto plan = daemon::parse_plan(fot_plan(6, 0.1));
+  const auto id = b.submit(plan.source);
+  Controls c;
+  auto ctx = context(*rig, b, &c, 200);
+  std::thread op([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    c.push(daemon::Control::estop);
+  });
+  const auto r = daemon::run_campaign(id, plan, ctx);
+  op.join();
+  CHECK(r.state == "aborted");
+  CHECK(r.reason == "e-stop by the operator");
+  drivers::RigSample s;
+  REQUIRE_FALSE(rig->read_sample(0, s));
+  CHECK((s.status_word & protocols::status::estop) != 0);
 }
 
 TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers") {

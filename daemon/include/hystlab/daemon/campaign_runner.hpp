@@ -17,7 +17,7 @@
 
 namespace hystlab::daemon {
 
-enum class Control { pause, resume, abort };
+enum class Control { pause, resume, abort, estop };  // estop: the rig's e-stop, now; no motion
 
 struct RunnerContext {
   RunnerContext(drivers::Rig& r, db::SampleWriter& w, db::Store& s) : rig(r), writer(w), store(s) {}
