@@ -148,9 +148,11 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
     worst = std::max(worst, std::fabs(e));
     ss += e * e;
   }
-  // Sharp corners in the simulator: the resumed table is the specimen's, within the noise.
-  CHECK(std::sqrt(ss / static_cast<double>(t.values().size())) < 0.5);
-  CHECK(worst < 2.0);
+  // Sharp corners in the simulator: the resumed table is the specimen's, within the noise and the
+  // sampling of the crossings (a sample every ~0.01 mm; a missed deadline doubles the gap). A
+  // wrong resume (memory not wiped, rows mixed) is off by several N.
+  CHECK(std::sqrt(ss / static_cast<double>(t.values().size())) < 1.0);
+  CHECK(worst < 3.0);
   bool preamble = false;
   for (const auto& e : s.events(1)) preamble |= e.detail.find("wipe-out preamble") != std::string::npos;
   CHECK(preamble);
