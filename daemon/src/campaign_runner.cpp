@@ -1,7 +1,5 @@
 #include "hystlab/daemon/campaign_runner.hpp"
 
-#include <time.h>
-
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -15,25 +13,12 @@
 #include "hystlab/models/lsq_fit.hpp"
 #include "hystlab/models/online_table_builder.hpp"
 #include "hystlab/models/preisach_model.hpp"
+#include "monotonic_clock.hpp"
 #include "run_finish.hpp"
 
 namespace hystlab::daemon {
 namespace {
 using drivers::RigError;
-
-double mono_now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-double wall_now() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-void sleep_until(double t) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(t);
-  ts.tv_nsec = static_cast<long>((t - static_cast<double>(ts.tv_sec)) * 1e9);
-  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
-}
 
 // The loop's state: everything one tick needs, in one place.
 struct Loop {
@@ -50,7 +35,7 @@ struct Loop {
   std::int64_t next_seq = 0;
   std::uint32_t last_counter = 0;
   bool have_counter = false, paused = false, watchdog_holding = false;
-  double pause_started = 0, prev_t = 0;
+  double pause_started = 0;
 
   void state(const std::string& to, const std::string& reason) {
     const std::string now = ctx.now_iso();
@@ -124,14 +109,12 @@ bool on_sample(Loop& L, const drivers::RigSample& s, double wall0) {
   L.ctx.writer.try_push({L.run, L.next_seq++, s.time_s, s.command_mm, s.displacement_mm, s.force_N, s.status_word});
   L.series.add(s.displacement_mm, s.force_N);
   ++L.result.samples;
-  if (auto trip = L.safety.check(s.displacement_mm, s.force_N, s.time_s - L.prev_t)) {
-    L.prev_t = s.time_s;
+  if (auto trip = L.safety.check(s.displacement_mm, s.force_N, s.time_s)) {
     L.result.reason = "safety trip: " + *trip;
     go_safe(L, wall0);
     L.result.state = "aborted";
     return false;
   }
-  L.prev_t = s.time_s;
   if ((s.status_word & 0x8U) != 0) {  // the rig's own e-stop
     L.result.reason = "e-stop pressed on the rig";
     L.result.state = "aborted";

@@ -12,17 +12,19 @@ std::string fmt(const char* f, double a, double b) {
 }
 }  // namespace
 
-std::optional<std::string> SafetyEnvelope::check(double x, double f, double dt) {
-  std::optional<std::string> trip;
+std::optional<std::string> SafetyEnvelope::check(double x, double f, double t) {
   if (x < l_.displacement_min_mm || x > l_.displacement_max_mm)
-    trip = fmt("displacement %.4g mm outside the limits (%.4g mm)", x, x < l_.displacement_min_mm ? l_.displacement_min_mm : l_.displacement_max_mm);
-  else if (std::fabs(f) > l_.force_max_N)
-    trip = fmt("force %.4g N beyond the limit of %.4g N", f, l_.force_max_N);
-  else if (have_prev_ && dt > 0 && std::fabs(x - prev_x_) / dt > l_.rate_max_mm_s)
-    trip = fmt("rate %.4g mm/s beyond the limit of %.4g mm/s", std::fabs(x - prev_x_) / dt, l_.rate_max_mm_s);
-  prev_x_ = x;
-  have_prev_ = true;
-  return trip;
+    return fmt("displacement %.4g mm outside the limits (%.4g mm)", x, x < l_.displacement_min_mm ? l_.displacement_min_mm : l_.displacement_max_mm);
+  if (std::fabs(f) > l_.force_max_N) return fmt("force %.4g N beyond the limit of %.4g N", f, l_.force_max_N);
+  if (!have_ref_) {
+    ref_x_ = x, ref_t_ = t, have_ref_ = true;
+    return std::nullopt;
+  }
+  if (t - ref_t_ < window_) return std::nullopt;  // not enough time yet for a meaningful rate
+  const double rate = std::fabs(x - ref_x_) / (t - ref_t_);
+  ref_x_ = x, ref_t_ = t;
+  if (rate > l_.rate_max_mm_s) return fmt("rate %.4g mm/s beyond the limit of %.4g mm/s", rate, l_.rate_max_mm_s);
+  return std::nullopt;
 }
 
 }  // namespace hystlab::daemon

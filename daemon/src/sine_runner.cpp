@@ -1,28 +1,19 @@
 // Sine campaigns on a shaker: each frequency is driven for settle_cycles, then measured for
 // measured_cycles; amplitude and phase of base and mass motion come from a least-squares sine fit,
 // and the transmissibility point is stored as it comes.
-#include <time.h>
-
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <nlohmann/json.hpp>
 #include <vector>
 
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/safety.hpp"
 #include "hystlab/models/sine_fit.hpp"
+#include "monotonic_clock.hpp"
 
 namespace hystlab::daemon {
 namespace {
-double mono_now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
-void sleep_until(double t) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(t);
-  ts.tv_nsec = static_cast<long>((t - static_cast<double>(ts.tv_sec)) * 1e9);
-  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
-}
-
 struct Step {
   std::vector<double> t, base, mass;
 };
@@ -99,7 +90,7 @@ RunnerResult run_sine_campaign(std::int64_t campaign_id, const Plan& plan, Runne
       r.reason = "too few samples to fit the sine at " + std::to_string(f) + " Hz";
       break;
     }
-    const double ratio = m.amplitude / b.amplitude, phase = std::remainder(m.phase_rad - b.phase_rad, 2 * M_PI);
+    const double ratio = m.amplitude / b.amplitude, phase = std::remainder(m.phase_rad - b.phase_rad, 2 * std::numbers::pi);
     const auto run = r.run_id;
     const std::string now = ctx.now_iso();
     ctx.writer.post([run, f, b, m, ratio, phase, campaign_id, now](db::Store& st) {

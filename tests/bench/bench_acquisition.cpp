@@ -78,9 +78,9 @@ int main(int argc, char** argv) {
   writer.flush();
   const db::WriterStats w = writer.stats();
   report("acquisition (ModbusRig -> hystlab-sim, runner, writer ingesting)", periods, static_cast<long>(r.missed_deadlines));
-  std::printf("campaign %s; %llu samples, %llu written, %llu dropped (ring full), %llu commits, max commit %.1f ms "
+  std::printf("campaign %s%s%s; %llu samples, %llu written, %llu dropped (ring full), %llu commits, max commit %.1f ms "
               "(target: p99.9 within 1 ms, no missed deadlines beyond the baseline's)\n",
-              r.state.c_str(), static_cast<unsigned long long>(r.samples), static_cast<unsigned long long>(w.written),
+              r.state.c_str(), r.reason.empty() ? "" : ": ", r.reason.c_str(), static_cast<unsigned long long>(r.samples), static_cast<unsigned long long>(w.written),
               static_cast<unsigned long long>(w.dropped_full), static_cast<unsigned long long>(w.commits), w.max_commit_ms);
   std::filesystem::remove_all(dir);
   return r.state == "completed" ? 0 : 1;

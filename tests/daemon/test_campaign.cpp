@@ -12,6 +12,8 @@
 #include "../drivers/sim_process.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/online_fot.hpp"
+#include "hystlab/daemon/safety.hpp"
+#include <random>
 #include "hystlab/drivers/can_rig.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "hystlab/models/fot_identification.hpp"
@@ -265,6 +267,34 @@ TEST_CASE("fot campaign over CAN (socketpair)") {
   CAPTURE(r.reason);
   CHECK(r.state == "completed");
   CHECK(r.nodes == 10);
+}
+
+TEST_CASE("safety envelope: limits on every sample; the rate over a window, not between two reads") {
+  daemon::Limits l;
+  l.displacement_min_mm = -1;
+  l.displacement_max_mm = 5;
+  l.force_max_N = 100;
+  l.rate_max_mm_s = 10;
+  daemon::SafetyEnvelope env(l);
+  // Steady 2 mm/s sampled with a jittery clock, the rig moving in 1 ms steps: reads 5 µs apart
+  // may straddle one step (0.002 mm / 5 µs = 400 mm/s between them). Must not trip.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.9e-3, 0.9e-3);
+  double t = 0;
+  for (int k = 0; k < 2000; ++k) {  // 0 to 4 mm
+    t += 1e-3 + (k % 7 == 0 ? jitter(rng) : 0.0);
+    const double x = 2.0 * std::floor(t * 1000.0) / 1000.0;  // the rig's own 1 ms steps
+    CAPTURE(k);
+    REQUIRE_FALSE(env.check(x, 10.0, t));
+  }
+  // A real runaway (50 mm/s for 40 ms) trips on rate; a bad force or position at once.
+  std::optional<std::string> trip;
+  for (int k = 1; k <= 40 && !trip; ++k) trip = env.check(2 * t + 0.05 * k > 4.9 ? 4.9 : 2 * t + 0.05 * k, 10.0, t + k * 1e-3);
+  REQUIRE(trip);
+  CHECK(trip->find("rate") != std::string::npos);
+  daemon::SafetyEnvelope env2(l);
+  CHECK(env2.check(1.0, 150.0, 0.0)->find("force") != std::string::npos);
+  CHECK(env2.check(6.0, 0.0, 0.001)->find("displacement") != std::string::npos);
 }
 
 TEST_CASE("plans: an error names the field and the reason") {

@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "hystlab/models/fot_identification.hpp"
@@ -187,7 +188,7 @@ TEST_CASE("sine fit: amplitude and phase of a noisy sine over whole cycles") {
   std::vector<double> t, y;
   for (int k = 0; k < 2000; ++k) {
     t.push_back(k * 1e-3);
-    y.push_back(0.3 + 1.5 * std::sin(2 * M_PI * 7.0 * t.back() + 0.4) + noise(rng));
+    y.push_back(0.3 + 1.5 * std::sin(2 * std::numbers::pi * 7.0 * t.back() + 0.4) + noise(rng));
   }
   const hystlab::models::SineFit f = hystlab::models::fit_sine(t, y, 7.0);
   REQUIRE(f.ok);

@@ -11,15 +11,17 @@ namespace hystlab::daemon {
 
 class SafetyEnvelope {
  public:
-  explicit SafetyEnvelope(Limits limits) : l_(limits) {}
-  // A reason to trip, or nothing. dt: rig seconds since the previous sample.
-  [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double dt_s);
+  // rate_window_s: the rate is measured over at least this much rig time. Two reads can come
+  // microseconds apart yet straddle one of the rig's own steps; their quotient is no velocity.
+  explicit SafetyEnvelope(Limits limits, double rate_window_s = 0.02) : l_(limits), window_(rate_window_s) {}
+  // A reason to trip, or nothing. t: rig seconds of this sample.
+  [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double t_s);
   [[nodiscard]] const Limits& limits() const noexcept { return l_; }
 
  private:
   Limits l_;
-  double prev_x_ = 0;
-  bool have_prev_ = false;
+  double window_, ref_x_ = 0, ref_t_ = 0;
+  bool have_ref_ = false;
 };
 
 // No fresh sample (a read error, or a sample counter that did not move) for hold_after periods:
