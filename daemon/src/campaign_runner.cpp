@@ -8,11 +8,7 @@
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/safety.hpp"
 #include "hystlab/daemon/sequencer.hpp"
-#include "hystlab/models/accuracy.hpp"
-#include "hystlab/models/formats.hpp"
-#include "hystlab/models/lsq_fit.hpp"
 #include "hystlab/models/online_table_builder.hpp"
-#include "hystlab/models/preisach_model.hpp"
 #include "monotonic_clock.hpp"
 #include "run_finish.hpp"
 
@@ -161,6 +157,7 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
          Watchdog(ctx.watchdog_hold_periods, ctx.watchdog_fail_periods), nullptr, nullptr, {}, {}};
   L.state("arming", "started by the daemon");
   const double wall0 = mono_now();
+  const std::uint64_t dropped_before = ctx.writer.stats().dropped_full;  // the writer outlives campaigns
   if (auto ec = ctx.rig.connect(0.0); ec && ec != RigError::not_connected) {
     L.result.state = "failed";
     L.result.reason = "cannot connect to the rig: " + ec.message();
@@ -239,7 +236,7 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
     going = on_sample(L, s, wall0) && !L.seq.done();
     if (going == false && L.result.state.empty()) L.result.state = "completed";
   }
-  L.result.dropped = ctx.writer.stats().dropped_full;
+  L.result.dropped = ctx.writer.stats().dropped_full - dropped_before;
   finish_run(L.result, campaign_id, plan, L.builder.get(), L.fot.get(), L.series, ctx);
   L.state(L.result.state, L.result.reason.empty() ? "finished" : L.result.reason);
   return L.result;

@@ -39,8 +39,9 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
     json r = j["rigs"][k];
     if (!r.is_object()) fail(where, "must be an object");
     RigEntry e;
-    e.name = r.value("name", json("rig " + std::to_string(k + 1))).is_string() ? r.value("name", "rig " + std::to_string(k + 1)) : "";
-    if (e.name.empty()) fail(where + ".name", "must be a non-empty string");
+    if (r.contains("name") && (!r["name"].is_string() || r["name"].get<std::string>().empty()))
+      fail(where + ".name", "must be a non-empty string");
+    e.name = r.value("name", "rig " + std::to_string(k + 1));
     for (std::size_t m = 0; m < k; ++m)
       if (j["rigs"][m].value("name", "") == e.name) fail(where + ".name", "repeats the name of rigs[" + std::to_string(m) + "]");
     e.time_scale = positive(r, "time_scale", 1.0, where);
