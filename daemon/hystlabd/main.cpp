@@ -4,7 +4,9 @@
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,28 +14,33 @@
 
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/web/http_api.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
-const char* kHelp = R"(usage: hystlabd [--config hystlab.json] [--db PATH]
+const char* kHelp = R"(usage: hystlabd [--config hystlab.json] [--db PATH] [--port N] [--bind ADDRESS]
 
-Runs campaigns on rigs and stores everything in one SQLite file. Without a config: one simulated
-load frame (hystlab-sim, started and supervised) and ./hystlab.db. Submit and follow campaigns
-with 'hystlab campaign ...'. SIGTERM or SIGINT stops it cleanly.
+Runs campaigns on rigs and stores everything in one SQLite file, and serves the HTTP/JSON API and
+the page (http://127.0.0.1:8080/ by default; --port 0 picks a free port). Without a config: one
+simulated load frame (hystlab-sim, started and supervised) and ./hystlab.db. Binding beyond
+loopback needs a token (http.token in the config, or $HYSTLAB_TOKEN). Submit and follow
+campaigns from the page, the API (docs/API.md) or 'hystlab campaign ...'. SIGTERM or SIGINT
+stops it cleanly.
 )";
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string config_path, db_path;
+  std::string config_path, db_path, port, bind;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--help" || a == "-h") {
       std::cout << kHelp;
       return 0;
     }
-    if ((a == "--config" || a == "--db") && k + 1 < argc) (a == "--config" ? config_path : db_path) = argv[++k];
+    if ((a == "--config" || a == "--db" || a == "--port" || a == "--bind") && k + 1 < argc)
+      (a == "--config" ? config_path : a == "--db" ? db_path : a == "--port" ? port : bind) = argv[++k];
     else {
       std::cerr << "hystlabd: error: unknown argument '" << a << "' (see --help)\n";
       return 2;
@@ -62,7 +69,19 @@ int main(int argc, char** argv) {
     }
     hystlab::daemon::DaemonConfig cfg = hystlab::daemon::parse_daemon_config(j, base);
     if (!db_path.empty()) cfg.db_path = db_path;
-    return hystlab::daemon::run_daemon(cfg, g_stop);
+    if (!bind.empty()) cfg.http.bind = bind;
+    if (!port.empty()) {
+      if (port.find_first_not_of("0123456789") != std::string::npos || port.size() > 5 || std::stoi(port) > 65535)
+        throw hystlab::daemon::ConfigError("--port: '" + port + "' is not a port number (0 to 65535)");
+      cfg.http.port = std::stoi(port);
+    }
+    hystlab::daemon::check_http_security(cfg.http, std::getenv("HYSTLAB_TOKEN"));
+    hystlab::daemon::Daemon daemon(cfg);
+    std::unique_ptr<hystlab::web::HttpApi> http;
+    if (cfg.http.enabled) http = std::make_unique<hystlab::web::HttpApi>(daemon, cfg.http);
+    daemon.run(g_stop);
+    if (http) http->stop();
+    return 0;
   } catch (const hystlab::daemon::ConfigError& e) {
     std::cerr << "hystlabd: error: " << e.what() << "\n";
     return 2;

@@ -105,6 +105,10 @@ bool on_sample(Loop& L, const drivers::RigSample& s, double wall0) {
   L.ctx.writer.try_push({L.run, L.next_seq++, s.time_s, s.command_mm, s.displacement_mm, s.force_N, s.status_word});
   L.series.add(s.displacement_mm, s.force_N);
   ++L.result.samples;
+  if (RigLive* live = L.ctx.live) {
+    live->ring.push({mono_now(), s.time_s, s.command_mm, s.displacement_mm, s.force_N, L.run, s.status_word});
+    live->samples.fetch_add(1, std::memory_order_relaxed);
+  }
   if (auto trip = L.safety.check(s.displacement_mm, s.force_N, s.time_s)) {
     L.result.reason = "safety trip: " + *trip;
     go_safe(L, wall0);
@@ -204,7 +208,10 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
     next += period;
     sleep_until(next);
     const double now = mono_now();
-    if (now - next > period) ++L.result.missed_deadlines;  // counted, never hidden
+    if (now - next > period) {  // counted, never hidden
+      ++L.result.missed_deadlines;
+      if (ctx.live) ctx.live->missed_deadlines.fetch_add(1, std::memory_order_relaxed);
+    }
     if (ctx.loop_periods_us && prev_tick > 0) ctx.loop_periods_us->push_back(static_cast<float>((now - prev_tick) * 1e6));
     prev_tick = now;
     if (ctx.stop && ctx.stop->load()) {

@@ -3,135 +3,93 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
-#include <ctime>
-#include <deque>
-#include <filesystem>
-#include <memory>
+#include <condition_variable>
+#include <future>
 #include <mutex>
-#include <thread>
 
-#include "hystlab/daemon/campaign_runner.hpp"
-#include "hystlab/db/sample_writer.hpp"
+#include "hystlab/daemon/plan.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
-#include "sim_child.hpp"
+#include "rig_worker.hpp"
 
 namespace hystlab::daemon {
-namespace {
 using nlohmann::json;
 
-std::string now_iso() {
-  const auto t = std::chrono::system_clock::now();
-  const std::time_t s = std::chrono::system_clock::to_time_t(t);
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  char buf[96];
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count() % 1000;
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
-                tm.tm_hour, tm.tm_min, tm.tm_sec, static_cast<int>(ms));
-  return buf;
-}
-
-// One rig: its driver, its acquisition thread, and the commands queued for its campaign.
-struct RigWorker {
-  RigEntry entry;
-  std::int64_t rig_id = 0;
-  std::unique_ptr<SimChild> sim;
-  std::unique_ptr<drivers::Rig> rig;
+struct Daemon::Impl {
+  DaemonConfig config;
+  db::Store store;  // the main loop's connection
+  std::vector<std::unique_ptr<RigWorker>> workers;
+  std::unique_ptr<db::SampleWriter> writer;
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
   std::mutex mu;
-  std::deque<Control> controls;
-  std::atomic<std::int64_t> running_campaign{0};
-  std::thread thread;
+  std::condition_variable cv;
+  std::deque<std::function<void()>> jobs;  // from other threads, run by the main loop
+  bool accepting = true;
+  const std::atomic<bool>* stop = nullptr;
 
-  void build_rig(const std::string& base) {
-    json cfg = entry.driver;
-    if (entry.simulated) {
-      if (!sim) sim = std::make_unique<SimChild>(entry.sim);
-      cfg = json{{"name", entry.name}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", sim->ensure_running()},
-                 {"rig", entry.sim.rig}};
-      entry.time_scale = entry.sim.time_scale;
+  explicit Impl(const DaemonConfig& c) : config(c), store(c.db_path) {}
+
+  // Runs f on the main loop with its store and waits for it (at most a few seconds).
+  template <class R>
+  R on_main(std::function<R()> f) {
+    auto task = std::make_shared<std::packaged_task<R()>>(std::move(f));
+    auto fut = task->get_future();
+    {
+      std::lock_guard lk(mu);
+      if (!accepting) throw std::runtime_error("the daemon is stopping");
+      jobs.emplace_back([task] { (*task)(); });
     }
-    cfg["name"] = entry.name;
-    rig = drivers::make_rig(cfg, "rig '" + entry.name + "'", base);
+    cv.notify_one();
+    if (fut.wait_for(std::chrono::seconds(10)) != std::future_status::ready)
+      throw std::runtime_error("the daemon did not answer within 10 s");
+    return fut.get();
   }
-  std::optional<Control> pop() {
-    std::lock_guard lk(mu);
-    if (controls.empty()) return std::nullopt;
-    const Control c = controls.front();
-    controls.pop_front();
-    return c;
+
+  // An operator command, as the CLI's (db) and the API's (queue) both arrive.
+  void route(std::int64_t campaign, const std::string& verb) {
+    const auto row = store.campaign(campaign);
+    if (!row) return;
+    for (auto& w : workers)
+      if (w->running_campaign == campaign) {
+        w->push(verb == "pause" ? Control::pause : verb == "resume" ? Control::resume : verb == "estop" ? Control::estop : Control::abort);
+        return;
+      }
+    if (verb == "resume" && (row->state == "interrupted" || row->state == "paused"))
+      store.transition(campaign, "queued", "re-queued to resume: wipe-out preamble, then the rows not yet measured", now_iso());
+    else if ((verb == "abort" || verb == "estop") && row->state == "queued")
+      store.transition(campaign, "aborted", "aborted by the operator before it started", now_iso());
+    else
+      store.add_event(campaign, "command", "'" + verb + "' ignored: the campaign is " + row->state, now_iso());
+  }
+
+  void store_io_stats() {
+    for (auto& w : workers) {
+      const auto h = w->rig->health();
+      const json stats{{"reads", h.reads}, {"writes", h.writes}, {"errors", h.total_errors()}, {"reconnects", h.reconnects},
+                       {"max_transaction_us", h.max_transaction_us}};
+      const auto id = w->info.id;
+      const std::string now = now_iso();
+      writer->post([id, stats, now](db::Store& s) {
+        db::Statement st(s.database(), "INSERT INTO io_stats(rig_id, at, stats) VALUES(?,?,?)");
+        st.bind(1, id).bind(2, now).bind(3, stats.dump());
+        st.step();
+      });
+    }
+  }
+
+  void run_jobs() {
+    std::deque<std::function<void()>> todo;
+    {
+      std::unique_lock lk(mu);
+      cv.wait_for(lk, std::chrono::milliseconds(100), [this] { return !jobs.empty(); });
+      todo.swap(jobs);
+    }
+    for (auto& j : todo) j();
   }
 };
 
-void run_one(RigWorker& w, std::int64_t id, db::Store& store, db::SampleWriter& writer, const std::atomic<bool>& stop,
-             const std::string& base) {
-  const auto row = store.campaign(id);
-  if (!row) return;
-  Plan plan;
-  try {
-    plan = parse_plan(json::parse(row->plan));
-  } catch (const std::exception& e) {  // a plan stored by an older or foreign tool: fail it, say why
-    store.transition(id, "failed", e.what(), now_iso());
-    return;
-  }
-  if (w.entry.simulated && w.sim && w.sim->ensure_running() != w.sim->port()) w.build_rig(base);
-  RunnerContext ctx(*w.rig, writer, store);
-  ctx.time_scale = w.entry.time_scale;
-  ctx.stop = &stop;
-  ctx.now_iso = now_iso;
-  ctx.next_control = [&w] { return w.pop(); };
-  for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) ctx.prior_nodes.push_back({a, b, fa, fab});
-  ctx.on_state = [&w, id](const std::string& s) { spdlog::info("rig '{}': campaign {} {}", w.entry.name, id, s); };
-  w.running_campaign = id;
-  const RunnerResult r = run_campaign(id, plan, ctx);
-  w.running_campaign = 0;
-  spdlog::info("rig '{}': campaign {} ended {} ({} samples, {} missed deadlines, {} dropped){}{}", w.entry.name, id, r.state,
-               r.samples, r.missed_deadlines, r.dropped, r.reason.empty() ? "" : ": ", r.reason);
-}
-
-void rig_thread(RigWorker& w, const std::string& db_path, db::SampleWriter& writer, const std::atomic<bool>& stop,
-                const std::string& base) {
-  db::Store store(db_path);
-  while (!stop) {
-    const auto queued = store.queued_campaigns(w.rig_id);
-    if (!queued.empty()) {
-      run_one(w, queued.front(), store, writer, stop, base);
-      continue;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  }
-}
-
-// Main thread: operator commands from the store to the right rig, and I/O statistics.
-void route_commands(db::Store& store, std::vector<std::unique_ptr<RigWorker>>& workers) {
-  for (const auto& c : store.take_commands(now_iso())) {
-    const auto row = store.campaign(c.campaign_id);
-    if (!row) continue;
-    bool routed = false;
-    for (auto& w : workers)
-      if (w->running_campaign == c.campaign_id) {
-        const Control k = c.command == "pause"    ? Control::pause
-                          : c.command == "resume" ? Control::resume
-                          : c.command == "estop"  ? Control::estop
-                                                  : Control::abort;
-        std::lock_guard lk(w->mu);
-        w->controls.push_back(k);
-        routed = true;
-      }
-    if (routed) continue;
-    if (c.command == "resume" && (row->state == "interrupted" || row->state == "paused"))
-      store.transition(c.campaign_id, "queued", "re-queued to resume: wipe-out preamble, then the rows not yet measured", now_iso());
-    else if (c.command == "abort" && row->state == "queued")
-      store.transition(c.campaign_id, "aborted", "aborted by the operator before it started", now_iso());
-    else
-      store.add_event(c.campaign_id, "command", "'" + c.command + "' ignored: the campaign is " + row->state, now_iso());
-  }
-}
-}  // namespace
-
-int run_daemon(const DaemonConfig& config, const std::atomic<bool>& stop) {
-  db::Store store(config.db_path);
-  if (const int n = store.mark_interrupted(now_iso())) spdlog::warn("{} campaign(s) were left running: now interrupted", n);
-  std::vector<std::unique_ptr<RigWorker>> workers;
+Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config)) {
+  auto& d = *impl_;
+  if (const int n = d.store.mark_interrupted(now_iso())) spdlog::warn("{} campaign(s) were left running: now interrupted", n);
   for (const RigEntry& e : config.rigs) {
     auto w = std::make_unique<RigWorker>();
     w->entry = e;
@@ -140,38 +98,91 @@ int run_daemon(const DaemonConfig& config, const std::atomic<bool>& stop) {
     } catch (const drivers::RigConfigError& err) {
       throw ConfigError(std::string("config: ") + err.what());
     }
-    w->rig_id = store.upsert_rig(e.name, e.simulated ? json{{"simulate", {{"time_scale", e.sim.time_scale}}}}.dump() : e.driver.dump(), now_iso());
-    spdlog::info("rig '{}': {}", e.name, w->rig->describe());
-    workers.push_back(std::move(w));
+    w->info.id = d.store.upsert_rig(e.name, e.simulated ? json{{"simulate", {{"time_scale", e.sim.time_scale}, {"rig", e.sim.rig}}}}.dump() : e.driver.dump(), now_iso());
+    spdlog::info("rig '{}': {}", e.name, w->info.description);
+    d.workers.push_back(std::move(w));
   }
-  db::SampleWriter writer(config.db_path);
-  for (auto& w : workers) w->thread = std::thread(rig_thread, std::ref(*w), config.db_path, std::ref(writer), std::cref(stop), config.base_dir);
-  spdlog::info("hystlabd running: database {}", config.db_path);
+  d.writer = std::make_unique<db::SampleWriter>(config.db_path);
+}
+
+Daemon::~Daemon() {
+  auto& d = *impl_;
+  {
+    std::lock_guard lk(d.mu);
+    d.accepting = false;
+  }
+  for (auto& w : d.workers)
+    if (w->thread.joinable()) w->thread.join();
+  d.writer->flush();
+  for (auto& w : d.workers)
+    if (w->sim) w->sim->stop();
+}
+
+void Daemon::run(const std::atomic<bool>& stop) {
+  auto& d = *impl_;
+  for (auto& w : d.workers)
+    w->thread = std::thread(rig_thread, std::ref(*w), d.config.db_path, std::ref(*d.writer), std::cref(stop), d.config.base_dir);
+  spdlog::info("hystlabd running: database {}", d.config.db_path);
   auto last_stats = std::chrono::steady_clock::now();
   while (!stop) {
-    route_commands(store, workers);
+    d.run_jobs();
+    for (const auto& c : d.store.take_commands(now_iso())) d.route(c.campaign_id, c.command);
     if (std::chrono::steady_clock::now() - last_stats > std::chrono::seconds(10)) {
       last_stats = std::chrono::steady_clock::now();
-      for (auto& w : workers) {
-        const auto h = w->rig->health();
-        const json stats{{"reads", h.reads}, {"writes", h.writes}, {"errors", h.total_errors()}, {"reconnects", h.reconnects},
-                         {"max_transaction_us", h.max_transaction_us}};
-        const auto id = w->rig_id;
-        const std::string now = now_iso();
-        writer.post([id, stats, now](db::Store& s) {
-          db::Statement st(s.database(), "INSERT INTO io_stats(rig_id, at, stats) VALUES(?,?,?)");
-          st.bind(1, id).bind(2, now).bind(3, stats.dump());
-          st.step();
-        });
-      }
+      d.store_io_stats();
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   spdlog::info("hystlabd stopping: holding rigs, finishing the write batch");
-  for (auto& w : workers) w->thread.join();  // each holds its rig and marks its campaign interrupted
-  writer.flush();
-  for (auto& w : workers)
-    if (w->sim) w->sim->stop();
+  {
+    std::lock_guard lk(d.mu);
+    d.accepting = false;
+  }
+  d.run_jobs();  // what was accepted is carried out (or its caller times out)
+  for (auto& w : d.workers) w->thread.join();  // each holds its rig and marks its campaign interrupted
+  d.writer->flush();
+}
+
+const DaemonConfig& Daemon::config() const noexcept { return impl_->config; }
+std::size_t Daemon::rig_count() const noexcept { return impl_->workers.size(); }
+const RigInfo& Daemon::rig_info(std::size_t k) const { return impl_->workers.at(k)->info; }
+const RigLive& Daemon::rig_live(std::size_t k) const { return impl_->workers.at(k)->live; }
+drivers::IoHealthSnapshot Daemon::rig_health(std::size_t k) const { return impl_->workers.at(k)->rig->health(); }
+db::WriterStats Daemon::writer_stats() const { return impl_->writer->stats(); }
+double Daemon::uptime_s() const noexcept {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - impl_->started).count();
+}
+
+std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) {
+  const Plan plan = parse_plan(plan_json);  // PlanError names the field
+  const RigWorker* rig = nullptr;
+  if (rig_name.empty()) {
+    if (impl_->workers.size() != 1) throw std::invalid_argument("rig: several rigs are configured; name one");
+    rig = impl_->workers.front().get();
+  } else {
+    for (const auto& w : impl_->workers)
+      if (w->info.name == rig_name) rig = w.get();
+    if (!rig) throw std::invalid_argument("rig: no rig named '" + rig_name + "'");
+  }
+  const bool shaker_plan = plan.kind == "sine";
+  if (shaker_plan != (rig->info.kind == "shaker"))
+    throw std::invalid_argument("plan.kind: a " + plan.kind + " plan cannot run on rig '" + rig->info.name + "', a " + rig->info.kind);
+  const std::int64_t rig_id = rig->info.id;
+  const std::string kind = plan.kind, text = plan_json.dump();
+  return impl_->on_main<std::int64_t>([this, rig_id, kind, text] { return impl_->store.create_campaign(rig_id, kind, text, now_iso()); });
+}
+
+void Daemon::command(std::int64_t campaign_id, const std::string& verb) {
+  if (verb != "pause" && verb != "resume" && verb != "abort" && verb != "estop")
+    throw std::invalid_argument("command: '" + verb + "' is not pause, resume, abort or estop");
+  impl_->on_main<int>([this, campaign_id, verb] {
+    impl_->route(campaign_id, verb);
+    return 0;
+  });
+}
+
+int run_daemon(const DaemonConfig& config, const std::atomic<bool>& stop) {
+  Daemon d(config);
+  d.run(stop);
   return 0;
 }
 

@@ -13,7 +13,39 @@ double positive(const json& j, const char* f, double def, const std::string& whe
     fail(where + "." + f, "must be a positive number");
   return j[f].get<double>();
 }
+bool loopback(const std::string& host) { return host == "127.0.0.1" || host == "localhost" || host == "::1"; }
+
+HttpConfig parse_http(const json& h, HttpConfig c) {
+  if (!h.is_object()) fail("http", "must be an object");
+  for (const auto& [k, v] : h.items()) {
+    if (k == "enabled") {
+      if (!v.is_boolean()) fail("http.enabled", "must be true or false");
+      c.enabled = v.get<bool>();
+    } else if (k == "bind" || k == "token" || k == "web_root" || k == "vendor_root") {
+      if (!v.is_string() || (k == "bind" && v.get<std::string>().empty())) fail("http." + k, "must be a non-empty string");
+      (k == "bind" ? c.bind : k == "token" ? c.token : k == "web_root" ? c.web_root : c.vendor_root) = v.get<std::string>();
+    } else if (k == "port" || k == "max_stream_clients") {
+      if (!v.is_number_integer() || v.get<long long>() < (k == "port" ? 0 : 1) || v.get<long long>() > (k == "port" ? 65535 : 1000))
+        fail("http." + k, k == "port" ? "must be a port number (0 to 65535; 0 picks a free one)" : "must be a whole number from 1 to 1000");
+      (k == "port" ? c.port : c.max_stream_clients) = v.get<int>();
+    } else if (k == "max_body_bytes") {
+      if (!v.is_number_integer() || v.get<long long>() < 1024) fail("http.max_body_bytes", "must be a whole number of at least 1024");
+      c.max_body_bytes = v.get<std::size_t>();
+    } else {
+      fail("http." + k, "is not a known field (enabled, bind, port, token, web_root, vendor_root, max_stream_clients, max_body_bytes)");
+    }
+  }
+  return c;
+}
 }  // namespace
+
+void check_http_security(HttpConfig& http, const char* env_token) {
+  if (http.token.empty() && env_token && *env_token) http.token = env_token;
+  if (http.enabled && !loopback(http.bind) && http.token.size() < 16)
+    throw ConfigError("config: http.bind is '" + http.bind +
+                      "', not loopback: set a token of at least 16 characters (http.token or $HYSTLAB_TOKEN) that every "
+                      "request changing state must carry");
+}
 
 DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
   DaemonConfig c;
@@ -24,7 +56,8 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
   }
   if (!j.is_object()) fail("", "must be a JSON object");
   for (const auto& [k, _] : j.items())
-    if (k != "db" && k != "rigs") fail(k, "is not a known field (db, rigs)");
+    if (k != "db" && k != "rigs" && k != "http") fail(k, "is not a known field (db, rigs, http)");
+  if (j.contains("http")) c.http = parse_http(j["http"], c.http);
   if (j.contains("db")) {
     if (!j["db"].is_string() || j["db"].get<std::string>().empty()) fail("db", "must be a file name");
     c.db_path = j["db"].get<std::string>();

@@ -56,7 +56,10 @@ RunnerResult run_sine_campaign(std::int64_t campaign_id, const Plan& plan, Runne
     for (double t = t_start; t < t_end && r.state.empty();) {
       next += period;
       sleep_until(next);
-      if (mono_now() - next > period) ++r.missed_deadlines;
+      if (mono_now() - next > period) {
+        ++r.missed_deadlines;
+        if (ctx.live) ctx.live->missed_deadlines.fetch_add(1, std::memory_order_relaxed);
+      }
       t = (mono_now() - wall0) * ctx.time_scale;
       if (ctx.stop && ctx.stop->load()) r.state = "interrupted", r.reason = "the daemon is stopping";
       if (const auto c = ctx.next_control(); c && (*c == Control::abort || *c == Control::estop)) {
@@ -75,6 +78,10 @@ RunnerResult run_sine_campaign(std::int64_t campaign_id, const Plan& plan, Runne
       // Shaker samples: base displacement in cmd, mass displacement in disp, mass acceleration in force.
       ctx.writer.try_push({r.run_id, seq++, t, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, s.status_word});
       ++r.samples;
+      if (ctx.live) {
+        ctx.live->ring.push({mono_now(), t, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, r.run_id, s.status_word});
+        ctx.live->samples.fetch_add(1, std::memory_order_relaxed);
+      }
       if (std::fabs(s.mass_displacement_mm) > plan.limits.displacement_max_mm)
         r.state = "aborted", r.reason = "safety trip: mass displacement beyond the limits";
       if (t >= t_measure) {

@@ -40,6 +40,7 @@ std::uint64_t IoHealthSnapshot::total_errors() const noexcept {
 void IoHealth::record_transaction(bool write, double us) noexcept {
   (write ? writes_ : reads_).fetch_add(1, std::memory_order_relaxed);
   last_us_.store(us, std::memory_order_relaxed);
+  total_us_.store(total_us_.load(std::memory_order_relaxed) + us, std::memory_order_relaxed);  // one I/O thread writes
   if (us > max_us_.load(std::memory_order_relaxed)) max_us_.store(us, std::memory_order_relaxed);
   std::size_t b = 0;
   for (double edge = 2.0; us >= edge && b + 1 < kLatencyBuckets; edge *= 2.0) ++b;
@@ -54,6 +55,7 @@ IoHealthSnapshot IoHealth::snapshot() const noexcept {
   for (std::size_t k = 0; k < kRigErrorCount; ++k) s.errors[k] = errors_[k].load(std::memory_order_relaxed);
   s.last_transaction_us = last_us_.load(std::memory_order_relaxed);
   s.max_transaction_us = max_us_.load(std::memory_order_relaxed);
+  s.total_transaction_us = total_us_.load(std::memory_order_relaxed);
   for (std::size_t k = 0; k < kLatencyBuckets; ++k) s.latency_histogram[k] = histogram_[k].load(std::memory_order_relaxed);
   return s;
 }

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/drivers/rig.hpp"
@@ -34,6 +35,7 @@ struct RunnerContext {
   // Resuming an interrupted campaign: the nodes its earlier runs measured. Rows they complete
   // are not driven again; the rest follow a wipe-out preamble to δmin.
   std::vector<models::FotNode> prior_nodes;
+  RigLive* live = nullptr;                        // when set, every sample and missed deadline is shown there
   std::vector<float>* loop_periods_us = nullptr;  // when set, every tick's period is recorded (benchmarks)
 };
 

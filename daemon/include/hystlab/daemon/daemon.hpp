@@ -5,13 +5,20 @@
 // Config (hystlab.json), every field optional:
 //   {"db": "hystlab.db",
 //    "rigs": [{"name": "frame A", "transport": "modbus-tcp", "port": 502, "time_scale": 1, ...},
-//             {"name": "sim frame", "simulate": {"time_scale": 20, "noise_N": 0.05}}]}
+//             {"name": "sim frame", "simulate": {"time_scale": 20, "noise_N": 0.05}}],
+//    "http": {"bind": "127.0.0.1", "port": 8080, "token": "...", "max_stream_clients": 64}}
 // With no config: one simulated load frame (hystlab-sim, supervised) and ./hystlab.db.
 #include <atomic>
+#include <cstdint>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "hystlab/daemon/live_feed.hpp"
+#include "hystlab/db/sample_writer.hpp"
+#include "hystlab/drivers/io_health.hpp"
 
 namespace hystlab::daemon {
 
@@ -32,14 +39,70 @@ struct RigEntry {
   SimulatorOptions sim;
 };
 
+// The HTTP/JSON API and the page (web/). Binding anywhere but loopback needs a token, which every
+// request that changes state must carry; the daemon refuses to start otherwise.
+struct HttpConfig {
+  bool enabled = true;
+  std::string bind = "127.0.0.1";
+  int port = 8080;
+  std::string token;           // from the config, or $HYSTLAB_TOKEN
+  std::string web_root;        // the page; empty: the one built in (web/static of the source tree, or installed)
+  std::string vendor_root;     // the plotting library's files (npm's uplot/dist)
+  int max_stream_clients = 64; // SSE subscribers; each holds one pool thread
+  std::size_t max_body_bytes = 8U << 20;
+};
+
 struct DaemonConfig {
   std::string db_path = "hystlab.db";
   std::vector<RigEntry> rigs;
   std::string base_dir = ".";
+  HttpConfig http;
 };
 
 // Throws ConfigError naming the field. A null json gives the embedded defaults.
 [[nodiscard]] DaemonConfig parse_daemon_config(const nlohmann::json& j, const std::string& base_dir = ".");
+
+// Takes the token from $HYSTLAB_TOKEN when the config has none; refuses (ConfigError) a bind
+// beyond loopback without a token.
+void check_http_security(HttpConfig& http, const char* env_token);
+
+struct RigInfo {
+  std::int64_t id = 0;
+  std::string name, kind, description;  // kind: "load_frame" or "shaker"
+  bool simulated = false;
+};
+
+// The daemon's owners: one acquisition thread per rig, the db writer thread, and the main loop
+// (run) that carries out commands and keeps the snapshots. Other threads (HTTP) read the
+// snapshots and live feeds, and send commands through a queue; they never touch a rig.
+class Daemon {
+ public:
+  explicit Daemon(const DaemonConfig& config);  // opens the store, creates the rigs; throws ConfigError
+  ~Daemon();
+  Daemon(const Daemon&) = delete;
+  Daemon& operator=(const Daemon&) = delete;
+
+  // The main loop: returns when stop becomes true, with the rigs held and the writes flushed.
+  void run(const std::atomic<bool>& stop);
+
+  [[nodiscard]] const DaemonConfig& config() const noexcept;
+  [[nodiscard]] std::size_t rig_count() const noexcept;
+  [[nodiscard]] const RigInfo& rig_info(std::size_t k) const;
+  [[nodiscard]] const RigLive& rig_live(std::size_t k) const;
+  [[nodiscard]] drivers::IoHealthSnapshot rig_health(std::size_t k) const;
+  [[nodiscard]] db::WriterStats writer_stats() const;
+  [[nodiscard]] double uptime_s() const noexcept;
+
+  // Queues a campaign on a rig (empty name: the only rig). Throws std::invalid_argument naming
+  // what is wrong (the plan's field, an unknown rig, a plan the rig cannot run).
+  std::int64_t submit(const std::string& rig_name, const nlohmann::json& plan);
+  // pause, resume, abort, estop: carried out by the main loop, as the CLI's commands are.
+  void command(std::int64_t campaign_id, const std::string& verb);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // Runs until stop becomes true; returns the process exit code.
 int run_daemon(const DaemonConfig& config, const std::atomic<bool>& stop);

@@ -15,7 +15,7 @@ inline constexpr std::size_t kLatencyBuckets = 16;  // bucket k: [2^k, 2^(k+1)) 
 struct IoHealthSnapshot {
   std::uint64_t reads = 0, writes = 0, reconnects = 0;
   std::array<std::uint64_t, kRigErrorCount> errors{};  // index = RigError value (0 unused)
-  double last_transaction_us = 0, max_transaction_us = 0;
+  double last_transaction_us = 0, max_transaction_us = 0, total_transaction_us = 0;
   std::array<std::uint64_t, kLatencyBuckets> latency_histogram{};
   [[nodiscard]] std::uint64_t errors_of(RigError e) const noexcept { return errors[static_cast<std::size_t>(e)]; }
   [[nodiscard]] std::uint64_t total_errors() const noexcept;
@@ -31,7 +31,7 @@ class IoHealth {
  private:
   std::atomic<std::uint64_t> reads_{0}, writes_{0}, reconnects_{0};
   std::array<std::atomic<std::uint64_t>, kRigErrorCount> errors_{};
-  std::atomic<double> last_us_{0}, max_us_{0};
+  std::atomic<double> last_us_{0}, max_us_{0}, total_us_{0};
   std::array<std::atomic<std::uint64_t>, kLatencyBuckets> histogram_{};
 };
 

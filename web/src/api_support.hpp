@@ -1,0 +1,56 @@
+#pragma once
+// Small helpers shared by the API's route files: JSON answers, errors as
+// {"error", "detail"} with the right status, argument parsing, and each HTTP thread's own
+// read connection to the store.
+#include <httplib.h>
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "hystlab/daemon/daemon.hpp"
+#include "hystlab/db/store.hpp"
+
+namespace hystlab::web {
+
+using nlohmann::json;
+
+// Thrown by handlers; turned into {"error": error, "detail": detail} with this status.
+struct ApiError : std::runtime_error {
+  ApiError(int status_code, std::string error_text, const std::string& detail_text)
+      : std::runtime_error(detail_text), status(status_code), error(std::move(error_text)) {}
+  int status;
+  std::string error;
+};
+
+void send_json(httplib::Response& res, const json& body, int status = 200);
+void send_error(httplib::Response& res, int status, const std::string& error, const std::string& detail);
+
+// Wraps a handler: every exception becomes one JSON error (400 for bad input, 500 otherwise).
+httplib::Server::Handler guarded(std::function<void(const httplib::Request&, httplib::Response&)> f);
+
+// The id captured by the route's first group; 404 when it is out of range.
+std::int64_t path_id(const httplib::Request& req, std::size_t group = 1);
+// A query parameter as a number in [lo, hi]; def when absent; 400 naming it otherwise.
+double query_number(const httplib::Request& req, const char* name, double def, double lo, double hi);
+// The body as a JSON object; 400 naming the problem otherwise.
+json body_object(const httplib::Request& req);
+
+// This thread's read connection (WAL: never blocks the writer).
+db::Store& reader(const std::string& db_path);
+
+// Shared by the route files.
+struct ApiContext {
+  ApiContext(daemon::Daemon& d, const daemon::HttpConfig& c, std::string db) : daemon(d), config(c), db_path(std::move(db)) {}
+  daemon::Daemon& daemon;
+  const daemon::HttpConfig& config;
+  std::string db_path;
+  std::atomic<int> stream_clients{0};
+  std::atomic<bool> stopping{false};
+  std::atomic<std::uint64_t> requests{0};
+};
+
+}  // namespace hystlab::web

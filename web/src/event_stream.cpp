@@ -1,0 +1,152 @@
+#include "event_stream.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <thread>
+
+#include "hystlab/db/sqlite.hpp"
+#include "routes.hpp"
+
+namespace hystlab::web {
+namespace {
+constexpr auto kTick = std::chrono::milliseconds(50);  // samples leave at most this long after acquisition
+constexpr int kRecordEvery = 4;                          // ticks between database polls (200 ms)
+constexpr int kKeepAliveEvery = 300;                     // ticks between comments on a quiet stream (15 s)
+
+struct StreamState {
+  StreamCursor cursor;
+  std::vector<std::uint64_t> ring_pos;  // per rig
+  std::vector<std::size_t> rigs;        // which rigs
+  double rate_hz = 20;
+  int tick = 0, quiet = 0;
+  bool hello_sent = false;
+};
+
+StreamCursor newest(db::Store& store) {
+  auto max_id = [&](const char* table) {
+    db::Statement st(store.database(), std::string("SELECT coalesce(max(id), 0) FROM ") + table);
+    st.step();
+    return st.column_int(0);
+  };
+  return {max_id("events"), max_id("fot_nodes"), max_id("tables")};
+}
+
+std::string frame(const std::string& type, const json& data, const std::string& id = {}) {
+  std::string f = id.empty() ? "" : "id: " + id + "\n";
+  return f + "event: " + type + "\ndata: " + data.dump(-1, ' ', false, json::error_handler_t::replace) + "\n\n";
+}
+
+// Records stored since the cursor, as frames; advances the cursor.
+std::string records(db::Store& store, StreamCursor& cur) {
+  std::string out;
+  db::Statement ev(store.database(), "SELECT id, campaign_id, at, kind, coalesce(from_state, ''), coalesce(to_state, ''), coalesce(detail, '') "
+                                     "FROM events WHERE id > ? ORDER BY id LIMIT 500");
+  ev.bind(1, cur.event);
+  while (ev.step()) {
+    cur.event = ev.column_int(0);
+    const std::string kind = ev.column_text(3), detail = ev.column_text(6);
+    json d = json::parse(detail, nullptr, false);
+    if (d.is_discarded()) d = detail;
+    json j{{"id", cur.event}, {"campaign", ev.column_int(1)}, {"at", ev.column_text(2)}, {"kind", kind}, {"detail", d}};
+    if (kind == "state") j["from"] = ev.column_text(4), j["to"] = ev.column_text(5);
+    out += frame(kind == "state" ? "campaign" : kind, j, cur.id());
+  }
+  db::Statement nd(store.database(), "SELECT f.id, r.campaign_id, f.run_id, alpha, beta, force_alpha, force_alpha_beta, f.t FROM fot_nodes f "
+                                     "JOIN runs r ON r.id = f.run_id WHERE f.id > ? ORDER BY f.id LIMIT 2000");
+  nd.bind(1, cur.node);
+  while (nd.step()) {
+    cur.node = nd.column_int(0);
+    out += frame("node", node_json(nd), cur.id());
+  }
+  db::Statement tb(store.database(), "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy FROM tables "
+                                     "WHERE id > ? ORDER BY id LIMIT 100");
+  tb.bind(1, cur.table);
+  while (tb.step()) {
+    cur.table = tb.column_int(0);
+    out += frame("table", table_row_json(tb), cur.id());
+  }
+  return out;
+}
+
+// New live samples of each rig, one frame per rig, every stride-th sample.
+std::string samples(const daemon::Daemon& d, StreamState& st) {
+  std::string out;
+  std::vector<daemon::LiveSample> got;
+  for (std::size_t k = 0; k < st.rigs.size(); ++k) {
+    const daemon::RigLive& live = d.rig_live(st.rigs[k]);
+    const double rig_rate = live.campaign.load() != 0 ? live.sample_rate_hz.load() : 0.0;
+    const auto stride = static_cast<std::size_t>(std::max(1.0, std::floor(rig_rate / st.rate_hz)));
+    got.clear();
+    st.ring_pos[k] = live.ring.read(st.ring_pos[k], stride, got);
+    if (got.empty()) continue;
+    json t, cmd, disp, force;
+    for (const auto& s : got) t.push_back(s.t), cmd.push_back(s.cmd), disp.push_back(s.disp), force.push_back(s.force);
+    out += frame("samples", {{"rig", d.rig_info(st.rigs[k]).name}, {"run", got.back().run}, {"t", t}, {"cmd", cmd}, {"disp", disp},
+                             {"force", force}, {"status", got.back().status}, {"mono_s", got.back().mono_s}});
+  }
+  return out;
+}
+
+bool write(httplib::DataSink& sink, const std::string& s) { return s.empty() || sink.write(s.data(), s.size()); }
+}  // namespace
+
+std::string StreamCursor::id() const { return std::to_string(event) + "." + std::to_string(node) + "." + std::to_string(table); }
+
+std::optional<StreamCursor> parse_cursor(const std::string& text) {
+  StreamCursor c;
+  long long e = -1, n = -1, t = -1;
+  int used = 0;
+  if (text.size() > 60 || std::sscanf(text.c_str(), "%lld.%lld.%lld%n", &e, &n, &t, &used) != 3 || used != static_cast<int>(text.size()) ||
+      e < 0 || n < 0 || t < 0 || text.find_first_of("+- ") != std::string::npos)
+    return std::nullopt;
+  return StreamCursor{e, n, t};
+}
+
+void add_stream_route(httplib::Server& s, ApiContext& c) {
+  s.Get("/api/stream", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    auto st = std::make_shared<StreamState>();
+    st->rate_hz = query_number(req, "rate", 20, 0.1, 1000);
+    const std::string last = req.has_header("Last-Event-ID") ? req.get_header_value("Last-Event-ID")
+                             : req.has_param("last_event_id") ? req.get_param_value("last_event_id") : "";
+    if (!last.empty()) {
+      const auto cur = parse_cursor(last);
+      if (!cur) throw ApiError(400, "invalid parameter", "Last-Event-ID: '" + last + "' is not an id this stream sent (E.N.T)");
+      st->cursor = *cur;
+    } else {
+      st->cursor = newest(reader(c.db_path));
+    }
+    const std::string rig = req.has_param("rig") ? req.get_param_value("rig") : "";
+    for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
+      if (rig.empty() || c.daemon.rig_info(k).name == rig) st->rigs.push_back(k);
+    if (st->rigs.empty()) throw ApiError(404, "not found", "rig: no rig named '" + rig + "'");
+    for (std::size_t k : st->rigs) st->ring_pos.push_back(c.daemon.rig_live(k).ring.head());
+    if (c.stream_clients.fetch_add(1) >= c.config.max_stream_clients) {
+      c.stream_clients.fetch_sub(1);
+      throw ApiError(503, "too many streams", "at most " + std::to_string(c.config.max_stream_clients) + " event streams at once (http.max_stream_clients)");
+    }
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Accel-Buffering", "no");
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [&c, st](std::size_t, httplib::DataSink& sink) {
+          if (c.stopping) {
+            sink.done();
+            return true;
+          }
+          if (!st->hello_sent) {
+            st->hello_sent = true;
+            return write(sink, "retry: 2000\n\n" + frame("hello", {{"cursor", st->cursor.id()}, {"rate_hz", st->rate_hz}}));
+          }
+          std::this_thread::sleep_for(kTick);
+          std::string out = samples(c.daemon, *st);
+          if (++st->tick % kRecordEvery == 0) out += records(reader(c.db_path), st->cursor);
+          if (out.empty() && ++st->quiet >= kKeepAliveEvery) out = ": keep-alive\n\n";
+          if (!out.empty()) st->quiet = 0;
+          return write(sink, out) && sink.is_writable();
+        },
+        [&c](bool) { c.stream_clients.fetch_sub(1); });
+  }));
+}
+
+}  // namespace hystlab::web

@@ -1,0 +1,106 @@
+#include "hystlab/web/http_api.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <thread>
+
+#include "api_support.hpp"
+#include "event_stream.hpp"
+#include "routes.hpp"
+
+namespace hystlab::web {
+namespace {
+bool changes_state(const std::string& method) { return method != "GET" && method != "HEAD" && method != "OPTIONS"; }
+
+// Equal-time comparison: the token must not leak through timing.
+bool same_secret(const std::string& a, const std::string& b) {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  for (std::size_t k = 0; k < a.size(); ++k) diff |= static_cast<unsigned char>(a[k] ^ (k < b.size() ? b[k] : 0));
+  return diff == 0;
+}
+
+// Requests that change state: same origin only (no CORS, so no other site's page can drive the
+// rig through a browser on this machine), and the token when one is configured.
+httplib::Server::HandlerResponse guard_request(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
+  c.requests.fetch_add(1, std::memory_order_relaxed);
+  if (!changes_state(req.method)) return httplib::Server::HandlerResponse::Unhandled;
+  if (req.has_header("Origin")) {
+    const std::string origin = req.get_header_value("Origin"), host = req.get_header_value("Host");
+    if (origin != "http://" + host) {
+      send_error(res, 403, "cross-origin request refused", "Origin '" + origin + "' is not this server (" + host + ")");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+  }
+  if (c.config.token.empty()) return httplib::Server::HandlerResponse::Unhandled;
+  std::string given = req.get_header_value("X-Hystlab-Token");
+  const std::string auth = req.get_header_value("Authorization");
+  if (auth.rfind("Bearer ", 0) == 0) given = auth.substr(7);
+  if (!same_secret(given, c.config.token)) {
+    res.set_header("WWW-Authenticate", "Bearer realm=\"hystlabd\"");
+    send_error(res, 401, "unauthorized", given.empty() ? "this request changes state: send the daemon's token (Authorization: Bearer ...)"
+                                                       : "the token does not match");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  return httplib::Server::HandlerResponse::Unhandled;
+}
+
+std::string default_dir(const std::string& configured, const char* built_in) {
+  return configured.empty() ? std::string(built_in) : configured;
+}
+}  // namespace
+
+struct HttpApi::Impl {
+  Impl(daemon::Daemon& d, const daemon::HttpConfig& cfg) : config(cfg), ctx(d, config, d.config().db_path) {}
+  daemon::HttpConfig config;
+  ApiContext ctx;
+  httplib::Server server;
+  std::thread thread;
+  int port = 0;
+};
+
+HttpApi::HttpApi(daemon::Daemon& d, const daemon::HttpConfig& cfg) : impl_(std::make_unique<Impl>(d, cfg)) {
+  Impl& m = *impl_;
+  httplib::Server& s = m.server;
+  s.set_tcp_nodelay(true);  // without it every answer waits ~40 ms for the client's delayed ACK
+  const auto threads = static_cast<std::size_t>(cfg.max_stream_clients) + 16;  // each open stream holds one thread
+  s.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  s.set_keep_alive_max_count(100);
+  s.set_keep_alive_timeout(5);
+  s.set_payload_max_length(cfg.max_body_bytes);
+  s.set_default_headers({{"X-Content-Type-Options", "nosniff"},
+                         {"Content-Security-Policy", "default-src 'self'; img-src 'self' data: blob:; style-src 'self'"},
+                         {"Referrer-Policy", "no-referrer"}});
+  s.set_pre_routing_handler([&m](const httplib::Request& req, httplib::Response& res) { return guard_request(m.ctx, req, res); });
+  s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (!res.body.empty()) return;  // the handler's own JSON error
+    if (res.status == 404) send_error(res, 404, "not found", "no such resource: " + req.method + " " + req.path);
+    else if (res.status == 413) send_error(res, 413, "payload too large", "the request body is larger than http.max_body_bytes");
+    else send_error(res, res.status, "bad request", "the request could not be served (HTTP " + std::to_string(res.status) + ")");
+  });
+  add_status_routes(s, m.ctx);
+  add_campaign_routes(s, m.ctx);
+  add_data_routes(s, m.ctx);
+  add_stream_route(s, m.ctx);
+  const std::string vendor = default_dir(cfg.vendor_root, HYSTLAB_VENDOR_ROOT), root = default_dir(cfg.web_root, HYSTLAB_WEB_ROOT);
+  if (!s.set_mount_point("/vendor/uplot", vendor))
+    spdlog::warn("http: the plotting library is not at '{}' (run 'npm ci' in web/): the page cannot plot", vendor);
+  if (!s.set_mount_point("/", root)) spdlog::warn("http: no page at '{}': the API alone is served", root);
+  m.port = cfg.port == 0 ? s.bind_to_any_port(cfg.bind) : (s.bind_to_port(cfg.bind, cfg.port) ? cfg.port : -1);
+  if (m.port <= 0) throw std::runtime_error("http: cannot listen on " + cfg.bind + ":" + std::to_string(cfg.port) + " (in use, or not an address here)");
+  m.thread = std::thread([&s] { s.listen_after_bind(); });
+  spdlog::info("http: serving the API and the page on http://{}:{}/", cfg.bind, m.port);
+}
+
+HttpApi::~HttpApi() { stop(); }
+
+int HttpApi::port() const noexcept { return impl_->port; }
+
+void HttpApi::stop() {
+  Impl& m = *impl_;
+  m.ctx.stopping = true;
+  m.server.stop();
+  if (m.thread.joinable()) m.thread.join();
+}
+
+}  // namespace hystlab::web

@@ -1,0 +1,178 @@
+// Runs and their samples (decimated with min/max per bucket, or full resolution as a streamed
+// CSV), tables (list, get, export) and model evaluation.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "hystlab/db/sqlite.hpp"
+#include "hystlab/models/preisach_model.hpp"
+#include "hystlab/models/table_export.hpp"
+#include "routes.hpp"
+
+namespace hystlab::web {
+namespace {
+constexpr std::size_t kMaxEvaluate = 1'000'000;
+constexpr std::int64_t kCsvChunk = 8192;
+
+struct RunRow {
+  std::int64_t id = 0, campaign = 0;
+  std::string state, started_at, ended_at;
+  double wall_anchor = 0;
+};
+
+RunRow run_or_404(db::Store& store, std::int64_t id) {
+  db::Statement st(store.database(), "SELECT id, campaign_id, state, started_at, coalesce(ended_at, ''), wall_anchor_unix FROM runs WHERE id = ?");
+  st.bind(1, id);
+  if (!st.step()) throw ApiError(404, "not found", "no run " + std::to_string(id));
+  return {st.column_int(0), st.column_int(1), st.column_text(2), st.column_text(3), st.column_text(4), st.column_double(5)};
+}
+
+std::pair<double, double> time_span(db::Store& store, std::int64_t run) {
+  db::Statement st(store.database(), "SELECT min(t_min), max(t_max) FROM sample_blocks WHERE run_id = ?");
+  st.bind(1, run);
+  st.step();
+  if (st.column_is_null(0)) return {0.0, 0.0};
+  return {st.column_double(0), st.column_double(1)};
+}
+
+std::string table_document(db::Store& store, std::int64_t id) {
+  db::Statement st(store.database(), "SELECT document FROM tables WHERE id = ?");
+  st.bind(1, id);
+  if (!st.step()) throw ApiError(404, "not found", "no table " + std::to_string(id));
+  return st.column_text(0);
+}
+
+std::vector<double> displacement_series(const json& body) {
+  const auto it = body.find("displacement_mm");
+  if (it == body.end() || !it->is_array() || it->empty())
+    throw ApiError(400, "invalid request", "displacement_mm: must be a non-empty array of displacements in mm");
+  if (it->size() > kMaxEvaluate) throw ApiError(400, "invalid request", "displacement_mm: at most 1000000 values per request");
+  std::vector<double> x;
+  x.reserve(it->size());
+  for (std::size_t k = 0; k < it->size(); ++k) {
+    const json& v = (*it)[k];
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
+      throw ApiError(400, "invalid request", "displacement_mm[" + std::to_string(k) + "]: must be a finite number");
+    x.push_back(v.get<double>());
+  }
+  return x;
+}
+
+// The model named by the body: a stored table, a table document, or simplified-model parameters.
+std::unique_ptr<models::HysteresisModel> model_of(const json& body, db::Store& store) {
+  const int given = static_cast<int>(body.contains("table_id")) + static_cast<int>(body.contains("table")) + static_cast<int>(body.contains("params"));
+  if (given != 1) throw ApiError(400, "invalid request", "give exactly one of table_id, table (a table document) or params (simplified-model parameters)");
+  if (body.contains("table_id")) {
+    if (!body["table_id"].is_number_integer()) throw ApiError(400, "invalid request", "table_id: must be a table's id");
+    const auto doc = models::table_from_json(table_document(store, body["table_id"].get<std::int64_t>()));
+    return std::make_unique<models::PreisachModel>(std::make_shared<const models::EverettTable>(doc.table));
+  }
+  if (body.contains("table")) {
+    if (!body["table"].is_object()) throw ApiError(400, "invalid request", "table: must be a table document (JSON object)");
+    const auto doc = models::table_from_json(body["table"].dump());
+    return std::make_unique<models::PreisachModel>(std::make_shared<const models::EverettTable>(doc.table));
+  }
+  if (!body["params"].is_object()) throw ApiError(400, "invalid request", "params: must be a parameters document (JSON object)");
+  return std::make_unique<models::SimplifiedSmaModel>(models::params_from_json(body["params"].dump()));
+}
+
+void stream_csv(httplib::Response& res, const std::string& db_path, std::int64_t run) {
+  res.set_header("Content-Disposition", "attachment; filename=\"run-" + std::to_string(run) + ".csv\"");
+  auto next = std::make_shared<std::int64_t>(-1);  // -1: the header is still to be sent
+  res.set_chunked_content_provider("text/csv", [db_path, run, next](std::size_t, httplib::DataSink& sink) {
+    if (*next < 0) {
+      const std::string head = "seq,t_s,command_mm,displacement_mm,force_N,status\n";
+      *next = 0;
+      return sink.write(head.data(), head.size());
+    }
+    std::string chunk;
+    std::int64_t rows = 0;
+    reader(db_path).for_each_sample(run, *next, *next + kCsvChunk - 1, [&](const db::SampleRow& r) {
+      char line[200];
+      const int n = std::snprintf(line, sizeof line, "%lld,%.9g,%.9g,%.9g,%.9g,%lld\n", static_cast<long long>(r.seq), r.t, r.cmd,
+                                  r.disp, r.force, static_cast<long long>(r.status));
+      chunk.append(line, static_cast<std::size_t>(n));
+      ++rows;
+    });
+    *next += kCsvChunk;
+    if (rows == 0 && *next > reader(db_path).max_seq(run)) {
+      sink.done();
+      return true;
+    }
+    return chunk.empty() || sink.write(chunk.data(), chunk.size());
+  });
+}
+}  // namespace
+
+void add_data_routes(httplib::Server& s, ApiContext& c) {
+  s.Get(R"(/api/runs/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    auto& store = reader(c.db_path);
+    const RunRow r = run_or_404(store, path_id(req));
+    const auto [t0, t1] = time_span(store, r.id);
+    send_json(res, {{"id", r.id}, {"campaign", r.campaign}, {"state", r.state}, {"started_at", r.started_at}, {"ended_at", r.ended_at},
+                    {"wall_anchor_unix", r.wall_anchor}, {"samples", store.sample_count(r.id)}, {"t_range_s", {t0, t1}}});
+  }));
+  s.Get(R"(/api/runs/(\d+)/samples)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    auto& store = reader(c.db_path);
+    const RunRow r = run_or_404(store, path_id(req));
+    const auto [lo, hi] = time_span(store, r.id);
+    const double t0 = query_number(req, "t0", lo, -1e12, 1e12), t1 = query_number(req, "t1", hi, -1e12, 1e12);
+    if (t1 < t0) throw ApiError(400, "invalid parameter", "t1 must not be before t0");
+    const int points = static_cast<int>(query_number(req, "points", 1000, 1, 100000));
+    json t_min, t_max, d_min, d_max, f_min, f_max, n;
+    for (const db::Bucket& b : store.overview(r.id, t0, t1, points)) {
+      t_min.push_back(b.t_min), t_max.push_back(b.t_max), d_min.push_back(b.disp_min), d_max.push_back(b.disp_max);
+      f_min.push_back(b.force_min), f_max.push_back(b.force_max), n.push_back(b.n);
+    }
+    send_json(res, {{"run", r.id}, {"t0", t0}, {"t1", t1}, {"buckets", n.size()},
+                    {"t_min", t_min}, {"t_max", t_max}, {"displacement_min_mm", d_min}, {"displacement_max_mm", d_max},
+                    {"force_min_N", f_min}, {"force_max_N", f_max}, {"n", n}});
+  }));
+  s.Get(R"(/api/runs/(\d+)/samples\.csv)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    const RunRow r = run_or_404(reader(c.db_path), path_id(req));
+    stream_csv(res, c.db_path, r.id);
+  }));
+  s.Get("/api/tables", guarded([&c](const httplib::Request&, httplib::Response& res) {
+    json out = json::array();
+    db::Statement st(reader(c.db_path).database(), "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy FROM tables ORDER BY id");
+    while (st.step()) out.push_back(table_row_json(st));
+    send_json(res, out);
+  }));
+  s.Get(R"(/api/tables/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    auto& store = reader(c.db_path);
+    const std::int64_t id = path_id(req);
+    const std::string doc = table_document(store, id);
+    db::Statement st(store.database(), "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy FROM tables WHERE id = ?");
+    st.bind(1, id);
+    st.step();
+    json j = table_row_json(st);
+    j["document"] = json::parse(doc);
+    send_json(res, j);
+  }));
+  s.Get(R"(/api/tables/(\d+)/export)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    const std::int64_t id = path_id(req);
+    const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
+    if (format != "json" && format != "csv" && format != "m")
+      throw ApiError(400, "invalid parameter", "format: '" + format + "' is not json, csv or m");
+    const std::string text = table_document(reader(c.db_path), id);
+    const std::string name = "hystlab_table_" + std::to_string(id) + "." + format;
+    res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
+    if (format == "json") return res.set_content(text, "application/json");
+    const models::TableDocument doc = models::table_from_json(text);
+    if (format == "csv") return res.set_content(models::table_to_csv(doc.table, doc.provenance), "text/csv");
+    res.set_content(models::table_to_matlab(doc.table, doc.provenance), "text/x-matlab");
+  }));
+  s.Post("/api/evaluate", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    const json body = body_object(req);
+    for (const auto& [k, _] : body.items())
+      if (k != "table_id" && k != "table" && k != "params" && k != "displacement_mm")
+        throw ApiError(400, "invalid request", k + ": not a known field (table_id, table, params, displacement_mm)");
+    const auto model = model_of(body, reader(c.db_path));
+    const std::vector<double> x = displacement_series(body);
+    std::vector<double> f(x.size());
+    for (std::size_t k = 0; k < x.size(); ++k) f[k] = model->step(x[k]);
+    send_json(res, {{"force_N", f}, {"samples", f.size()}, {"saturations", model->saturation_count()}});
+  }));
+}
+
+}  // namespace hystlab::web

@@ -1,0 +1,165 @@
+// Daemon status, rigs with their live sample and I/O health, and /metrics (Prometheus text).
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <vector>
+
+#include "hystlab/db/sqlite.hpp"
+#include "routes.hpp"
+
+namespace hystlab::web {
+namespace {
+constexpr const char* kErrorNames[] = {"", "timeout", "exception_response", "connection_lost", "crc_error",
+                                       "out_of_range", "protocol_error", "not_connected", "stale_data", "unsupported"};
+static_assert(sizeof kErrorNames / sizeof kErrorNames[0] == drivers::kRigErrorCount);
+
+std::map<std::string, std::int64_t> campaigns_by_state(db::Store& store) {
+  std::map<std::string, std::int64_t> out;
+  for (const char* s : {"queued", "arming", "running", "paused", "completed", "aborted", "failed", "interrupted"}) out[s] = 0;
+  db::Statement st(store.database(), "SELECT state, count(*) FROM campaigns GROUP BY state");
+  while (st.step()) out[st.column_text(0)] = st.column_int(1);
+  return out;
+}
+
+json health_json(const drivers::IoHealthSnapshot& h) {
+  json errors = json::object();
+  for (std::size_t k = 1; k < drivers::kRigErrorCount; ++k) errors[kErrorNames[k]] = h.errors[k];
+  return {{"reads", h.reads}, {"writes", h.writes}, {"reconnects", h.reconnects}, {"errors", errors},
+          {"last_transaction_us", h.last_transaction_us}, {"max_transaction_us", h.max_transaction_us},
+          {"latency_histogram_us", h.latency_histogram}};
+}
+
+json rig_json(const daemon::Daemon& d, std::size_t k) {
+  const daemon::RigInfo& info = d.rig_info(k);
+  const daemon::RigLive& live = d.rig_live(k);
+  json j{{"id", info.id}, {"index", k}, {"name", info.name}, {"kind", info.kind}, {"description", info.description},
+         {"simulated", info.simulated}, {"campaign", live.campaign.load()}, {"samples", live.samples.load()},
+         {"missed_deadlines", live.missed_deadlines.load()}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
+  const std::uint64_t h = live.ring.head();
+  daemon::LiveSample s;
+  if (h > 0 && live.ring.get(h - 1, s)) {
+    const char* names[] = {"command_mm", "displacement_mm", "force_N"};
+    const char* shaker[] = {"base_displacement_mm", "mass_displacement_mm", "mass_accel_m_s2"};
+    const char** n = info.kind == "shaker" ? shaker : names;
+    j["sample"] = {{"t", s.t}, {n[0], s.cmd}, {n[1], s.disp}, {n[2], s.force}, {"status", s.status}, {"run", s.run}};
+  }
+  return j;
+}
+
+// Label values escaped as the exposition format asks.
+std::string label(const std::string& v) {
+  std::string o;
+  for (char ch : v) {
+    if (ch == '\\' || ch == '"') o += '\\';
+    if (ch == '\n') {
+      o += "\\n";
+      continue;
+    }
+    o += ch;
+  }
+  return o;
+}
+
+void metric(std::string& out, const char* name, const char* type, const char* help) {
+  out += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n";
+}
+
+std::string metrics_text(ApiContext& c) {
+  const daemon::Daemon& d = c.daemon;
+  std::string o;
+  auto line = [&o](const std::string& name, const std::string& labels, double v) {
+    o += name + (labels.empty() ? "" : "{" + labels + "}") + " " + json(v).dump() + "\n";
+  };
+  const db::WriterStats w = d.writer_stats();
+  metric(o, "hystlab_samples_written_total", "counter", "Samples committed to the database.");
+  line("hystlab_samples_written_total", "", static_cast<double>(w.written));
+  metric(o, "hystlab_writer_queue_depth", "gauge", "Samples waiting for the writer thread.");
+  line("hystlab_writer_queue_depth", "", static_cast<double>(w.depth));
+  metric(o, "hystlab_writer_dropped_total", "counter", "Samples lost because the writer queue was full.");
+  line("hystlab_writer_dropped_total", "", static_cast<double>(w.dropped_full));
+  metric(o, "hystlab_writer_commits_total", "counter", "Write transactions committed.");
+  line("hystlab_writer_commits_total", "", static_cast<double>(w.commits));
+  metric(o, "hystlab_samples_acquired_total", "counter", "Samples acquired during campaigns.");
+  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_samples_acquired_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_live(k).samples.load()));
+  metric(o, "hystlab_missed_deadlines_total", "counter", "Acquisition periods that started more than a period late.");
+  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_missed_deadlines_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_live(k).missed_deadlines.load()));
+  std::vector<std::pair<std::string, drivers::IoHealthSnapshot>> rigs;  // one read per rig: families stay consistent
+  for (std::size_t k = 0; k < d.rig_count(); ++k) rigs.emplace_back("rig=\"" + label(d.rig_info(k).name) + "\"", d.rig_health(k));
+  auto family = [&](const char* name, const char* type, const char* help, auto value) {
+    metric(o, name, type, help);
+    for (const auto& [rl, h] : rigs) line(name, rl, static_cast<double>(value(h)));
+  };
+  family("hystlab_rig_reads_total", "counter", "Rig read transactions.", [](const auto& h) { return h.reads; });
+  family("hystlab_rig_writes_total", "counter", "Rig write transactions.", [](const auto& h) { return h.writes; });
+  family("hystlab_rig_reconnects_total", "counter", "Rig reconnections.", [](const auto& h) { return h.reconnects; });
+  family("hystlab_rig_transaction_max_seconds", "gauge", "Longest rig transaction.", [](const auto& h) { return h.max_transaction_us * 1e-6; });
+  metric(o, "hystlab_rig_errors_total", "counter", "Rig I/O errors by kind.");
+  for (const auto& [rl, h] : rigs)
+    for (std::size_t e = 1; e < drivers::kRigErrorCount; ++e)
+      line("hystlab_rig_errors_total", rl + ",kind=\"" + kErrorNames[e] + "\"", static_cast<double>(h.errors[e]));
+  metric(o, "hystlab_rig_transaction_seconds", "histogram", "Rig transaction time.");
+  for (const auto& [rl, h] : rigs) {
+    std::uint64_t cum = 0;
+    for (std::size_t b = 0; b < drivers::kLatencyBuckets; ++b) {
+      cum += h.latency_histogram[b];
+      const std::string le = b + 1 == drivers::kLatencyBuckets ? "+Inf" : json(static_cast<double>(1ULL << (b + 1)) * 1e-6).dump();
+      line("hystlab_rig_transaction_seconds_bucket", rl + ",le=\"" + le + "\"", static_cast<double>(cum));
+    }
+    line("hystlab_rig_transaction_seconds_sum", rl, h.total_transaction_us * 1e-6);
+    line("hystlab_rig_transaction_seconds_count", rl, static_cast<double>(cum));
+  }
+  metric(o, "hystlab_sse_clients", "gauge", "Open Server-Sent Events streams.");
+  line("hystlab_sse_clients", "", c.stream_clients.load());
+  metric(o, "hystlab_http_requests_total", "counter", "HTTP requests answered.");
+  line("hystlab_http_requests_total", "", static_cast<double>(c.requests.load()));
+  metric(o, "hystlab_campaigns", "gauge", "Campaigns by state.");
+  for (const auto& [state, n] : campaigns_by_state(reader(c.db_path))) line("hystlab_campaigns", "state=\"" + state + "\"", static_cast<double>(n));
+  metric(o, "hystlab_uptime_seconds", "gauge", "Seconds since the daemon started.");
+  line("hystlab_uptime_seconds", "", d.uptime_s());
+  return o;
+}
+
+// /api/status is what monitors poll: served from a snapshot at most 0.25 s old.
+struct StatusCache {
+  std::mutex mu;
+  std::string body;
+  std::chrono::steady_clock::time_point at{};
+};
+}  // namespace
+
+void add_status_routes(httplib::Server& s, ApiContext& c) {
+  auto cache = std::make_shared<StatusCache>();
+  s.Get("/api/status", guarded([&c, cache](const httplib::Request&, httplib::Response& res) {
+    std::lock_guard lk(cache->mu);
+    const auto now = std::chrono::steady_clock::now();
+    if (cache->body.empty() || now - cache->at > std::chrono::milliseconds(250)) {
+      json rigs = json::array();
+      for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
+        rigs.push_back({{"name", c.daemon.rig_info(k).name}, {"kind", c.daemon.rig_info(k).kind}, {"campaign", c.daemon.rig_live(k).campaign.load()}});
+      const auto w = c.daemon.writer_stats();
+      cache->body = json{{"name", "hystlabd"}, {"version", HYSTLAB_VERSION}, {"uptime_s", c.daemon.uptime_s()},
+                         {"database", c.db_path}, {"rigs", rigs}, {"campaigns", campaigns_by_state(reader(c.db_path))},
+                         {"writer", {{"written", w.written}, {"queue_depth", w.depth}, {"dropped", w.dropped_full}}},
+                         {"stream_clients", c.stream_clients.load()}}
+                        .dump();
+      cache->at = now;
+    }
+    res.set_content(cache->body, "application/json");
+  }));
+  s.Get("/api/rigs", guarded([&c](const httplib::Request&, httplib::Response& res) {
+    json out = json::array();
+    for (std::size_t k = 0; k < c.daemon.rig_count(); ++k) out.push_back(rig_json(c.daemon, k));
+    send_json(res, out);
+  }));
+  s.Get(R"(/api/rigs/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    const std::int64_t id = path_id(req);
+    for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
+      if (c.daemon.rig_info(k).id == id) return send_json(res, rig_json(c.daemon, k));
+    throw ApiError(404, "not found", "no rig " + std::to_string(id));
+  }));
+  s.Get("/metrics", guarded([&c](const httplib::Request&, httplib::Response& res) {
+    res.set_content(metrics_text(c), "text/plain; version=0.0.4");
+  }));
+}
+
+}  // namespace hystlab::web
