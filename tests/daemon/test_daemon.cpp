@@ -82,19 +82,19 @@ const char* kPlan = R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 12, "
 TEST_CASE("hystlabd: a bad config is refused at start, naming the field") {
   Dir d;
   d.write("bad.json", R"({"rigs": [{"name": "x", "transport": "modbus-tcp", "port": 99999}]})");
-  CHECK(wait_exit(spawn({HYSTLABD, "--config", (d.path / "bad.json").string(), "--db", d.db()}, d.path / "log")) == 2);
+  CHECK(wait_exit(spawn({HYSTLABD, "--config", (d.path / "bad.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log")) == 2);
   std::ifstream in(d.path / "log");
   const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CHECK(log.find("port must be an integer from 1 to 65535") != std::string::npos);
   d.write("bad2.json", R"({"rigz": []})");
-  CHECK(wait_exit(spawn({HYSTLABD, "--config", (d.path / "bad2.json").string(), "--db", d.db()}, d.path / "log2")) == 2);
+  CHECK(wait_exit(spawn({HYSTLABD, "--config", (d.path / "bad2.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log2")) == 2);
 }
 
 TEST_CASE("hystlabd: SIGTERM holds, marks the campaign interrupted, exits 0") {
   Dir d;
   d.write("cfg.json", kConfig);
   d.write("plan.json", kPlan);
-  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db()}, d.path / "log");
+  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   REQUIRE(eventually([&] { return fs::exists(d.db()); }));
   REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "running"; }));
@@ -107,7 +107,7 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
   Dir d;
   d.write("cfg.json", kConfig);
   d.write("plan.json", kPlan);
-  pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db()}, d.path / "log");
+  pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   REQUIRE(eventually([&] { return fs::exists(d.db()); }));
   REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
   std::int64_t committed = -1;
@@ -130,7 +130,7 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
     CHECK(s.sample_count(1) == s.max_seq(1) + 1);  // no holes
     CHECK(s.campaign(1)->state == "running");      // as the crash left it
   }
-  pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db()}, d.path / "log2");
+  pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log2");
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "interrupted"; }));
   REQUIRE(cli("campaign resume 1 --db " + d.db()) == 0);
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "completed"; }, 40000));

@@ -1,0 +1,114 @@
+// 50 Server-Sent-Events clients during a 1 kHz acquisition (a real hystlabd, a real simulated
+// load frame at time scale 1): the missed acquisition deadlines of a stretch with the clients
+// against a stretch of the same length without them (the baseline, same run), and the latency
+// from a sample's acquisition to its arrival at a client (both read the machine's steady clock).
+// Targets: no missed deadlines added; latency p99 < 200 ms.
+#include <httplib.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "daemon_process.hpp"
+
+namespace {
+double mono_now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+struct Counters {
+  double missed = 0, acquired = 0;
+};
+
+Counters counters(httplib::Client& c) {
+  Counters k;
+  auto r = c.Get("/metrics");
+  if (!r) throw std::runtime_error("no /metrics");
+  std::istringstream in(r->body);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("hystlab_missed_deadlines_total{", 0) == 0) k.missed += std::stod(line.substr(line.rfind(' ') + 1));
+    if (line.rfind("hystlab_samples_acquired_total{", 0) == 0) k.acquired += std::stod(line.substr(line.rfind(' ') + 1));
+  }
+  return k;
+}
+
+struct Latencies {
+  std::mutex mu;
+  std::vector<double> ms;
+  std::atomic<long> frames{0};
+};
+
+// One client: reads frames, and for each samples frame the age of its newest sample.
+void client(int port, const std::atomic<bool>& stop, Latencies& out) {
+  httplib::Client c("127.0.0.1", port);
+  c.set_read_timeout(30, 0);
+  std::string buf;
+  std::vector<double> mine;
+  c.Get("/api/stream?rate=20", [&](const char* data, std::size_t n) {
+    const double now = mono_now();
+    buf.append(data, n);
+    for (std::size_t end; (end = buf.find("\n\n")) != std::string::npos; buf.erase(0, end + 2)) {
+      const std::size_t at = buf.find("\"mono_s\":");
+      if (buf.compare(0, 14, "event: samples") == 0 && at != std::string::npos && at < end) {
+        mine.push_back((now - std::stod(buf.substr(at + 9))) * 1000.0);
+        ++out.frames;
+      }
+    }
+    return !stop;
+  });
+  std::lock_guard lk(out.mu);
+  out.ms.insert(out.ms.end(), mine.begin(), mine.end());
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int clients = argc > 2 && std::string(argv[1]) == "--clients" ? std::atoi(argv[2]) : 50;
+  const double stretch = 15;
+  try {
+    hystlab::bench::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1}}]})");
+    httplib::Client c("127.0.0.1", daemon.port());
+    const nlohmann::json plan{{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 12}, {"ramp_rate_mm_s", 0.5}, {"sample_rate_hz", 1000},
+                              {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
+    auto r = c.Post("/api/campaigns", nlohmann::json{{"plan", plan}}.dump(), "application/json");
+    if (!r || r->status != 201) throw std::runtime_error("cannot submit the campaign");
+    const auto id = nlohmann::json::parse(r->body)["id"].get<long>();
+    std::this_thread::sleep_for(std::chrono::seconds(3));  // armed and running
+
+    const Counters a0 = counters(c);
+    std::this_thread::sleep_for(std::chrono::duration<double>(stretch));
+    const Counters a1 = counters(c);
+
+    Latencies lat;
+    std::atomic<bool> stop{false};
+    std::vector<std::thread> threads;
+    for (int k = 0; k < clients; ++k) threads.emplace_back(client, daemon.port(), std::cref(stop), std::ref(lat));
+    std::this_thread::sleep_for(std::chrono::seconds(2));  // all connected
+    const Counters b0 = counters(c);
+    std::this_thread::sleep_for(std::chrono::duration<double>(stretch));
+    const Counters b1 = counters(c);
+    const std::string sse = c.Get("/metrics")->body;
+    stop = true;
+    for (auto& t : threads) t.join();
+    c.Post(("/api/campaigns/" + std::to_string(id) + "/abort").c_str());
+
+    std::sort(lat.ms.begin(), lat.ms.end());
+    if (lat.ms.empty()) throw std::runtime_error("no samples frames reached the clients");
+    const auto q = [&](double f) { return lat.ms[static_cast<std::size_t>(f * static_cast<double>(lat.ms.size() - 1))]; };
+    const auto at = sse.find("\nhystlab_sse_clients ");
+    std::printf("without clients (baseline): %.0f samples in %.0f s, %.0f missed deadlines\n", a1.acquired - a0.acquired, stretch, a1.missed - a0.missed);
+    std::printf("with %d SSE clients (%s): %.0f samples in %.0f s, %.0f missed deadlines\n", clients,
+                at == std::string::npos ? "?" : sse.substr(at + 1, sse.find('\n', at + 1) - at - 1).c_str(), b1.acquired - b0.acquired, stretch, b1.missed - b0.missed);
+    std::printf("missed deadlines added by the clients: %.0f (target 0)\n", std::max(0.0, (b1.missed - b0.missed) - (a1.missed - a0.missed)));
+    std::printf("sample-to-client latency over %zu frames: p50 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 < 200 ms)\n", lat.ms.size(), q(0.5),
+                q(0.99), lat.ms.back());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_sse: %s\n", e.what());
+    return 1;
+  }
+}
