@@ -28,7 +28,8 @@ function check(cond, what) {
 
 // The daemon: its own database and config (a fast simulated load frame), a free port.
 fs.writeFileSync(path.join(outDir, 'hystlab.json'), JSON.stringify({
-  db: 'browser.db', rigs: [{ name: 'sim frame', simulate: { time_scale: 10, noise_N: 0.05 } }],
+  db: 'browser.db', rigs: [{ name: 'sim frame', simulate: { time_scale: 10, noise_N: 0.05 } },
+                           { name: 'sim shaker', simulate: { time_scale: 1, rig: 'shaker' } }],
 }));
 const daemon = spawn(daemonPath, ['--config', path.join(outDir, 'hystlab.json'), '--port', '0'], { cwd: outDir, stdio: ['ignore', 'pipe', 'pipe'] });
 let log = '';
@@ -96,6 +97,20 @@ try {
   await page.click('#abort');
   check(await wait(page, () => window.hystlab.state() === 'aborted', null, 'aborted', 30000), 'Abort ends it (safe position)');
   await page.screenshot({ path: path.join(outDir, 'page.png'), fullPage: true });
+
+  // 3. A shaker sweep: the rig is picked for the plan, transmissibility builds point by point.
+  await page.selectOption('select[name=kind]', 'sine');
+  check(await page.inputValue('select[name=rig]') === 'sim shaker', 'a sine plan picks the shaker');
+  await page.fill('input[name=freqs]', '4, 8, 12');
+  await page.fill('input[name=settle]', '3');
+  await page.fill('input[name=measured]', '3');
+  await page.fill('input[name=hz]', '500');
+  await page.click('#submit');
+  check(await wait(page, () => window.hystlab.transmissibilityPoints() >= 1 && window.hystlab.loopPoints() > 20, null, 'transmissibility'),
+        'the transmissibility plot and the base/mass signals build while the sweep runs');
+  check(await wait(page, () => window.hystlab.state() === 'completed' && window.hystlab.transmissibilityPoints() === 3, null, 'sweep done'),
+        'the sweep completes with a point per frequency');
+  await page.screenshot({ path: path.join(outDir, 'shaker.png'), fullPage: true });
   check(errors.length === 0, 'no script errors on the page' + (errors.length ? ': ' + errors.join(' | ') : ''));
 } catch (e) {
   console.log('FAIL ' + (e.stack || e));

@@ -92,6 +92,8 @@ async function refreshDetail() {
   const shaker = d.kind === 'sine';
   timeplot.setLabels(shaker ? ['base displacement (mm)', 'mass displacement (mm)'] : ['displacement (mm)', 'force (N)']);
   $('loop-caption').textContent = shaker ? 'Mass against base displacement' : 'Force–displacement';
+  $('time-caption').textContent = shaker ? 'Base and mass displacement against time' : 'Displacement and force against time';
+  loop.relabel(shaker ? 'base displacement (mm)' : 'displacement (mm)', shaker ? 'mass displacement (mm)' : 'force (N)');
   showProgress(d);
   showAccuracy(d);
   showDownloads(d);
@@ -209,6 +211,21 @@ function setOnline(on) {
 async function refreshStatus() {
   const s = await api('/api/status');
   $('daemon').textContent = `hystlabd ${s.version} · ${s.rigs.map(r => r.name).join(', ')}`;
+  const chosen = form.rig.value;
+  form.rig.replaceChildren(...s.rigs.map(r => {
+    const o = document.createElement('option');
+    o.value = r.name; o.textContent = `${r.name} (${r.kind === 'shaker' ? 'shaker' : 'load frame'})`; o.dataset.kind = r.kind;
+    return o;
+  }));
+  if (chosen) form.rig.value = chosen;
+  else pickRigFor(form.kind.value);
+}
+
+// The first rig that can run this kind of plan (a sine sweep needs a shaker).
+function pickRigFor(kind) {
+  const want = kind === 'sine' ? 'shaker' : 'load_frame';
+  const o = [...form.rig.options].find(x => x.dataset.kind === want);
+  if (o) form.rig.value = o.value;
 }
 
 function onSamples(m) {
@@ -267,6 +284,7 @@ const form = $('plan-form');
 form.kind.addEventListener('change', () => {
   form.querySelector('.fot').hidden = form.kind.value !== 'fot';
   form.querySelector('.sine').hidden = form.kind.value !== 'sine';
+  pickRigFor(form.kind.value);
 });
 
 function planFromForm() {
@@ -286,7 +304,9 @@ form.addEventListener('submit', e => {
   $('form-error').textContent = '';
   serial(async () => {
     try {
-      const c = await api('/api/campaigns', { method: 'POST', body: JSON.stringify({ plan: planFromForm() }) });
+      const body = { plan: planFromForm() };
+      if (form.rig.value) body.rig = form.rig.value;
+      const c = await api('/api/campaigns', { method: 'POST', body: JSON.stringify(body) });
       S.follow = true;
       await refreshList();
       await select(c.id);

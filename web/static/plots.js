@@ -17,7 +17,13 @@ function extent(arrays, fallback) {
 // An x-y plot (uPlot's mode 2): series of [xs, ys] drawn as lines in the order given.
 export class XYPlot {
   constructor(el, xLabel, yLabel, series) {
+    this.el = el; this.series = series;
     this.data = series.map(() => [[], []]);
+    this.build(xLabel, yLabel);
+  }
+  build(xLabel, yLabel) {
+    const series = this.series;
+    this.labels = [xLabel, yLabel];
     const opts = {
       mode: 2, width: W, height: H, legend: { live: false },
       scales: { x: { time: false, auto: false }, y: { auto: false } },
@@ -25,7 +31,13 @@ export class XYPlot {
       series: [{}, ...series.map(s => ({ label: s.label, stroke: s.color, width: s.width || 1.5, points: { show: !!s.points, size: 5, fill: s.color },
                                          facets: [{ scale: 'x', auto: true }, { scale: 'y', auto: true }] }))],
     };
-    this.u = new uPlot(opts, [null, ...this.data], el);
+    this.u = new uPlot(opts, [null, ...this.data], this.el);
+  }
+  // uPlot draws axis labels once: new labels, new plot.
+  relabel(xLabel, yLabel) {
+    if (this.labels[0] === xLabel && this.labels[1] === yLabel) return;
+    this.u.destroy();
+    this.build(xLabel, yLabel);
   }
   set(k, xs, ys) { this.data[k] = [xs, ys]; }
   points(k) { return this.data[k][0].length; }
@@ -43,18 +55,24 @@ export class XYPlot {
 // Signals against time (uPlot's mode 1), two y scales.
 export class TimePlot {
   constructor(el, labels) {
+    this.el = el;
     this.t = []; this.a = []; this.b = [];
+    this.build(labels);
+  }
+  build(labels) {
+    this.labels = labels;
     this.u = new uPlot({
       width: W * 2 + 20, height: 240, legend: { live: false },
       scales: { x: { time: false }, a: {}, b: {} },
       axes: [{ label: 'rig time (s)' }, { scale: 'a', label: labels[0], stroke: '#1565c0' },
              { scale: 'b', side: 1, label: labels[1], stroke: '#c62828', grid: { show: false } }],
       series: [{}, { label: labels[0], scale: 'a', stroke: '#1565c0' }, { label: labels[1], scale: 'b', stroke: '#c62828' }],
-    }, [[], [], []], el);
+    }, [this.t, this.a, this.b], this.el);
   }
   setLabels(labels) {
-    this.u.series[1].label = labels[0]; this.u.series[2].label = labels[1];
-    this.u.axes[1].label = labels[0]; this.u.axes[2].label = labels[1];
+    if (this.labels[0] === labels[0] && this.labels[1] === labels[1]) return;
+    this.u.destroy();
+    this.build(labels);
   }
   clear() { this.t = []; this.a = []; this.b = []; }
   push(t, a, b, keep) {
