@@ -31,19 +31,30 @@ fs.writeFileSync(path.join(outDir, 'hystlab.json'), JSON.stringify({
   db: 'browser.db', rigs: [{ name: 'sim frame', simulate: { time_scale: 10, noise_N: 0.05 } },
                            { name: 'sim shaker', simulate: { time_scale: 1, rig: 'shaker' } }],
 }));
-const daemon = spawn(daemonPath, ['--config', path.join(outDir, 'hystlab.json'), '--port', '0'], { cwd: outDir, stdio: ['ignore', 'pipe', 'pipe'] });
-let log = '';
-const port = await new Promise((resolve, reject) => {
-  const timer = setTimeout(() => reject(new Error('hystlabd did not start within 20 s:\n' + log)), 20000);
-  const onData = d => {
-    log += d;
-    const m = /serving the API and the page on http:\/\/127\.0\.0\.1:(\d+)\//.exec(log);
-    if (m) { clearTimeout(timer); resolve(Number(m[1])); }
-  };
-  daemon.stdout.on('data', onData);
-  daemon.stderr.on('data', onData);
-  daemon.on('exit', code => reject(new Error(`hystlabd exited (${code}):\n${log}`)));
-});
+function startDaemon(portArg) {
+  const proc = spawn(daemonPath, ['--config', path.join(outDir, 'hystlab.json'), '--port', String(portArg)], { cwd: outDir, stdio: ['ignore', 'pipe', 'pipe'] });
+  let log = '';
+  const port = new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error('hystlabd did not start within 20 s:\n' + log)), 20000);
+    const onData = d => {
+      log += d;
+      const m = /serving the API and the page on http:\/\/127\.0\.0\.1:(\d+)\//.exec(log);
+      if (m) { clearTimeout(timer); resolve(Number(m[1])); }
+    };
+    proc.stdout.on('data', onData);
+    proc.stderr.on('data', onData);
+    proc.on('exit', code => reject(new Error(`hystlabd exited (${code}):\n${log}`)));
+  });
+  return { proc, port };
+}
+async function stopDaemon(d) {
+  if (d.proc.exitCode !== null) return;
+  const exited = new Promise(r => d.proc.on('exit', r));
+  d.proc.kill('SIGTERM');
+  await exited;
+}
+let daemon = startDaemon(0);
+const port = await daemon.port;
 const base = `http://127.0.0.1:${port}`;
 
 const browser = await chromium.launch({
@@ -111,14 +122,25 @@ try {
   check(await wait(page, () => window.hystlab.state() === 'completed' && window.hystlab.transmissibilityPoints() === 3, null, 'sweep done'),
         'the sweep completes with a point per frequency');
   await page.screenshot({ path: path.join(outDir, 'shaker.png'), fullPage: true });
+
   check(errors.length === 0, 'no script errors on the page' + (errors.length ? ': ' + errors.join(' | ') : ''));
+
+  // 4. The daemon restarts: the page notices, and reconnects on its own (the browser logs the
+  // broken stream as a failed resource; anything else would be a script error).
+  errors.length = 0;
+  await stopDaemon(daemon);
+  check(await wait(page, () => !window.hystlab.online(), null, 'offline', 20000), 'the page shows the daemon gone');
+  daemon = startDaemon(port);
+  await daemon.port;
+  check(await wait(page, () => window.hystlab.online(), null, 'reconnect', 30000), 'and reconnects when it is back');
+  const unexpected = errors.filter(e => !/Failed to load resource: net::/.test(e));
+  check(unexpected.length === 0, 'no script errors across the restart' + (unexpected.length ? ': ' + unexpected.join(' | ') : ''));
 } catch (e) {
   console.log('FAIL ' + (e.stack || e));
   failures++;
 } finally {
   await browser.close();
-  daemon.kill('SIGTERM');
-  await new Promise(r => daemon.on('exit', r));
+  await stopDaemon(daemon);
 }
 console.log(failures ? `${failures} check(s) failed (screenshots in ${outDir})` : `all checks passed (screenshots in ${outDir})`);
 process.exit(failures ? 1 : 0);
