@@ -33,6 +33,7 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
   campaign   submit, list, show, pause, resume, abort campaigns of hystlabd (on its db file)
   tables     list and export the tables hystlabd identified
   runs       export a run's samples as CSV
+  simulate   the base-excited isolator (sdof): time histories, transmissibility sweeps
 )";
 
 int dispatch(const std::string& verb, const Args& args) {
@@ -47,6 +48,7 @@ int dispatch(const std::string& verb, const Args& args) {
   if (verb == "campaign") return run_campaign_cmd(args);
   if (verb == "tables") return run_tables_cmd(args);
   if (verb == "runs") return run_runs_cmd(args);
+  if (verb == "simulate") return run_simulate(args);
   throw CliError("unknown verb '" + verb + "' (hystlab --help lists them)");
 }
 }  // namespace
