@@ -282,3 +282,37 @@ TEST_CASE("cli: campaigns on the daemon's db: submit validates, a waveform CSV i
   check_error(w.run("tables export 5 --db d.db"), "no table 5");
   check_error(w.run("runs export 3 --db d.db"), "no samples for run 3");
 }
+
+TEST_CASE("cli: simulate sdof: time history, sweep up and down with the linear comparison, and its refusals") {
+  Workdir w;
+  const Result h = w.run("simulate sdof --mass 1 --springs 2 --linear 5 --damping 0.02 --preload-mm 2 --amplitude-mm 0.05 "
+                         "--frequency-hz 10 --duration-s 0.5 --every 10 -o H.csv");
+  REQUIRE(h.code == 0);
+  const std::string hist = slurp(w / "H.csv");
+  CHECK(hist.rfind("t_s,base_mm,mass_mm,compression_mm,force_N,input_work_Nmm", 0) == 0);
+  CHECK(column(hist, 0).size() == 501);
+  const Result s = w.run("simulate sdof --mass 1 --springs 2 --linear 5 --preload-mm 2 --amplitude-mm 0.05 --sweep "
+                         "--frequencies 8,16,30 --settle-cycles 30 --zetas 0.1 -o S.csv --svg S.svg");
+  REQUIRE(s.code == 0);
+  const std::string sweep = slurp(w / "S.csv");
+  CHECK(sweep.rfind("frequency_hz,up,down,up_p2p,down_p2p,linear_zeta_0.1", 0) == 0);
+  const auto zeta01 = column(sweep, 5), f = column(sweep, 0);
+  REQUIRE(zeta01.size() == 3);
+  // The matched linear system is this one with ζ = 0.1: f_n = 100/2π Hz.
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double r = f[k] / (100.0 / (2 * 3.141592653589793)), a = 0.2 * r;
+    CHECK(zeta01[k] == doctest::Approx(std::sqrt((1 + a * a) / ((1 - r * r) * (1 - r * r) + a * a))).epsilon(0.02));
+  }
+  CHECK(slurp(w / "S.svg").find("<svg") != std::string::npos);
+  const Result sma = w.run("simulate sdof --mass 2 --springs 2 --model simplified --preload-mm 3 --amplitude-mm 0.5 --sweep "
+                           "--from-hz 20 --to-hz 40 --steps 5 --settle-cycles 30 -o M.csv");
+  REQUIRE(sma.code == 0);
+  CHECK(column(slurp(w / "M.csv"), 1).size() == 5);
+  check_error(w.run("simulate sdof --mass 1 --linear 5 --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1 --dt 0.05"), "unstable");
+  check_error(w.run("simulate sdof --mass -1 --linear 5 --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1"), "mass_kg");
+  check_error(w.run("simulate sdof --mass 1 --linear -5 --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1"), "--linear");
+  check_error(w.run("simulate sdof --mass 1 --linear 5 --amplitude-mm 0.1 --sweep --frequencies 5,x"), "'x' is not a number");
+  check_error(w.run("simulate pendulum --mass 1"), "unknown simulation");
+  w.write("bad.json", R"({"format": "hystlab-everett-table", "version": 9})");
+  check_error(w.run("simulate sdof --mass 1 --table bad.json --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1"), "version");
+}
