@@ -51,8 +51,15 @@ httplib::Server::HandlerResponse guard_request(ApiContext& c, const httplib::Req
   return httplib::Server::HandlerResponse::Unhandled;
 }
 
-std::string default_dir(const std::string& configured, const char* built_in) {
-  return configured.empty() ? std::string(built_in) : configured;
+// The configured folder; else the installed one beside the executable
+// (<bindir>/../share/hystlab/web/<sub>); else the source tree's.
+std::string default_dir(const std::string& configured, const std::string& installed_sub, const char* source_tree) {
+  if (!configured.empty()) return configured;
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const auto installed = exe.parent_path().parent_path() / "share" / "hystlab" / "web" / installed_sub;
+  if (!ec && std::filesystem::exists(installed / (installed_sub.empty() ? "index.html" : "uPlot.iife.min.js"), ec)) return installed.string();
+  return source_tree;
 }
 }  // namespace
 
@@ -88,7 +95,7 @@ HttpApi::HttpApi(daemon::Daemon& d, const daemon::HttpConfig& cfg) : impl_(std::
   add_campaign_routes(s, m.ctx);
   add_data_routes(s, m.ctx);
   add_stream_route(s, m.ctx);
-  const std::string vendor = default_dir(cfg.vendor_root, HYSTLAB_VENDOR_ROOT), root = default_dir(cfg.web_root, HYSTLAB_WEB_ROOT);
+  const std::string vendor = default_dir(cfg.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT), root = default_dir(cfg.web_root, "", HYSTLAB_WEB_ROOT);
   if (!s.set_mount_point("/vendor/uplot", vendor))
     spdlog::warn("http: the plotting library is not at '{}' (run 'npm ci' in web/): the page cannot plot", vendor);
   if (!s.set_mount_point("/", root)) spdlog::warn("http: no page at '{}': the API alone is served", root);

@@ -1,0 +1,124 @@
+// The C API over hystlab::models: exceptions and error codes stop here.
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <new>
+#include <sstream>
+#include <string>
+
+#include "hystlab/hystlab.h"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/preisach_model.hpp"
+#include "hystlab/models/simplified_sma.hpp"
+
+struct hystlab_model {
+  std::unique_ptr<hystlab::models::HysteresisModel> model;
+  int kind = 0;
+};
+
+namespace {
+thread_local std::string g_error;
+
+hystlab_status fail(hystlab_status s, std::string message) {
+  g_error = std::move(message);
+  return s;
+}
+
+// Runs f, turning every exception into a status and a message.
+template <class F>
+hystlab_status guarded(F&& f) noexcept {
+  try {
+    return f();
+  } catch (const hystlab::models::FormatError& e) {
+    return fail(HYSTLAB_ERROR_FORMAT, e.what());
+  } catch (const std::invalid_argument& e) {
+    return fail(HYSTLAB_ERROR_FORMAT, e.what());
+  } catch (const std::bad_alloc&) {
+    return fail(HYSTLAB_ERROR_MEMORY, "out of memory");
+  } catch (const std::exception& e) {
+    return fail(HYSTLAB_ERROR_ARGUMENT, e.what());
+  }
+}
+
+hystlab_status make(const std::string& text, hystlab_model** out) {
+  const auto j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return fail(HYSTLAB_ERROR_FORMAT, "not a JSON object (a table or a parameter set)");
+  auto m = std::make_unique<hystlab_model>();
+  if (j.contains("format")) {
+    auto doc = hystlab::models::table_from_json(text);
+    m->model = std::make_unique<hystlab::models::PreisachModel>(std::make_shared<const hystlab::models::EverettTable>(std::move(doc.table)));
+    m->kind = 1;
+  } else {
+    m->model = std::make_unique<hystlab::models::SimplifiedSmaModel>(hystlab::models::params_from_json(text));
+    m->kind = 2;
+  }
+  *out = m.release();
+  return HYSTLAB_OK;
+}
+}  // namespace
+
+extern "C" {
+
+const char* hystlab_version(void) { return HYSTLAB_VERSION; }
+int hystlab_api_version(void) { return HYSTLAB_API_VERSION; }
+const char* hystlab_last_error(void) { return g_error.c_str(); }
+
+hystlab_status hystlab_model_load(const char* path, hystlab_model** out) {
+  if (!path || !out) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_load: null argument");
+  *out = nullptr;
+  return guarded([&] {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return fail(HYSTLAB_ERROR_IO, std::string("cannot open '") + path + "'");
+    std::stringstream s;
+    s << in.rdbuf();
+    const hystlab_status st = make(s.str(), out);
+    if (st != HYSTLAB_OK) g_error = std::string(path) + ": " + g_error;
+    return st;
+  });
+}
+
+hystlab_status hystlab_model_from_json(const char* text, hystlab_model** out) {
+  if (!text || !out) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_from_json: null argument");
+  *out = nullptr;
+  return guarded([&] { return make(text, out); });
+}
+
+hystlab_status hystlab_model_step(hystlab_model* m, double x, double* force) {
+  if (!m || !force) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_step: null argument");
+  if (!std::isfinite(x)) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_step: the displacement is not a finite number");
+  *force = m->model->step(x);
+  return HYSTLAB_OK;
+}
+
+hystlab_status hystlab_model_evaluate(hystlab_model* m, const double* x, double* force, size_t n) {
+  if (!m || (n > 0 && (!x || !force))) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_evaluate: null argument");
+  for (size_t k = 0; k < n; ++k)
+    if (!std::isfinite(x[k])) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_evaluate: x[" + std::to_string(k) + "] is not a finite number");
+  for (size_t k = 0; k < n; ++k) force[k] = m->model->step(x[k]);
+  return HYSTLAB_OK;
+}
+
+hystlab_status hystlab_model_reset(hystlab_model* m) {
+  if (!m) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_reset: null model");
+  m->model->reset();
+  return HYSTLAB_OK;
+}
+
+hystlab_status hystlab_model_copy(const hystlab_model* m, hystlab_model** out) {
+  if (!m || !out) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_copy: null argument");
+  *out = nullptr;
+  return guarded([&] {
+    auto c = std::make_unique<hystlab_model>();
+    c->model = m->model->clone();
+    c->kind = m->kind;
+    *out = c.release();
+    return HYSTLAB_OK;
+  });
+}
+
+void hystlab_model_free(hystlab_model* m) { delete m; }
+
+int hystlab_model_kind(const hystlab_model* m) { return m ? m->kind : 0; }
+uint64_t hystlab_model_saturations(const hystlab_model* m) { return m ? m->model->saturation_count() : 0; }
+
+}  // extern "C"
