@@ -19,6 +19,7 @@ int run_campaign_cmd(const Args& args);
 int run_tables_cmd(const Args& args);
 int run_runs_cmd(const Args& args);
 int run_simulate(const Args& args);
+int run_export(const Args& args);
 
 // True (and the help printed) when args ask for it.
 bool print_help_if_asked(const Args& args, const char* text);

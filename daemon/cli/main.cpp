@@ -34,6 +34,7 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
   tables     list and export the tables hystlabd identified
   runs       export a run's samples as CSV
   simulate   the base-excited isolator (sdof): time histories, transmissibility sweeps
+  export     a table or parameters as JSON, CSV, MATLAB/Octave or a C header
 )";
 
 int dispatch(const std::string& verb, const Args& args) {
@@ -49,6 +50,7 @@ int dispatch(const std::string& verb, const Args& args) {
   if (verb == "tables") return run_tables_cmd(args);
   if (verb == "runs") return run_runs_cmd(args);
   if (verb == "simulate") return run_simulate(args);
+  if (verb == "export") return run_export(args);
   throw CliError("unknown verb '" + verb + "' (hystlab --help lists them)");
 }
 }  // namespace

@@ -1,15 +1,20 @@
 #include "hystlab/models/table_export.hpp"
 
+#include <cctype>
+#include <charconv>
 #include <cstdio>
+#include <tuple>
+#include <vector>
 #include <sstream>
 
 namespace hystlab::models {
 namespace {
-// Round-trip precision: what was identified is what the other tool gets.
+// The shortest text that reads back to the same double: what was identified is what the other
+// tool gets, and 2.95 stays 2.95.
 std::string num(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
 }
 
 // Provenance as comment text: one line, no line breaks smuggled in from a source name.
@@ -79,7 +84,73 @@ function v = hystlab_everett(T, a, b)
   end
 end
 )";
+void check_identifier(const std::string& name) {
+  bool ok = !name.empty() && name.size() <= 64 && !std::isdigit(static_cast<unsigned char>(name[0]));
+  for (char c : name) ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+  if (!ok) throw FormatError("export: '" + name + "' is not a C identifier (letters, digits, _; not starting with a digit)");
+}
+
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// The parameters in the order of docs/FORMATS.md, with their units.
+std::vector<std::tuple<const char*, double, const char*>> params_of(const SmaParameters& p) {
+  return {{"KA", p.KA, "N/mm"},     {"KM", p.KM, "N/mm"},     {"dtr_max", p.dtr_max, "mm"}, {"C", p.C, "N/degC"},
+          {"Mf0", p.Mf0, "degC"},   {"Ms0", p.Ms0, "degC"},   {"As0", p.As0, "degC"},      {"Af0", p.Af0, "degC"},
+          {"T", p.T, "degC"}};
+}
 }  // namespace
+
+std::string table_to_c_header(const EverettTable& table, const TableProvenance& p, const std::string& name) {
+  check_identifier(name);
+  const std::string N = upper(name);
+  const Grid& g = table.grid();
+  std::ostringstream o;
+  o << "/* hystlab Everett table (" << kTableFormat << " v" << kTableVersion << "), " << one_line(p.method) << ", "
+    << one_line(p.source) << ", created " << one_line(p.created) << ".\n"
+    << " * F(delta_i, delta_j) in N for 0 <= j <= i <= n at " << N << "_VALUES_N[i*(i+1)/2 + j];\n"
+    << " * delta_i = lo + (hi - lo) * i / n in mm. Evaluate with the memory-stack rule of hystlab's docs. */\n"
+    << "#ifndef " << N << "_H\n#define " << N << "_H\n\n"
+    << "#define " << N << "_N " << g.n << "\n"
+    << "#define " << N << "_NODE_COUNT " << Grid::node_count(g.n) << "\n"
+    << "static const double " << N << "_LO_MM = " << num(g.lo) << ";\n"
+    << "static const double " << N << "_HI_MM = " << num(g.hi) << ";\n"
+    << "static const double " << N << "_FORCE_OFFSET_N = " << num(table.force_offset()) << ";\n"
+    << "static const double " << N << "_VALUES_N[" << N << "_NODE_COUNT] = {\n";
+  for (int i = 0; i <= g.n; ++i) {
+    o << "   ";
+    for (int j = 0; j <= i; ++j) o << " " << num(table.node_value(i, j)) << ",";
+    o << "\n";
+  }
+  o << "};\n\n#endif\n";
+  return o.str();
+}
+
+std::string params_to_csv(const SmaParameters& p) {
+  std::ostringstream o;
+  o << "# " << kParamsModel << "\nname,value,unit\n";
+  for (const auto& [n, v, u] : params_of(p)) o << n << "," << num(v) << "," << u << "\n";
+  return o.str();
+}
+
+std::string params_to_matlab(const SmaParameters& p) {
+  std::ostringstream o;
+  o << "% hystlab " << kParamsModel << " parameters (N, mm, degC).\nP = struct();\n";
+  for (const auto& [n, v, u] : params_of(p)) o << "P." << n << " = " << num(v) << ";  % " << u << "\n";
+  return o.str();
+}
+
+std::string params_to_c_header(const SmaParameters& p, const std::string& name) {
+  check_identifier(name);
+  const std::string N = upper(name);
+  std::ostringstream o;
+  o << "/* hystlab " << kParamsModel << " parameters (N, mm, degC). */\n#ifndef " << N << "_H\n#define " << N << "_H\n";
+  for (const auto& [n, v, u] : params_of(p)) o << "static const double " << N << "_" << upper(n) << " = " << num(v) << "; /* " << u << " */\n";
+  o << "#endif\n";
+  return o.str();
+}
 
 std::string table_to_csv(const EverettTable& table, const TableProvenance& p) {
   const Grid& g = table.grid();

@@ -316,3 +316,38 @@ TEST_CASE("cli: simulate sdof: time history, sweep up and down with the linear c
   w.write("bad.json", R"({"format": "hystlab-everett-table", "version": 9})");
   check_error(w.run("simulate sdof --mass 1 --table bad.json --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1"), "version");
 }
+
+TEST_CASE("cli: export a table and parameters as JSON, CSV, MATLAB and a C header that compiles") {
+  Workdir w;
+  REQUIRE(w.run("identify --model simplified --range 0,4 --subdivisions 6 -o T.json").code == 0);
+  REQUIRE(w.run("export --table T.json --format csv -o T.csv").code == 0);
+  REQUIRE(w.run("export --table T.json --format h --name isolator -o isolator.h").code == 0);
+  REQUIRE(w.run("export --table T.json --format m -o T.m").code == 0);
+  REQUIRE(w.run("export --table T.json --format json -o T2.json").code == 0);
+  CHECK(slurp(w / "T.m").find("function f = hystlab_eval(T, x)") != std::string::npos);
+  CHECK(slurp(w / "T2.json").find("\"hystlab-everett-table\"") != std::string::npos);
+  // The header, compiled by the C compiler, holds the CSV's node values exactly.
+  w.write("main.c", "#include <stdio.h>\n#include \"isolator.h\"\nint main(void) {\n"
+                    "  for (int k = 0; k < ISOLATOR_NODE_COUNT; ++k) printf(\"%.17g\\n\", ISOLATOR_VALUES_N[k]);\n"
+                    "  printf(\"%d %.17g %.17g\\n\", ISOLATOR_N, ISOLATOR_LO_MM, ISOLATOR_HI_MM);\n  return 0;\n}\n");
+  const std::string cc = "cd '" + (w / "").string() + "' && cc -std=c99 -Wall -Werror main.c -o main && ./main > values.txt";
+  REQUIRE(std::system(cc.c_str()) == 0);
+  std::istringstream csv(slurp(w / "T.csv")), values(slurp(w / "values.txt"));
+  std::vector<double> from_csv, from_c;
+  for (std::string line; std::getline(csv, line);)
+    if (!line.empty() && line[0] != '#' && line[0] != 'i') from_csv.push_back(std::stod(line.substr(line.rfind(',') + 1)));
+  for (std::string line; std::getline(values, line);) from_c.push_back(std::strtod(line.c_str(), nullptr));
+  REQUIRE(from_csv.size() == 28);  // (n+1)(n+2)/2
+  REQUIRE(from_c.size() == 29);
+  for (std::size_t k = 0; k < 28; ++k) CHECK(from_c[k] == from_csv[k]);
+  w.write("P.json", R"({"model": "simplified-sma", "KA_N_per_mm": 40, "KM_N_per_mm": 150, "dtr_max_mm": 2.95, "C_N_per_degC": 5.7,
+                        "Mf0_degC": 12.7, "Ms0_degC": 17.9, "As0_degC": 17.9, "Af0_degC": 21.5, "T_degC": 25})");
+  const Result ph = w.run("export --params P.json --format h --name tube");
+  REQUIRE(ph.code == 0);
+  CHECK(ph.out.find("static const double TUBE_KM = 150;") != std::string::npos);
+  CHECK(w.run("export --params P.json --format csv").out.find("dtr_max,2.95,mm") != std::string::npos);
+  CHECK(w.run("export --params P.json --format m").out.find("P.Af0 = 21.5;") != std::string::npos);
+  check_error(w.run("export --table T.json --format xlsx"), "xlsx");
+  check_error(w.run("export --table T.json --params P.json --format h"), "one of");
+  check_error(w.run("export --table T.json --format h --name 9lives"), "not a C identifier");
+}

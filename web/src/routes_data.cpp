@@ -152,14 +152,15 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/tables/(\d+)/export)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     const std::int64_t id = path_id(req);
     const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
-    if (format != "json" && format != "csv" && format != "m")
-      throw ApiError(400, "invalid parameter", "format: '" + format + "' is not json, csv or m");
+    if (format != "json" && format != "csv" && format != "m" && format != "h")
+      throw ApiError(400, "invalid parameter", "format: '" + format + "' is not json, csv, m or h");
     const std::string text = table_document(reader(c.db_path), id);
     const std::string name = "hystlab_table_" + std::to_string(id) + "." + format;
     res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
     if (format == "json") return res.set_content(text, "application/json");
     const models::TableDocument doc = models::table_from_json(text);
     if (format == "csv") return res.set_content(models::table_to_csv(doc.table, doc.provenance), "text/csv");
+    if (format == "h") return res.set_content(models::table_to_c_header(doc.table, doc.provenance, "hystlab_table_" + std::to_string(id)), "text/x-c");
     res.set_content(models::table_to_matlab(doc.table, doc.provenance), "text/x-matlab");
   }));
   s.Post("/api/evaluate", guarded([&c](const httplib::Request& req, httplib::Response& res) {

@@ -15,4 +15,13 @@ namespace hystlab::models {
 // diagonal), then the functions hystlab_eval(T, x) and hystlab_everett(T, a, b) (MODELS.md §1).
 [[nodiscard]] std::string table_to_matlab(const EverettTable& table, const TableProvenance& provenance);
 
+// A C header: NAME_N, NAME_LO_MM, NAME_HI_MM, NAME_FORCE_OFFSET_N and NAME_VALUES_N[] (node
+// (i, j) at index i(i+1)/2 + j), all static const; name must be a C identifier (FormatError).
+[[nodiscard]] std::string table_to_c_header(const EverettTable& table, const TableProvenance& provenance, const std::string& name);
+
+// Simplified-model parameters: name,value rows; a MATLAB/Octave struct P; C constants NAME_KA...
+[[nodiscard]] std::string params_to_csv(const SmaParameters& p);
+[[nodiscard]] std::string params_to_matlab(const SmaParameters& p);
+[[nodiscard]] std::string params_to_c_header(const SmaParameters& p, const std::string& name);
+
 }  // namespace hystlab::models
