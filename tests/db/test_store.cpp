@@ -161,13 +161,26 @@ TEST_CASE("kill -9 at random moments: integrity ok, every acknowledged sample pr
     REQUIRE(posix_spawn(&pid, exe.c_str(), &fa, nullptr, argv, environ) == 0);
     posix_spawn_file_actions_destroy(&fa);
     close(out[1]);
+    // The random moment is counted from the first committed batch, so that a slow host (a
+    // sanitizer build under load) cannot make a round vacuous.
+    std::string text;
+    char buf[4096];
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    auto committed = [](const std::string& out_text) {  // an "ack N" with N >= 0 (-1: nothing yet)
+      for (auto p = out_text.find("ack "); p != std::string::npos; p = out_text.find("ack ", p + 1))
+        if (p + 4 < out_text.size() && std::isdigit(static_cast<unsigned char>(out_text[p + 4]))) return true;
+      return false;
+    };
+    while (!committed(text) && std::chrono::steady_clock::now() < give_up) {
+      const ssize_t n = read(out[0], buf, sizeof buf);
+      if (n <= 0) break;
+      text.append(buf, static_cast<std::size_t>(n));
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms(rng)));
     kill(pid, SIGKILL);
     int st = 0;
     waitpid(pid, &st, 0);
     // The last acknowledgement printed before the kill.
-    std::string text;
-    char buf[4096];
     for (ssize_t n; (n = read(out[0], buf, sizeof buf)) > 0;) text.append(buf, static_cast<std::size_t>(n));
     close(out[0]);
     const auto pos = text.rfind("ack ");
