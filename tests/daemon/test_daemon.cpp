@@ -66,7 +66,7 @@ std::string state_of(const std::string& db, std::int64_t id) { return db::Store(
 
 // Polls until pred holds (or a few seconds pass).
 template <class F>
-bool eventually(F pred, int ms = 20000) {
+bool eventually(F pred, int ms = 60000) {  // generous: a sanitizer build on a loaded host
   for (int k = 0; k < ms / 50; ++k) {
     if (pred()) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
