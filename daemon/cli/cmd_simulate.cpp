@@ -3,6 +3,8 @@
 // matched static stiffness.
 #include <cmath>
 #include <iostream>
+#include <memory>
+#include "hystlab/models/formats.hpp"
 #include <sstream>
 
 #include "cli_support.hpp"
@@ -20,6 +22,7 @@ const char* kHelp = R"(usage: hystlab simulate sdof --mass KG --amplitude-mm Y S
 A mass on N springs over a base moving as y = Y sin(2πft) (mm, N, kg, s). The springs carry the
 weight at the preload; their compression is preload + y − x and they only push.
   SPRING:  --table T.json | --model simplified [--params P.json] | --linear K_N_per_mm
+           | --tables T1.json,T2.json,...  (one calibrated table per spring)
   --springs N         springs in parallel, each the model above (default 1)
   --damping C         a linear damper beside them, N·s/mm (default 0)
   --preload-mm D      static compression under the weight (default 0)
@@ -59,9 +62,11 @@ std::unique_ptr<models::HysteresisModel> spring_model(const Options& opt, std::s
   return std::move(m.model);
 }
 
-models::SdofSystem make_system(const models::HysteresisModel& proto, int n, const models::SdofOptions& o) {
+using Springs = std::vector<std::shared_ptr<const models::HysteresisModel>>;  // one prototype per spring
+
+models::SdofSystem make_system(const Springs& protos, const models::SdofOptions& o) {
   std::vector<models::SdofSpring> springs;
-  for (int k = 0; k < n; ++k) springs.push_back({proto.clone(), stiffness_bound(proto)});
+  for (const auto& p : protos) springs.push_back({p->clone(), stiffness_bound(*p)});
   try {
     return models::SdofSystem(std::move(springs), o);
   } catch (const std::invalid_argument& e) {
@@ -105,10 +110,11 @@ std::pair<std::vector<models::SteadyResponse>, std::vector<models::SteadyRespons
   return {up, down};
 }
 
-int run_sweep(const Options& opt, const models::HysteresisModel& proto, int n, const models::SdofOptions& o, double y, const std::string& what) {
+int run_sweep(const Options& opt, const Springs& protos, const models::SdofOptions& o, double y, const std::string& what) {
+  const int n = static_cast<int>(protos.size());
   const std::vector<double> f = sweep_frequencies(opt);
   const int settle = opt.integer("settle-cycles", 20, 0, 100000), measured = opt.integer("measured-cycles", 10, 1, 100000);
-  const auto [up, down] = sweep(make_system(proto, n, o), y, f, settle, measured);
+  const auto [up, down] = sweep(make_system(protos, o), y, f, settle, measured);
   std::vector<std::string> header{"frequency_hz", "up", "down", "up_p2p", "down_p2p"};
   std::vector<std::vector<double>> cols(5);
   for (std::size_t k = 0; k < f.size(); ++k) {
@@ -118,7 +124,7 @@ int run_sweep(const Options& opt, const models::HysteresisModel& proto, int n, c
   std::vector<PlotSeries> plot{{"SMA isolator, sweep up", "#1565c0", f, cols[1]}, {"SMA isolator, sweep down", "#c62828", f, cols[2], true}};
   const std::vector<double> zetas = list(opt.get("zetas", "0.05,0.1,0.2,0.4"), "--zetas");
   if (o.preload_mm > 0) {
-    const models::SdofSystem probe = make_system(proto, n, o);
+    const models::SdofSystem probe = make_system(protos, o);
     const double k_eq = probe.weight_N() / n / o.preload_mm;  // same static deflection under the same weight
     const double wn = std::sqrt(1000.0 * n * k_eq / o.mass_kg);
     const char* colours[] = {"#2e7d32", "#6a1b9a", "#ef6c00", "#00838f", "#5d4037", "#455a64"};
@@ -126,7 +132,8 @@ int run_sweep(const Options& opt, const models::HysteresisModel& proto, int n, c
       if (!(zetas[z] >= 0) || zetas[z] > 10) throw CliError("--zetas: damping ratios from 0 to 10");
       models::SdofOptions lo = o;
       lo.damping_N_s_per_mm = 2 * zetas[z] * o.mass_kg * wn / 1000.0;
-      const auto [lup, ldown] = sweep(make_system(models::LinearSpring(k_eq), n, lo), y, f, settle, measured);
+      const Springs linear(protos.size(), std::make_shared<models::LinearSpring>(k_eq));
+      const auto [lup, ldown] = sweep(make_system(linear, lo), y, f, settle, measured);
       header.push_back("linear_zeta_" + format_number(zetas[z]));
       cols.emplace_back();
       for (const auto& r : lup) cols.back().push_back(r.ratio);
@@ -150,7 +157,7 @@ int run_simulate(const Args& args) {
     return args.empty() ? 2 : 0;
   }
   const Options opt(Args(args.begin() + 1, args.end()),
-                    {"mass", "springs", "table", "model", "params", "linear", "damping", "preload-mm", "dt", "amplitude-mm", "frequency-hz",
+                    {"mass", "springs", "table", "tables", "model", "params", "linear", "damping", "preload-mm", "dt", "amplitude-mm", "frequency-hz",
                      "duration-s", "every", "frequencies", "from-hz", "to-hz", "steps", "settle-cycles", "measured-cycles", "zetas", "svg", "output"},
                     {"sweep", "log"});
   models::SdofOptions o;
@@ -163,9 +170,22 @@ int run_simulate(const Args& args) {
   const double y = opt.number("amplitude-mm", 0);
   if (!(y > 0)) throw CliError("--amplitude-mm: a positive base amplitude is required");
   std::string what;
-  const auto proto = spring_model(opt, what);
-  if (opt.has("sweep")) return run_sweep(opt, *proto, n, o, y, what);
-  models::SdofSystem sys = make_system(*proto, n, o);
+  Springs protos;
+  if (opt.has("tables")) {  // one calibrated table per spring
+    if (opt.has("table") || opt.has("model") || opt.has("linear") || opt.has("springs"))
+      throw CliError("--tables gives one table per spring: no --table, --model, --linear or --springs with it");
+    std::stringstream in(opt.get("tables"));
+    for (std::string path; std::getline(in, path, ',');) {
+      const auto doc = models::table_from_json(read_file(path));
+      protos.push_back(std::make_shared<models::PreisachModel>(doc.table));
+    }
+    what = std::to_string(protos.size()) + " calibrated tables";
+  } else {
+    const std::shared_ptr<const models::HysteresisModel> proto = spring_model(opt, what);
+    protos.assign(static_cast<std::size_t>(n), proto);
+  }
+  if (opt.has("sweep")) return run_sweep(opt, protos, o, y, what);
+  models::SdofSystem sys = make_system(protos, o);
   const double f = opt.number("frequency-hz", 0), duration = opt.number("duration-s", 0);
   if (!(f > 0) || !(duration > 0)) throw CliError("--frequency-hz and --duration-s: positive numbers (or --sweep)");
   const int every = opt.integer("every", 10, 1, 1000000);

@@ -312,6 +312,15 @@ TEST_CASE("cli: simulate sdof: time history, sweep up and down with the linear c
   check_error(w.run("simulate sdof --mass -1 --linear 5 --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1"), "mass_kg");
   check_error(w.run("simulate sdof --mass 1 --linear -5 --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1"), "--linear");
   check_error(w.run("simulate sdof --mass 1 --linear 5 --amplitude-mm 0.1 --sweep --frequencies 5,x"), "'x' is not a number");
+  // One calibrated table per spring.
+  REQUIRE(w.run("identify --model simplified --range 0,5 --subdivisions 6 -o A.json").code == 0);
+  REQUIRE(w.run("identify --model simplified --range 0,5 --subdivisions 10 -o B.json").code == 0);
+  const Result two = w.run("simulate sdof --mass 2 --tables A.json,B.json --preload-mm 3 --amplitude-mm 0.3 --frequency-hz 20 "
+                           "--duration-s 0.2 -o two.csv");
+  CAPTURE(two.err);
+  REQUIRE(two.code == 0);
+  CHECK(column(slurp(w / "two.csv"), 4).front() > 0);  // the two tables carry the weight
+  check_error(w.run("simulate sdof --mass 2 --tables A.json,B.json --springs 3 --amplitude-mm 0.3 --frequency-hz 20 --duration-s 0.2"), "--tables");
   check_error(w.run("simulate pendulum --mass 1"), "unknown simulation");
   w.write("bad.json", R"({"format": "hystlab-everett-table", "version": 9})");
   check_error(w.run("simulate sdof --mass 1 --table bad.json --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1"), "version");
