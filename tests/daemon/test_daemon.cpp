@@ -50,6 +50,17 @@ pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
   return pid;
 }
 
+// A daemon a failed REQUIRE left running is killed when the test case ends.
+struct Reaper {
+  const pid_t& pid;
+  ~Reaper() {
+    if (pid > 0 && waitpid(pid, nullptr, WNOHANG) == 0) {
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+    }
+  }
+};
+
 int wait_exit(pid_t pid) {
   int st = 0;
   waitpid(pid, &st, 0);
@@ -95,6 +106,7 @@ TEST_CASE("hystlabd: SIGTERM holds, marks the campaign interrupted, exits 0") {
   d.write("cfg.json", kConfig);
   d.write("plan.json", kPlan);
   const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
+  const Reaper reaper{pid};
   REQUIRE(eventually([&] { return fs::exists(d.db()); }));
   REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "running"; }));
@@ -108,6 +120,7 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
   d.write("cfg.json", kConfig);
   d.write("plan.json", kPlan);
   pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
+  const Reaper reaper{pid};
   REQUIRE(eventually([&] { return fs::exists(d.db()); }));
   REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
   std::int64_t committed = -1;
