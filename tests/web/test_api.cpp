@@ -78,6 +78,7 @@ TEST_CASE("a campaign through the API: submit, follow, nodes, tables and their e
   CHECK(r->body.find("T.n = 3;") != std::string::npos);
   CHECK(json::parse(c.Get(("/api/tables/" + std::to_string(table)).c_str())->body)["document"]["format"] == "hystlab-everett-table");
   CHECK(json::parse(c.Get("/api/tables")->body).size() == 2);
+  CHECK(json::parse(c.Get("/api/campaigns")->body)[0]["tables"] == 2);
 
   // Samples: the full CSV stream, and a 50-point overview that keeps the extremes.
   r = c.Get(("/api/runs/" + std::to_string(run) + "/samples.csv").c_str());

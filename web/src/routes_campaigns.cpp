@@ -97,7 +97,13 @@ json table_row_json(db::Statement& st) {
 json campaign_json(db::Store& store, const db::CampaignRow& row, bool details) {
   json j{{"id", row.id}, {"rig", rig_name(store, row.rig_id)}, {"kind", row.kind}, {"state", row.state},
          {"created_at", row.created_at}, {"updated_at", row.updated_at}};
-  if (!details) return j;
+  if (!details) {
+    db::Statement st(store.database(), "SELECT count(*) FROM tables WHERE campaign_id = ?");
+    st.bind(1, row.id);
+    st.step();
+    j["tables"] = st.column_int(0);
+    return j;
+  }
   j["plan"] = parse_or_text(row.plan);
   j["runs"] = runs_of(store, row.id);
   j["tables"] = tables_of(store, row.id);

@@ -44,7 +44,7 @@ async function refreshList() {
   const ul = $('campaigns');
   ul.replaceChildren(...S.campaigns.slice().reverse().map(c => {
     const li = document.createElement('li');
-    li.textContent = `#${c.id} ${c.kind} — ${c.state}`;
+    li.textContent = `#${c.id} ${c.kind} — ${c.state}` + (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : '');
     li.dataset.id = c.id;
     li.className = c.id === S.selected ? 'selected' : '';
     li.addEventListener('click', serial(() => { S.follow = false; return select(c.id); }));
