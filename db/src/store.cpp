@@ -1,5 +1,7 @@
 #include "hystlab/db/store.hpp"
 
+#include <atomic>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -8,6 +10,12 @@
 #include "hystlab/db/schema.hpp"
 
 namespace hystlab::db {
+namespace {
+std::atomic<std::uint64_t> g_records{0};
+void records_changed() noexcept { g_records.fetch_add(1, std::memory_order_release); }
+}  // namespace
+
+std::uint64_t record_generation() noexcept { return g_records.load(std::memory_order_acquire); }
 namespace {
 Database& migrated(Database& db) {
   migrate(db);
@@ -63,6 +71,7 @@ std::int64_t Store::create_campaign(std::int64_t rig, const std::string& kind, c
   ev.bind(1, id).bind(2, now).bind(3, std::string_view("queued"));
   ev.step();
   tx.commit();
+  records_changed();
   return id;
 }
 
@@ -79,6 +88,7 @@ void Store::transition(std::int64_t id, const std::string& to, const std::string
   ev.bind(1, id).bind(2, now).bind(3, from).bind(4, to).bind(5, reason);
   ev.step();
   tx.commit();
+  records_changed();
 }
 
 std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, double wall, double mono) {
@@ -98,6 +108,7 @@ std::int64_t Store::add_event(std::int64_t campaign, const std::string& kind, co
   Statement st(db_, "INSERT INTO events(campaign_id, at, kind, detail) VALUES(?,?,?,?)");
   st.bind(1, campaign).bind(2, now).bind(3, kind).bind(4, detail);
   st.step();
+  records_changed();
   return db_.last_insert_rowid();
 }
 
@@ -106,6 +117,7 @@ std::int64_t Store::add_transmissibility(std::int64_t run, double f, double base
                     "VALUES(?,?,?,?,?,?)");
   st.bind(1, run).bind(2, f).bind(3, base).bind(4, mass).bind(5, ratio).bind(6, phase);
   st.step();
+  records_changed();
   return db_.last_insert_rowid();
 }
 
@@ -113,6 +125,7 @@ std::int64_t Store::add_fot_node(std::int64_t run, double a, double b, double fa
   Statement st(db_, "INSERT INTO fot_nodes(run_id, alpha, beta, force_alpha, force_alpha_beta, t) VALUES(?,?,?,?,?,?)");
   st.bind(1, run).bind(2, a).bind(3, b).bind(4, fa).bind(5, fab).bind(6, t);
   st.step();
+  records_changed();
   return db_.last_insert_rowid();
 }
 
@@ -125,6 +138,7 @@ std::int64_t Store::add_table(std::optional<std::int64_t> campaign, std::optiona
   run ? st.bind(2, *run) : st.bind_null(2);
   st.bind(3, method).bind(4, n).bind(5, lo).bind(6, hi).bind(7, now).bind(8, accuracy).bind(9, document);
   st.step();
+  records_changed();
   return db_.last_insert_rowid();
 }
 

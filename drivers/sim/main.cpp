@@ -1,8 +1,10 @@
 // hystlab-sim: a simulated load frame or shaker that speaks the real protocols over real sockets.
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -42,6 +44,8 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --control-port P               text control channel on 127.0.0.1 (default 0: any free port)
   --duration S                   stop after S wall-clock seconds (default: run until SIGTERM or 'quit')
   --exit-with-parent 1           stop when the process that started it is gone (a supervising daemon)
+  --realtime N                   run at SCHED_FIFO priority N when allowed: it stands in for a
+                                 controller with a CPU of its own (it only ever blocks in poll)
 On start it prints one line per endpoint ("modbus-tcp 127.0.0.1:1502", "control 127.0.0.1:40123") and "ready".
 )";
 
@@ -50,7 +54,7 @@ void on_signal(int) { g_stop = 1; }
 
 struct Args {
   std::string rig = "load_frame", transport = "tcp", address = "127.0.0.1", map, params, table;
-  int port = 1502, can_fd = -1, can_node = 1, control_port = 0;
+  int port = 1502, can_fd = -1, can_node = 1, control_port = 0, realtime = 0;
   double time_scale = 1, sample_rate = 1000, can_rate = 1000, noise = 0.05, drift = 0, corner = 0.05, duration = 0;
   bool exit_with_parent = false;
   std::uint64_t seed = 1;
@@ -105,6 +109,7 @@ Args parse(int argc, char** argv) {
     else if (o == "--control-port") a.control_port = static_cast<int>(num());
     else if (o == "--duration") a.duration = num();
     else if (o == "--exit-with-parent") a.exit_with_parent = num() != 0;
+    else if (o == "--realtime") a.realtime = static_cast<int>(num());
     else throw std::runtime_error("unknown option " + o + " (see --help)");
   }
   if (a.rig != "load_frame" && a.rig != "shaker") throw std::runtime_error("--rig must be load_frame or shaker");
@@ -146,6 +151,12 @@ int run(const Args& a) {
     modbus.emplace(a.transport == "tcp" ? sim::ModbusEndpoint::Transport::tcp : sim::ModbusEndpoint::Transport::rtu,
                    a.address, a.port, std::move(map));
     std::cout << modbus->where() << "\n";
+  }
+  if (a.realtime > 0) {
+    sched_param sp{};
+    sp.sched_priority = a.realtime;
+    if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+      std::cerr << "hystlab-sim: staying at normal priority (SCHED_FIFO " << a.realtime << " refused: " << std::strerror(errno) << ")\n";
   }
   sim::ControlChannel control(a.control_port);
   std::cout << "control 127.0.0.1:" << control.port() << "\nready" << std::endl;

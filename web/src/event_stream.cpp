@@ -11,7 +11,9 @@
 namespace hystlab::web {
 namespace {
 constexpr auto kTick = std::chrono::milliseconds(50);  // samples leave at most this long after acquisition
-constexpr int kRecordEvery = 4;                          // ticks between database polls (200 ms)
+constexpr int kRecordEvery = 4;                          // ticks between checks for new records (200 ms)
+constexpr int kRecordPollAnyway = 40;                    // ticks between reads even when nothing moved here (2 s):
+                                                         // another process (the CLI) may have written
 constexpr int kKeepAliveEvery = 300;                     // ticks between comments on a quiet stream (15 s)
 
 struct StreamState {
@@ -19,7 +21,8 @@ struct StreamState {
   std::vector<std::uint64_t> ring_pos;  // per rig
   std::vector<std::size_t> rigs;        // which rigs
   double rate_hz = 20;
-  int tick = 0, quiet = 0;
+  int tick = 0, quiet = 0, since_read = 0;
+  std::uint64_t seen_generation = ~0ULL;
   bool hello_sent = false;
 };
 
@@ -140,7 +143,16 @@ void add_stream_route(httplib::Server& s, ApiContext& c) {
           }
           std::this_thread::sleep_for(kTick);
           std::string out = samples(c.daemon, *st);
-          if (++st->tick % kRecordEvery == 0) out += records(reader(c.db_path), st->cursor);
+          ++st->since_read;
+          if (++st->tick % kRecordEvery == 0) {
+            // Read the database only when this process changed a record, or now and then.
+            const std::uint64_t gen = db::record_generation();
+            if (gen != st->seen_generation || st->since_read >= kRecordPollAnyway) {
+              st->seen_generation = gen;  // taken before the read: a change during it is read next time
+              st->since_read = 0;
+              out += records(reader(c.db_path), st->cursor);
+            }
+          }
           if (out.empty() && ++st->quiet >= kKeepAliveEvery) out = ": keep-alive\n\n";
           if (!out.empty()) st->quiet = 0;
           return write(sink, out) && sink.is_writable();

@@ -36,6 +36,11 @@ struct EventRow {
   std::string at, kind, from_state, to_state, detail;
 };
 
+// Bumped after every committed change of the records the API streams (campaigns and their
+// events, FOT nodes, tables, transmissibility) made through a Store of this process: event
+// streams read the database only when it moved (or now and then, for other processes' writes).
+[[nodiscard]] std::uint64_t record_generation() noexcept;
+
 class Store {
  public:
   explicit Store(const std::string& path, bool synchronous_full = true);  // opens and migrates
