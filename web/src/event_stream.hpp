@@ -7,6 +7,9 @@
 // the database, so nothing is missed across reconnects or daemon restarts.
 #include <httplib.h>
 
+#include <optional>
+#include <string>
+
 #include "api_support.hpp"
 
 namespace hystlab::web {
