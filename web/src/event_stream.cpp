@@ -55,14 +55,14 @@ std::string records(db::Store& store, StreamCursor& cur) {
     if (kind == "state") j["from"] = ev.column_text(4), j["to"] = ev.column_text(5);
     out += frame(kind == "state" ? "campaign" : kind, j, cur.id());
   }
-  db::Statement nd(store.database(), "SELECT f.id, r.campaign_id, f.run_id, alpha, beta, force_alpha, force_alpha_beta, f.t FROM fot_nodes f "
-                                     "JOIN runs r ON r.id = f.run_id WHERE f.id > ? ORDER BY f.id LIMIT 2000");
+  db::Statement nd(store.database(), kNodeSelect +
+                                     "WHERE f.id > ? ORDER BY f.id LIMIT 2000");
   nd.bind(1, cur.node);
   while (nd.step()) {
     cur.node = nd.column_int(0);
     out += frame("node", node_json(nd), cur.id());
   }
-  db::Statement tb(store.database(), "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy FROM tables "
+  db::Statement tb(store.database(), kTableSelect +
                                      "WHERE id > ? ORDER BY id LIMIT 100");
   tb.bind(1, cur.table);
   while (tb.step()) {

@@ -41,7 +41,7 @@ json runs_of(db::Store& store, std::int64_t campaign) {
 
 json tables_of(db::Store& store, std::int64_t campaign) {
   json out = json::array();
-  db::Statement st(store.database(), "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy FROM tables "
+  db::Statement st(store.database(), kTableSelect +
                                      "WHERE campaign_id = ? ORDER BY id");
   st.bind(1, campaign);
   while (st.step()) out.push_back(table_row_json(st));
@@ -57,8 +57,8 @@ json last_fit(db::Store& store, std::int64_t campaign) {
 
 json nodes_json(db::Store& store, const db::CampaignRow& row) {
   json nodes = json::array();
-  db::Statement st(store.database(), "SELECT f.id, r.campaign_id, f.run_id, alpha, beta, force_alpha, force_alpha_beta, f.t FROM fot_nodes f "
-                                     "JOIN runs r ON r.id = f.run_id WHERE r.campaign_id = ? ORDER BY f.id");
+  db::Statement st(store.database(), kNodeSelect +
+                                     "WHERE r.campaign_id = ? ORDER BY f.id");
   st.bind(1, row.id);
   while (st.step()) nodes.push_back(node_json(st));
   json out{{"campaign", row.id}, {"nodes", nodes}};

@@ -134,7 +134,7 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
   }));
   s.Get("/api/tables", guarded([&c](const httplib::Request&, httplib::Response& res) {
     json out = json::array();
-    db::Statement st(reader(c.db_path).database(), "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy FROM tables ORDER BY id");
+    db::Statement st(reader(c.db_path).database(), kTableSelect + "ORDER BY id");
     while (st.step()) out.push_back(table_row_json(st));
     send_json(res, out);
   }));
@@ -142,7 +142,7 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
     auto& store = reader(c.db_path);
     const std::int64_t id = path_id(req);
     const std::string doc = table_document(store, id);
-    db::Statement st(store.database(), "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy FROM tables WHERE id = ?");
+    db::Statement st(store.database(), kTableSelect + "WHERE id = ?");
     st.bind(1, id);
     st.step();
     json j = table_row_json(st);
