@@ -93,6 +93,12 @@ Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config
   for (const RigEntry& e : config.rigs) {
     auto w = std::make_unique<RigWorker>();
     w->entry = e;
+    w->acquisition = config.acquisition;
+    // A simulator shares the acquisition's CPU, just below it: its answers are then never queued
+    // behind the daemon's other threads (they keep the other CPUs).
+    w->entry.sim.cpu = resolve_cpu(config.acquisition.cpu);
+    if (w->entry.sim.realtime_priority < 0)
+      w->entry.sim.realtime_priority = w->entry.sim.cpu >= 0 && config.acquisition.priority > 1 ? config.acquisition.priority - 1 : 0;
     try {
       w->build_rig(config.base_dir);
     } catch (const drivers::RigConfigError& err) {

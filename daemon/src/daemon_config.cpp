@@ -37,6 +37,25 @@ HttpConfig parse_http(const json& h, HttpConfig c) {
   }
   return c;
 }
+AcquisitionSettings parse_acquisition(const json& a) {
+  if (!a.is_object()) fail("acquisition", "must be an object");
+  AcquisitionSettings s;
+  for (const auto& [k, v] : a.items()) {
+    if (k == "priority") {
+      if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 98)
+        fail("acquisition.priority", "must be a whole number from 0 (normal scheduling) to 98 (SCHED_FIFO)");
+      s.priority = v.get<int>();
+    } else if (k == "cpu") {
+      if (v == "last") s.cpu = AcquisitionSettings::kLastCpu;
+      else if (v == "any") s.cpu = AcquisitionSettings::kAnyCpu;
+      else if (v.is_number_integer() && v.get<long long>() >= 0 && v.get<long long>() < 4096) s.cpu = v.get<int>();
+      else fail("acquisition.cpu", "must be a CPU number, \"last\" or \"any\"");
+    } else {
+      fail("acquisition." + k, "is not a known field (priority, cpu)");
+    }
+  }
+  return s;
+}
 }  // namespace
 
 void check_http_security(HttpConfig& http, const char* env_token) {
@@ -56,8 +75,9 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
   }
   if (!j.is_object()) fail("", "must be a JSON object");
   for (const auto& [k, _] : j.items())
-    if (k != "db" && k != "rigs" && k != "http") fail(k, "is not a known field (db, rigs, http)");
+    if (k != "db" && k != "rigs" && k != "http" && k != "acquisition") fail(k, "is not a known field (db, rigs, http, acquisition)");
   if (j.contains("http")) c.http = parse_http(j["http"], c.http);
+  if (j.contains("acquisition")) c.acquisition = parse_acquisition(j["acquisition"]);
   if (j.contains("db")) {
     if (!j["db"].is_string() || j["db"].get<std::string>().empty()) fail("db", "must be a file name");
     c.db_path = j["db"].get<std::string>();
@@ -83,13 +103,19 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
       const json& s = r["simulate"];
       if (!s.is_object()) fail(where + ".simulate", "must be an object");
       for (const auto& [f, _] : s.items())
-        if (f != "time_scale" && f != "noise_N" && f != "corner_width_mm" && f != "rig") fail(where + ".simulate." + f, "is not a known field");
+        if (f != "time_scale" && f != "noise_N" && f != "corner_width_mm" && f != "rig" && f != "realtime_priority") fail(where + ".simulate." + f, "is not a known field");
       e.simulated = true;
       e.sim.time_scale = positive(s, "time_scale", 10.0, where + ".simulate");
       e.sim.noise_N = s.contains("noise_N") && s["noise_N"] == 0 ? 0.0 : positive(s, "noise_N", 0.05, where + ".simulate");
       e.sim.rig = s.value("rig", std::string("load_frame"));
       if (e.sim.rig != "load_frame" && e.sim.rig != "shaker") fail(where + ".simulate.rig", "must be \"load_frame\" or \"shaker\"");
       e.sim.corner_width_mm = s.contains("corner_width_mm") && s["corner_width_mm"] == 0 ? 0.0 : positive(s, "corner_width_mm", 0.05, where + ".simulate");
+      if (s.contains("realtime_priority")) {
+        const json& p = s["realtime_priority"];
+        if (!p.is_number_integer() || p.get<int>() < 0 || p.get<int>() > 98)
+          fail(where + ".simulate.realtime_priority", "must be an integer from 0 (normal scheduling) to 98");
+        e.sim.realtime_priority = p.get<int>();
+      }
       r.erase("simulate");
     }  // driver fields are checked by make_rig when the daemon creates the rigs, before anything runs
     e.driver = r;

@@ -2,9 +2,6 @@
 
 #include <spdlog/spdlog.h>
 
-#include <pthread.h>
-#include <sched.h>
-
 #include <chrono>
 #include <cstring>
 #include <ctime>
@@ -103,21 +100,12 @@ void idle_sample(RigWorker& w, double t) {
   if (!w.rig->read_sample(t, s)) w.live.ring.push({mono_now(), t, s.command_mm, s.displacement_mm, s.force_N, 0, s.status_word});
 }
 
-// The acquisition thread runs ahead of everything else in the process when the system allows it
-// (SCHED_FIFO needs CAP_SYS_NICE or an rtprio limit); otherwise it says so once and goes on.
-void raise_priority(const std::string& rig) {
-  sched_param p{};
-  p.sched_priority = 20;
-  if (const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p))
-    spdlog::info("rig '{}': acquisition at normal priority (SCHED_FIFO refused: {})", rig, std::strerror(err));
-  else
-    spdlog::info("rig '{}': acquisition thread at real-time priority (SCHED_FIFO 20)", rig);
-}
 }  // namespace
 
 void rig_thread(RigWorker& w, const std::string& db_path, db::SampleWriter& writer, const std::atomic<bool>& stop,
                 const std::string& base) {
-  raise_priority(w.entry.name);
+  // Ahead of everything else in the process when the system allows it; otherwise it says so once.
+  spdlog::info("rig '{}': acquisition thread at {}", w.entry.name, enter_acquisition_thread(w.acquisition));
   db::Store store(db_path);
   const double t0 = mono_now();
   (void)w.rig->connect(0.0);

@@ -22,6 +22,7 @@ namespace hystlab::daemon {
 
 struct RigWorker {
   RigEntry entry;
+  AcquisitionSettings acquisition;
   RigInfo info;
   std::unique_ptr<SimChild> sim;
   std::unique_ptr<drivers::Rig> rig;

@@ -1,6 +1,8 @@
 #include "sim_child.hpp"
 
 #include <poll.h>
+#include <sched.h>
+#include <spdlog/spdlog.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -40,14 +42,25 @@ int SimChild::ensure_running() {
   std::string exe = find_simulator(), scale = std::to_string(opt_.time_scale), noise = std::to_string(opt_.noise_N),
               corner = std::to_string(opt_.corner_width_mm);
   std::vector<std::string> args{exe, "--port", "0", "--time-scale", scale, "--noise", noise, "--corner-width", corner, "--exit-with-parent", "1", "--rig", opt_.rig};
-  // Not --realtime: at a large time scale its physics catch-up is real work, and at SCHED_FIFO it
-  // starved the daemon's other threads (a campaign stalled in a sanitizer build).
+  // --realtime only when configured: at a large time scale the physics catch-up is real work, and
+  // at SCHED_FIFO it starved the daemon's other threads (a campaign stalled in a sanitizer build).
+  if (opt_.realtime_priority > 0) args.insert(args.end(), {"--realtime", std::to_string(opt_.realtime_priority)});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  const int rc = posix_spawnp(&pid_, exe.c_str(), &fa, nullptr, argv.data(), environ);
+  // Normal scheduling unless asked: the caller may be an acquisition thread at SCHED_FIFO.
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sched_param normal{};
+  posix_spawnattr_setschedpolicy(&attr, SCHED_OTHER);
+  posix_spawnattr_setschedparam(&attr, &normal);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSCHEDULER);
+  const int rc = posix_spawnp(&pid_, exe.c_str(), &fa, &attr, argv.data(), environ);
+  posix_spawnattr_destroy(&attr);
   posix_spawn_file_actions_destroy(&fa);
   close(out[1]);
+  if (rc == 0 && opt_.cpu >= 0 && !pin_process(pid_, opt_.cpu))
+    spdlog::info("hystlab-sim: not pinned to CPU {} (refused)", opt_.cpu);
   if (rc != 0) {
     close(out[0]);
     pid_ = -1;

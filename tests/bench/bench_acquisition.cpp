@@ -1,6 +1,8 @@
 // A 1 kHz acquisition for 60 s through the campaign runner (rig reads, safety, sequencer, ring
 // push) while the writer thread ingests; next to a bare 1 kHz sleep loop in the same run, which
-// is what the machine's scheduler alone allows.
+// is what the machine's scheduler alone allows. Both run as hystlabd runs a rig's acquisition
+// thread (daemon/realtime.hpp: SCHED_FIFO 20 when allowed, pinned to the last CPU), with the
+// simulator where hystlabd puts it (that CPU, SCHED_FIFO 19) and the writer at normal priority.
 #include <time.h>
 
 #include <algorithm>
@@ -12,6 +14,7 @@
 
 #include "../drivers/sim_process.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
+#include "hystlab/daemon/realtime.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 
 using namespace hystlab;
@@ -53,15 +56,18 @@ int main(int argc, char** argv) {
   double seconds = 60;
   for (int k = 1; k + 1 < argc; k += 2)
     if (!std::strcmp(argv[k], "--seconds")) seconds = std::atof(argv[k + 1]);
-  long base_missed = 0;
-  report("baseline: bare 1 kHz sleep loop", sleep_loop(seconds / 3, base_missed), base_missed);
-
-  test::SimProcess sim({"--port", "0", "--noise", "0.05"});
+  const daemon::AcquisitionSettings settings;  // the daemon's defaults
+  test::SimProcess sim({"--port", "0", "--noise", "0.05", "--realtime", std::to_string(settings.priority - 1)});
+  if (!daemon::pin_process(sim.pid(), daemon::resolve_cpu(settings.cpu))) std::printf("the simulator is not pinned\n");
   char tmpl[] = "/tmp/hystlab-acq-XXXXXX";
   const std::filesystem::path dir = mkdtemp(tmpl);
   const std::string path = (dir / "hystlab.db").string();
   db::Store store(path);
-  db::SampleWriter writer(path);
+  db::SampleWriter writer(path);  // its thread is started before this one turns real-time: it stays normal
+  std::printf("this thread: %s\n", daemon::enter_acquisition_thread(settings).c_str());
+  long base_missed = 0;
+  report("baseline: bare 1 kHz sleep loop", sleep_loop(seconds / 3, base_missed), base_missed);
+
   auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", sim.modbus_port}});
   nlohmann::json points = nlohmann::json::array();
   const int legs = std::max(2, static_cast<int>(seconds / 1.5));

@@ -34,6 +34,8 @@ fs.writeFileSync(path.join(outDir, 'hystlab.json'), JSON.stringify({
 function startDaemon(portArg) {
   const proc = spawn(daemonPath, ['--config', path.join(outDir, 'hystlab.json'), '--port', String(portArg)], { cwd: outDir, stdio: ['ignore', 'pipe', 'pipe'] });
   let log = '';
+  proc.stdout.on('data', d => { daemonLog += d; });
+  proc.stderr.on('data', d => { daemonLog += d; });
   const port = new Promise((resolve, reject) => {
     const timer = setTimeout(() => reject(new Error('hystlabd did not start within 20 s:\n' + log)), 20000);
     const onData = d => {
@@ -53,6 +55,8 @@ async function stopDaemon(d) {
   d.proc.kill('SIGTERM');
   await exited;
 }
+let daemonLog = '';
+let pageWarnings = [];  // everything the daemons printed, shown when a check fails
 let daemon = startDaemon(0);
 const port = await daemon.port;
 const base = `http://127.0.0.1:${port}`;
@@ -62,15 +66,35 @@ const browser = await chromium.launch({
   args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking', '--disable-component-update',
          '--no-first-run', '--disable-sync', '--disable-quic'],
 });
+// On a timeout, say what the page and the daemon saw, so a failure in CI explains itself.
+async function explain(page, what) {
+  console.log(`timed out waiting for ${what}`);
+  try {
+    const seen = await page.evaluate(() => ({ state: window.hystlab.state(), selected: window.hystlab.selected(),
+      online: window.hystlab.online(), loop: window.hystlab.loopPoints(), identified: window.hystlab.heatmapIdentified() }));
+    console.log('  the page: ' + JSON.stringify(seen));
+    if (seen.selected != null) {
+      const get = async p => { const r = await fetch(base + p, { signal: AbortSignal.timeout(5000) }); return r.ok ? r.json() : `${r.status} ${await r.text()}`; };
+      const c = await get(`/api/campaigns/${seen.selected}`);
+      console.log('  the daemon: ' + JSON.stringify({ state: c.state, progress: c.progress, runs: c.runs && c.runs.length }));
+      const ev = await get(`/api/campaigns/${seen.selected}/events`);
+      const list = Array.isArray(ev) ? ev : (ev.events || []);
+      for (const e of list.slice(-8)) console.log('  event: ' + JSON.stringify(e));
+      console.log('  rigs: ' + JSON.stringify(await get('/api/rigs')));
+    }
+  } catch (e) { console.log('  (could not ask: ' + e + ')'); }
+}
 const wait = (page, fn, arg, what, timeout = 60000) =>
-  page.waitForFunction(fn, arg, { timeout, polling: 100 }).then(() => true, () => { console.log(`timed out waiting for ${what}`); return false; });
+  page.waitForFunction(fn, arg, { timeout, polling: 100 }).then(() => true, async () => { await explain(page, what); return false; });
 
 try {
   const context = await browser.newContext({ acceptDownloads: true, viewport: { width: 1400, height: 1100 } });
   const page = await context.newPage();
   const errors = [];
   page.on('pageerror', e => errors.push(String(e)));
-  page.on('console', m => { if (m.type() === 'error') errors.push(m.text()); });
+  const warnings = [];  // the page's own account of a failed update (shown if a check fails)
+  page.on('console', m => { if (m.type() === 'error') errors.push(m.text()); else if (m.type() === 'warning') warnings.push(m.text()); });
+  pageWarnings = warnings;
   await page.goto(base + '/');
   check(await wait(page, () => window.hystlab && window.hystlab.online(), null, 'the event stream'), 'the page loads and its event stream goes live');
   check(await page.evaluate(() => typeof uPlot === 'function'), 'the plotting library is served by the daemon');
@@ -142,5 +166,7 @@ try {
   await browser.close();
   await stopDaemon(daemon);
 }
+if (failures && pageWarnings.length) console.log('the page warned:\n' + pageWarnings.slice(-20).join('\n'));
+if (failures) console.log('the daemon printed (last 6000 characters):\n' + daemonLog.slice(-6000));
 console.log(failures ? `${failures} check(s) failed (screenshots in ${outDir})` : `all checks passed (screenshots in ${outDir})`);
 process.exit(failures ? 1 : 0);

@@ -1,7 +1,9 @@
 // Campaigns end to end: the runner drives hystlab-sim over real sockets, stores into a real
 // SQLite file through the writer thread, and fits the table online.
 #include <doctest/doctest.h>
+#include <sched.h>
 #include <sys/socket.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <deque>
@@ -11,6 +13,8 @@
 
 #include "../drivers/sim_process.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
+#include "hystlab/daemon/daemon.hpp"
+#include "hystlab/daemon/realtime.hpp"
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/safety.hpp"
 #include <random>
@@ -340,4 +344,48 @@ TEST_CASE("sine campaign on the simulated shaker: transmissibility per frequency
   const auto r2 = daemon::run_sine_campaign(id2, plan, ctx2);
   CHECK(r2.state == "failed");
   CHECK(r2.reason.find("not one") != std::string::npos);
+}
+
+TEST_CASE("daemon config: acquisition settings and the simulator's priority, with errors that name the field") {
+  using daemon::AcquisitionSettings;
+  const auto c = daemon::parse_daemon_config(nlohmann::json::parse(
+      R"({"acquisition": {"priority": 0, "cpu": "any"}, "rigs": [{"simulate": {"time_scale": 1, "realtime_priority": 5}}]})"));
+  CHECK(c.acquisition.priority == 0);
+  CHECK(c.acquisition.cpu == AcquisitionSettings::kAnyCpu);
+  CHECK(c.rigs.at(0).sim.realtime_priority == 5);
+  const auto d = daemon::parse_daemon_config(nlohmann::json(nullptr));
+  CHECK(d.acquisition.priority == 20);
+  CHECK(d.acquisition.cpu == AcquisitionSettings::kLastCpu);
+  CHECK(d.rigs.at(0).sim.realtime_priority == -1);  // decided by the daemon from the acquisition's
+  auto refused = [](const char* text, const char* what) {
+    CAPTURE(text);
+    try {
+      (void)daemon::parse_daemon_config(nlohmann::json::parse(text));
+      FAIL("accepted");
+    } catch (const daemon::ConfigError& e) {
+      CHECK(std::string(e.what()).find(what) != std::string::npos);
+    }
+  };
+  refused(R"({"acquisition": {"priority": 99}})", "acquisition.priority must be");
+  refused(R"({"acquisition": {"cpu": "first"}})", "acquisition.cpu must be");
+  refused(R"({"acquisition": {"cpus": 1}})", "acquisition.cpus is not a known field");
+  refused(R"({"acquisition": 3})", "acquisition must be an object");
+  refused(R"({"rigs": [{"simulate": {"realtime_priority": -1}}]})", "rigs[0].simulate.realtime_priority must be");
+}
+
+TEST_CASE("acquisition thread: pinned to the CPU it names, its priority as far as allowed") {
+  const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+  CHECK(daemon::resolve_cpu(daemon::AcquisitionSettings::kAnyCpu) == -1);
+  CHECK(daemon::resolve_cpu(static_cast<int>(cpus)) == -1);  // not there
+  CHECK(daemon::resolve_cpu(daemon::AcquisitionSettings::kLastCpu) == (cpus > 1 ? cpus - 1 : -1));
+  std::string got;
+  int cpu_seen = -2;
+  std::thread t([&] {
+    got = daemon::enter_acquisition_thread({0, daemon::AcquisitionSettings::kLastCpu});
+    cpu_seen = sched_getcpu();
+  });
+  t.join();
+  CAPTURE(got);
+  CHECK(got.find("normal priority") == 0);
+  if (cpus > 1) CHECK(cpu_seen == cpus - 1);
 }

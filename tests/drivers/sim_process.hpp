@@ -77,6 +77,8 @@ class SimProcess {
   int modbus_port = 0, control_port = 0;
   std::string rtu_path;
 
+ [[nodiscard]] pid_t pid() const noexcept { return pid_; }
+
  private:
   std::string read_line(int timeout_ms) {
     std::string line;

@@ -1,5 +1,9 @@
 #include "api_support.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <memory>
 
@@ -70,6 +74,10 @@ json body_object(const httplib::Request& req) {
   }
   if (!j.is_object()) throw ApiError(400, "malformed JSON", "the request body must be a JSON object");
   return j;
+}
+
+void set_thread_nice(int nice) noexcept {
+  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), nice);
 }
 
 db::Store& reader(const std::string& db_path) {

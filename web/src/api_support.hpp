@@ -42,6 +42,12 @@ json body_object(const httplib::Request& req);
 // This thread's read connection (WAL: never blocks the writer).
 db::Store& reader(const std::string& db_path);
 
+// HTTP threads yield to acquisition and to the rig's simulator: requests run at nice 5, and a
+// thread streaming events at nice 19 and off the acquisition's CPU (its work is small and its
+// latency budget large; its system calls on that CPU would delay the acquisition's wake-ups).
+constexpr int kRequestNice = 5, kStreamNice = 19;
+void set_thread_nice(int nice) noexcept;  // this thread only; best effort (raising back needs privilege)
+
 // Shared by the route files.
 struct ApiContext {
   ApiContext(daemon::Daemon& d, const daemon::HttpConfig& c, std::string db) : daemon(d), config(c), db_path(std::move(db)) {}

@@ -139,6 +139,8 @@ void add_stream_route(httplib::Server& s, ApiContext& c) {
           }
           if (!st->hello_sent) {
             st->hello_sent = true;
+            set_thread_nice(kStreamNice);
+            (void)daemon::avoid_cpu(daemon::resolve_cpu(c.daemon.config().acquisition.cpu));
             return write(sink, "retry: 2000\n\n" + frame("hello", {{"cursor", st->cursor.id()}, {"rate_hz", st->rate_hz}}));
           }
           std::this_thread::sleep_for(kTick);
@@ -157,7 +159,11 @@ void add_stream_route(httplib::Server& s, ApiContext& c) {
           if (!out.empty()) st->quiet = 0;
           return write(sink, out) && sink.is_writable();
         },
-        [&c](bool) { c.stream_clients.fetch_sub(1); });
+        [&c](bool) {
+          set_thread_nice(kRequestNice);  // a request thread again (stays at 19 without CAP_SYS_NICE)
+          (void)daemon::avoid_cpu(-1);
+          c.stream_clients.fetch_sub(1);
+        });
   }));
 }
 

@@ -1,9 +1,6 @@
 #include "hystlab/web/http_api.hpp"
 
 #include <spdlog/spdlog.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <thread>
@@ -27,7 +24,7 @@ bool same_secret(const std::string& a, const std::string& b) {
 // rig through a browser on this machine), and the token when one is configured.
 httplib::Server::HandlerResponse guard_request(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   // HTTP threads yield to acquisition: each lowers its own priority once (no privilege needed).
-  static thread_local const bool lowered = setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 5) == 0;
+  static thread_local const bool lowered = (set_thread_nice(kRequestNice), true);
   (void)lowered;
   c.requests.fetch_add(1, std::memory_order_relaxed);
   if (!changes_state(req.method)) return httplib::Server::HandlerResponse::Unhandled;

@@ -24,11 +24,12 @@ window.hystlab = {
 };
 
 // ---- API ----
+const API_TIMEOUT_MS = 20000;  // a request that never ends must not stall every later update
 async function api(path, options = {}) {
   const headers = Object.assign({}, options.body ? { 'Content-Type': 'application/json' } : {}, options.headers || {});
   const token = sessionStorage.getItem('hystlab-token');
   if (token && options.method && options.method !== 'GET') headers.Authorization = 'Bearer ' + token;
-  const res = await fetch(path, Object.assign({}, options, { headers }));
+  const res = await fetch(path, Object.assign({ signal: AbortSignal.timeout(API_TIMEOUT_MS) }, options, { headers }));
   const body = res.headers.get('Content-Type')?.includes('json') ? await res.json() : await res.text();
   if (res.status === 401 && !options.retried) {
     const t = window.prompt('This daemon needs its token for changes:');
@@ -62,23 +63,28 @@ async function select(id) {
   for (const li of $('campaigns').children) li.className = Number(li.dataset.id) === id ? 'selected' : '';
   S.loopX = []; S.loopY = []; S.modelTable = null; S.trans = [];
   loop.set(0, [], []); loop.set(1, [], []); timeplot.clear();
-  await refreshDetail();
+  heat.setGrid(null);
+  await refreshDetail();  // for a FOT campaign, with its nodes
   const d = S.detail;
-  if (d.kind === 'fot') {
-    const nodes = await api(`/api/campaigns/${id}/nodes`);
-    heat.setGrid(nodes.grid);
-    for (const n of nodes.nodes) heat.add(n.alpha, n.beta, n.F);
-    heat.redraw();
-  }
   if (d.kind === 'sine') { S.trans = await api(`/api/campaigns/${id}/transmissibility`); drawTrans(); }
   if (S.runId) await loadRun(S.runId);
   await overlayModel();
   redraw();
 }
 
+async function loadNodes(id) {
+  const nodes = await api(`/api/campaigns/${id}/nodes`);
+  if (id !== S.selected) return;
+  heat.setGrid(nodes.grid);
+  for (const n of nodes.nodes) heat.add(n.alpha, n.beta, n.F);
+  heat.redraw();
+}
+
 async function refreshDetail() {
   if (S.selected == null) return;
   const d = S.detail = await api(`/api/campaigns/${S.selected}`);
+  // The stored count is the truth: a node missed on the stream (or a failed load) is fetched again.
+  if (d.kind === 'fot' && d.progress && (heat.grid ? d.progress.nodes !== heat.identified() : true)) await loadNodes(d.id);
   S.runId = d.runs.length ? d.runs[d.runs.length - 1].id : null;
   $('title').textContent = `Campaign #${d.id}: ${d.kind} on ${d.rig}`;
   $('state').textContent = d.state;
@@ -315,3 +321,9 @@ form.addEventListener('submit', e => {
 });
 
 connect();
+// Now and then, the selected campaign from the API, while it is live: a record the stream
+// missed (or a request that failed) never leaves the page stale for long.
+setInterval(() => {
+  const d = S.detail;
+  if (S.online && d && ['queued', 'arming', 'running', 'paused'].includes(d.state)) serial(refreshDetail)();
+}, 5000);

@@ -113,10 +113,10 @@ export class TriangleHeatmap {
     const h = (this.grid.hi_mm - this.grid.lo_mm) / this.grid.n;
     return [this.grid.lo_mm - h / 2, this.grid.hi_mm + h / 2];
   }
+  // The grid of a campaign, with the nodes measured so far (they replace what was shown).
   setGrid(grid) {
-    const same = this.grid && grid && this.grid.n === grid.n && this.grid.lo_mm === grid.lo_mm && this.grid.hi_mm === grid.hi_mm;
     this.grid = grid;
-    if (!same) this.values.clear();
+    this.values.clear();
     this.u.setData([[grid ? grid.lo_mm : 0, grid ? grid.hi_mm : 1], [null, null]]);
   }
   node(i) { return this.grid.lo_mm + (this.grid.hi_mm - this.grid.lo_mm) * i / this.grid.n; }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "hystlab/daemon/live_feed.hpp"
+#include "hystlab/daemon/realtime.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/drivers/io_health.hpp"
 
@@ -29,6 +30,9 @@ struct ConfigError : std::invalid_argument {
 struct SimulatorOptions {
   double time_scale = 10.0, noise_N = 0.05, corner_width_mm = 0.05;
   std::string rig = "load_frame";  // or "shaker"
+  int cpu = -1;                     // pinned there when >= 0 (the daemon sets its acquisition CPU)
+  int realtime_priority = -1;       // > 0: SCHED_FIFO, as a controller with a CPU of its own; 0: normal;
+                                    // -1: one below the acquisition's when that is pinned, else 0
 };
 
 struct RigEntry {
@@ -57,6 +61,7 @@ struct DaemonConfig {
   std::vector<RigEntry> rigs;
   std::string base_dir = ".";
   HttpConfig http;
+  AcquisitionSettings acquisition;  // every rig's acquisition thread (and supervised simulator)
 };
 
 // Throws ConfigError naming the field. A null json gives the embedded defaults.
