@@ -95,10 +95,12 @@ Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config
     w->entry = e;
     w->acquisition = config.acquisition;
     // A simulator shares the acquisition's CPU, just below it: its answers are then never queued
-    // behind the daemon's other threads (they keep the other CPUs).
+    // behind other threads. Not above real time: there its physics catch-up is real work, and at
+    // SCHED_FIFO it starved the daemon (a campaign stalled at time scale 100 in an ASan build).
     w->entry.sim.cpu = resolve_cpu(config.acquisition.cpu);
     if (w->entry.sim.realtime_priority < 0)
-      w->entry.sim.realtime_priority = w->entry.sim.cpu >= 0 && config.acquisition.priority > 1 ? config.acquisition.priority - 1 : 0;
+      w->entry.sim.realtime_priority =
+          w->entry.sim.cpu >= 0 && config.acquisition.priority > 1 && e.sim.time_scale <= 1 ? config.acquisition.priority - 1 : 0;
     try {
       w->build_rig(config.base_dir);
     } catch (const drivers::RigConfigError& err) {

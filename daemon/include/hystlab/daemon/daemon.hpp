@@ -32,7 +32,8 @@ struct SimulatorOptions {
   std::string rig = "load_frame";  // or "shaker"
   int cpu = -1;                     // pinned there when >= 0 (the daemon sets its acquisition CPU)
   int realtime_priority = -1;       // > 0: SCHED_FIFO, as a controller with a CPU of its own; 0: normal;
-                                    // -1: one below the acquisition's when that is pinned, else 0
+                                    // -1: one below the acquisition's when that is pinned and
+                                    // time_scale <= 1, else 0
 };
 
 struct RigEntry {
