@@ -110,7 +110,12 @@ Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config
     spdlog::info("rig '{}': {}", e.name, w->info.description);
     d.workers.push_back(std::move(w));
   }
+  // The writer's thread starts off the acquisition's CPU and stays there: this kernel does not
+  // preempt system calls (PREEMPT_NONE), so its writes and fsyncs on that CPU would hold back the
+  // acquisition's wake-ups by milliseconds.
+  const bool moved = avoid_cpu(resolve_cpu(config.acquisition.cpu));
   d.writer = std::make_unique<db::SampleWriter>(config.db_path);
+  if (moved) (void)avoid_cpu(-1);
 }
 
 Daemon::~Daemon() {

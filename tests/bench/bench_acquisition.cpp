@@ -2,7 +2,8 @@
 // push) while the writer thread ingests; next to a bare 1 kHz sleep loop in the same run, which
 // is what the machine's scheduler alone allows. Both run as hystlabd runs a rig's acquisition
 // thread (daemon/realtime.hpp: SCHED_FIFO 20 when allowed, pinned to the last CPU), with the
-// simulator where hystlabd puts it (that CPU, SCHED_FIFO 19) and the writer at normal priority.
+// simulator where hystlabd puts it (that CPU, SCHED_FIFO 19) and the writer at normal priority
+// on the other CPUs.
 #include <time.h>
 
 #include <algorithm>
@@ -63,7 +64,10 @@ int main(int argc, char** argv) {
   const std::filesystem::path dir = mkdtemp(tmpl);
   const std::string path = (dir / "hystlab.db").string();
   db::Store store(path);
-  db::SampleWriter writer(path);  // its thread is started before this one turns real-time: it stays normal
+  // As in hystlabd: the writer's thread starts at normal priority, off the acquisition's CPU.
+  const bool moved = daemon::avoid_cpu(daemon::resolve_cpu(settings.cpu));
+  db::SampleWriter writer(path);
+  if (moved) (void)daemon::avoid_cpu(-1);
   std::printf("this thread: %s\n", daemon::enter_acquisition_thread(settings).c_str());
   long base_missed = 0;
   report("baseline: bare 1 kHz sleep loop", sleep_loop(seconds / 3, base_missed), base_missed);

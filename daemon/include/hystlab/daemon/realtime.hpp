@@ -25,8 +25,10 @@ struct AcquisitionSettings {
 std::string enter_acquisition_thread(const AcquisitionSettings& s) noexcept;
 
 // Keeps the calling thread off the CPU (when there is another), or lets it run anywhere again
-// (cpu < 0). For threads whose system calls would delay the acquisition's wake-ups there: event
-// streams. (Keeping every other thread off it cost a third of the HTTP throughput on 2 CPUs.)
+// (cpu < 0). For threads whose system calls would delay the acquisition's wake-ups there (the
+// kernel here does not preempt system calls): the writer, event streams. A thread started
+// meanwhile inherits it. (Keeping every HTTP thread off it cost a third of the HTTP throughput
+// on 2 CPUs.)
 bool avoid_cpu(int cpu) noexcept;
 
 // Pins a process (a supervised simulator) to the CPU; false if refused or cpu < 0.
