@@ -112,7 +112,7 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
       e.sim.corner_width_mm = s.contains("corner_width_mm") && s["corner_width_mm"] == 0 ? 0.0 : positive(s, "corner_width_mm", 0.05, where + ".simulate");
       if (s.contains("realtime_priority")) {
         const json& p = s["realtime_priority"];
-        if (!p.is_number_integer() || p.get<int>() < 0 || p.get<int>() > 98)
+        if (!p.is_number_integer() || p.get<long long>() < 0 || p.get<long long>() > 98)
           fail(where + ".simulate.realtime_priority", "must be an integer from 0 (normal scheduling) to 98");
         e.sim.realtime_priority = p.get<int>();
       }

@@ -7,6 +7,14 @@
 #include <cstring>
 
 namespace hystlab::daemon {
+namespace {
+cpu_set_t only(int cpu) noexcept {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(static_cast<unsigned>(cpu), &set);
+  return set;
+}
+}  // namespace
 
 int resolve_cpu(int cpu) noexcept {
   const long online = sysconf(_SC_NPROCESSORS_ONLN);
@@ -27,9 +35,7 @@ std::string enter_acquisition_thread(const AcquisitionSettings& s) noexcept {
     got = "normal priority";
   }
   if (const int cpu = resolve_cpu(s.cpu); cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(static_cast<unsigned>(cpu), &set);
+    const cpu_set_t set = only(cpu);
     const int err = pthread_setaffinity_np(pthread_self(), sizeof set, &set);
     got += err ? std::string(", on any CPU (pinning refused: ") + std::strerror(err) + ")" : ", on CPU " + std::to_string(cpu);
   } else {
@@ -50,9 +56,7 @@ bool avoid_cpu(int cpu) noexcept {
 
 bool pin_process(pid_t pid, int cpu) noexcept {
   if (cpu < 0) return false;
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(static_cast<unsigned>(cpu), &set);
+  const cpu_set_t set = only(cpu);
   return sched_setaffinity(pid, sizeof set, &set) == 0;
 }
 

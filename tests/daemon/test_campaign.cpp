@@ -371,6 +371,7 @@ TEST_CASE("daemon config: acquisition settings and the simulator's priority, wit
   refused(R"({"acquisition": {"cpus": 1}})", "acquisition.cpus is not a known field");
   refused(R"({"acquisition": 3})", "acquisition must be an object");
   refused(R"({"rigs": [{"simulate": {"realtime_priority": -1}}]})", "rigs[0].simulate.realtime_priority must be");
+  refused(R"({"rigs": [{"simulate": {"realtime_priority": 4294967306}}]})", "rigs[0].simulate.realtime_priority must be");
 }
 
 TEST_CASE("acquisition thread: pinned to the CPU it names, its priority as far as allowed") {
