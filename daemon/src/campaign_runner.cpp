@@ -135,6 +135,14 @@ bool on_sample(Loop& L, const drivers::RigSample& s, double wall0) {
   return true;
 }
 
+// Block reads: a sample the controller's buffer lost before it was read is a missed deadline.
+void count_lost(Loop& L, std::uint64_t lost_before) {
+  const std::uint64_t lost = L.ctx.rig.health().lost_samples - lost_before;
+  if (lost == L.result.missed_deadlines) return;
+  if (L.ctx.live) L.ctx.live->missed_deadlines.fetch_add(lost - L.result.missed_deadlines, std::memory_order_relaxed);
+  L.result.missed_deadlines = lost;
+}
+
 // A failed read: the watchdog decides between waiting, holding and failing.
 bool on_missed(Loop& L, std::error_code ec) {
   const auto v = L.watchdog.missed();
@@ -200,8 +208,12 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
   }
   L.state("running", "armed");
   const double period = 1.0 / plan.sample_rate_hz;
+  const bool blocks = ctx.rig.block_reads();
+  const std::uint64_t lost_before = ctx.rig.health().lost_samples;
   double next = mono_now();
-  drivers::RigSample s;
+  std::vector<drivers::RigSample> block;
+  block.reserve(4096);  // the rig fills it without allocating
+  double last_kept = -1e300;
   bool going = true;
   double prev_tick = 0;
   while (going) {
@@ -209,8 +221,12 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
     sleep_until(next);
     const double now = mono_now();
     if (now - next > period) {  // counted, never hidden
-      ++L.result.missed_deadlines;
-      if (ctx.live) ctx.live->missed_deadlines.fetch_add(1, std::memory_order_relaxed);
+      ++L.result.late_wakeups;
+      if (ctx.live) ctx.live->late_wakeups.fetch_add(1, std::memory_order_relaxed);
+      if (!blocks) {  // polling the latest value, a late period is a sample not taken in time
+        ++L.result.missed_deadlines;
+        if (ctx.live) ctx.live->missed_deadlines.fetch_add(1, std::memory_order_relaxed);
+      }
     }
     if (ctx.loop_periods_us && prev_tick > 0) ctx.loop_periods_us->push_back(static_cast<float>((now - prev_tick) * 1e6));
     prev_tick = now;
@@ -223,26 +239,36 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
     const double t = (now - wall0) * ctx.time_scale;
     going = handle_control(L, t, wall0);
     if (!going) break;
-    if (const auto ec = ctx.rig.read_sample(t, s)) {
+    if (const auto ec = ctx.rig.read_samples(t, block)) {
       going = on_missed(L, ec);
       continue;
     }
-    const bool fresh = !L.have_counter || s.sample_counter != L.last_counter;
-    L.have_counter = true;
-    L.last_counter = s.sample_counter;
+    if (blocks) count_lost(L, lost_before);
+    bool fresh = false;
+    for (const drivers::RigSample& s : block) {
+      if (L.have_counter && s.sample_counter == L.last_counter) continue;
+      L.have_counter = true;
+      L.last_counter = s.sample_counter;
+      fresh = true;
+      // A controller faster than the plan: keep the plan's rate (its clock, not ours).
+      if (blocks && s.time_s - last_kept < period * ctx.time_scale * (1 - 1e-6)) continue;
+      last_kept = s.time_s;
+      if (L.watchdog_holding) {  // the link is back: recover
+        L.watchdog_holding = false;
+        (void)ctx.rig.hold(false);
+        L.seq.restart_at(L.seq.index());
+      }
+      going = on_sample(L, s, wall0) && !L.seq.done();
+      if (!going) break;
+    }
     if (!fresh) {
       going = on_missed(L, drivers::RigError::stale_data);
       continue;
     }
     L.watchdog.fresh();
-    if (L.watchdog_holding) {  // the link is back: recover
-      L.watchdog_holding = false;
-      (void)ctx.rig.hold(false);
-      L.seq.restart_at(L.seq.index());
-    }
-    going = on_sample(L, s, wall0) && !L.seq.done();
     if (going == false && L.result.state.empty()) L.result.state = "completed";
   }
+  if (blocks) count_lost(L, lost_before);
   L.result.dropped = ctx.writer.stats().dropped_full - dropped_before;
   finish_run(L.result, campaign_id, plan, L.builder.get(), L.fot.get(), L.series, ctx);
   L.state(L.result.state, L.result.reason.empty() ? "finished" : L.result.reason);

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -148,6 +149,9 @@ int run(const Args& a) {
     const std::string text = a.map.empty() ? (a.rig == "shaker" ? protocols::kDefaultShakerMap : protocols::kDefaultLoadFrameMap) : read_file(a.map);
     protocols::RegisterMap map = protocols::RegisterMap::from_json(text);
     if (map.kind() != rig.kind()) throw std::runtime_error("the map is for another kind of rig than --rig " + a.rig);
+    if (const auto& w = map.sample_window(); w && std::fabs(w->period_s * a.sample_rate - 1.0) > 1e-9)
+      throw std::runtime_error("the map's sample_window.period_s (" + std::to_string(w->period_s) + " s) is not the period of --sample-rate " +
+                               std::to_string(a.sample_rate) + " Hz");
     modbus.emplace(a.transport == "tcp" ? sim::ModbusEndpoint::Transport::tcp : sim::ModbusEndpoint::Transport::rtu,
                    a.address, a.port, std::move(map));
     std::cout << modbus->where() << "\n";
@@ -178,6 +182,7 @@ int run(const Args& a) {
     for (int guard = 0; sim_due >= sample_dt && guard < 100000; ++guard) {
       rig.step(sample_dt);
       sim_due -= sample_dt;
+      if (modbus && !faults.freeze) modbus->record(rig.measurements(faults));  // the controller's own clock
     }
     const sim::SignalValues m = rig.measurements(faults);
     if (modbus && !faults.freeze) modbus->publish(m);

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "hystlab/protocols/modbus_crc.hpp"
+#include "hystlab/protocols/sample_record.hpp"
 
 namespace hystlab::sim {
 using protocols::ModbusTable;
@@ -25,6 +26,7 @@ int table_size(const protocols::RegisterMap& m, ModbusTable t) {
   int n = 0;
   for (const auto& e : m.entries())
     if (e.table == t) n = std::max(n, e.address + e.width());
+  if (const auto& w = m.sample_window(); w && w->table == t) n = std::max(n, w->address + w->records * w->record_width);
   return n;
 }
 }  // namespace
@@ -56,6 +58,7 @@ ModbusEndpoint::ModbusEndpoint(Transport t, const std::string& address, int port
     modbus_set_socket(ctx_, pty_master_);  // a master has no path: drive its fd directly
   }
   modbus_set_slave(ctx_, map_.slave_id());
+  if (const auto& w = map_.sample_window()) window_ring_.assign(static_cast<std::size_t>(w->records * w->record_width), 0);
 }
 
 ModbusEndpoint::~ModbusEndpoint() {
@@ -167,6 +170,15 @@ SignalValues ModbusEndpoint::written_commands() const {
 }
 
 void ModbusEndpoint::publish(const SignalValues& m) {
+  if (const auto& w = map_.sample_window(); w && window_dirty_) {  // newest record first
+    std::uint16_t* tab = w->table == ModbusTable::input_register ? mapping_->tab_input_registers : mapping_->tab_registers;
+    const auto width = static_cast<std::size_t>(w->record_width), n = static_cast<std::size_t>(w->records);
+    for (std::size_t k = 0; k < window_filled_; ++k) {
+      const std::uint16_t* src = window_ring_.data() + ((window_head_ + n - k) % n) * width;
+      std::copy(src, src + width, tab + w->address + k * width);
+    }
+    window_dirty_ = false;
+  }
   for (const auto& e : map_.entries()) {
     const double value = m[static_cast<std::size_t>(e.signal)];
     if (protocols::is_command(e.signal) || std::isnan(value)) continue;
@@ -183,6 +195,19 @@ void ModbusEndpoint::publish(const SignalValues& m) {
         break;
     }
   }
+}
+
+void ModbusEndpoint::record(const SignalValues& m) {
+  const auto& w = map_.sample_window();
+  if (!w) return;
+  const auto width = static_cast<std::size_t>(w->record_width);
+  window_head_ = (window_head_ + 1) % static_cast<std::size_t>(w->records);
+  const std::span<std::uint16_t> slot(window_ring_.data() + window_head_ * width, width);
+  // A value the encoding cannot carry (an overload beyond the type) keeps the slot's old words,
+  // as publish() keeps a register's last value; the counter still moves on in a fresh slot.
+  (void)protocols::encode_record(map_, *w, m, slot);
+  window_filled_ = std::min(window_filled_ + 1, static_cast<std::size_t>(w->records));
+  window_dirty_ = true;
 }
 
 }  // namespace hystlab::sim

@@ -27,6 +27,9 @@ class ModbusEndpoint {
   // Handles whatever is ready on fd; returns the commands written (NaN where none).
   void handle(int fd, const Faults& faults, SimRig& rig);
   void publish(const SignalValues& measurements);
+  // One sample of the controller's clock into the map's sample window (if it has one); the
+  // window's registers change at the next publish().
+  void record(const SignalValues& measurements);
   void drop_clients();
 
  private:
@@ -42,6 +45,9 @@ class ModbusEndpoint {
   std::string address_, pty_path_;
   int port_ = 0;
   std::vector<int> clients_;
+  std::vector<std::uint16_t> window_ring_;  // encoded records, oldest overwritten first
+  std::size_t window_head_ = 0, window_filled_ = 0;
+  bool window_dirty_ = false;
 };
 
 }  // namespace hystlab::sim

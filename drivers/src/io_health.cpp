@@ -52,6 +52,7 @@ IoHealthSnapshot IoHealth::snapshot() const noexcept {
   s.reads = reads_.load(std::memory_order_relaxed);
   s.writes = writes_.load(std::memory_order_relaxed);
   s.reconnects = reconnects_.load(std::memory_order_relaxed);
+  s.lost_samples = lost_.load(std::memory_order_relaxed);
   for (std::size_t k = 0; k < kRigErrorCount; ++k) s.errors[k] = errors_[k].load(std::memory_order_relaxed);
   s.last_transaction_us = last_us_.load(std::memory_order_relaxed);
   s.max_transaction_us = max_us_.load(std::memory_order_relaxed);

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 
 namespace hystlab::drivers {
 namespace {
@@ -38,6 +39,16 @@ double micros_since(std::chrono::steady_clock::time_point t0) {
 ModbusRig::ModbusRig(ModbusRigConfig config) : cfg_(std::move(config)) {
   for (const auto& b : cfg_.map.measurement_blocks()) block_words_.emplace_back(b.count, 0);
   if (cfg_.slave == 0) cfg_.slave = cfg_.map.slave_id();
+  if (cfg_.block_reads) {
+    const auto& w = cfg_.map.sample_window();
+    if (!w) throw std::invalid_argument(cfg_.name + ": block reads need a register map with a sample_window");
+    if (cfg_.map.kind() != protocols::RigKind::load_frame) throw std::invalid_argument(cfg_.name + ": block reads are for load frames");
+    for (const Signal s : {Signal::displacement_mm, Signal::force_N, Signal::status_word})
+      if (std::find(w->fields.begin(), w->fields.end(), s) == w->fields.end())
+        throw std::invalid_argument(cfg_.name + ": block reads need " + std::string(protocols::signal_name(s)) + " in the map's sample_window.fields");
+    window_words_.assign(static_cast<std::size_t>(w->records * w->record_width), 0);
+    window_records_.assign(static_cast<std::size_t>(w->records), protocols::SignalArray{});
+  }
 }
 
 ModbusRig::~ModbusRig() { disconnect(); }
@@ -181,6 +192,100 @@ std::error_code ModbusRig::read_sample(double now_s, RigSample& out) noexcept {
   out = RigSample{now_s, c, d, f, static_cast<std::uint16_t>(st), static_cast<std::uint16_t>(fc),
                   static_cast<std::uint32_t>(hb), static_cast<std::uint32_t>(n)};
   return check_stale(now_s, out.sample_counter);
+}
+
+// --- Block reads of the controller's sample window (newest record first) ---
+
+std::error_code ModbusRig::read_window_page(int first, int count) noexcept {
+  const protocols::SampleWindow& w = *cfg_.map.sample_window();
+  const int words = count * w.record_width;
+  const auto address = static_cast<int>(w.address) + first * w.record_width;
+  std::uint16_t* dst = window_words_.data() + first * w.record_width;
+  const auto t0 = std::chrono::steady_clock::now();
+  const int rc = w.table == ModbusTable::input_register ? modbus_read_input_registers(ctx_, address, words, dst)
+                                                        : modbus_read_registers(ctx_, address, words, dst);
+  if (rc == -1) return fail(errno, "read");
+  if (rc != words) return fail(EMBBADDATA, "read");
+  health_.record_transaction(false, micros_since(t0));
+  return {};
+}
+
+// Reads pages of the window until it reaches a record already taken (usually the first page
+// does); decodes the fresh ones into window_records_, newest first.
+std::error_code ModbusRig::take_window(double now_s, int& fresh, bool& reached) noexcept {
+  const protocols::SampleWindow& w = *cfg_.map.sample_window();
+  const auto counter_at = static_cast<std::size_t>(Signal::sample_counter);
+  fresh = 0;
+  reached = false;
+  for (int first = 0; first < w.records && !reached; first += w.records_per_read()) {
+    const int count = std::min(w.records_per_read(), w.records - first);
+    if (auto ec = read_window_page(first, count)) return ec;
+    for (int k = first; k < first + count; ++k) {
+      protocols::SignalArray& r = window_records_[static_cast<std::size_t>(k)];
+      const auto words = std::span<const std::uint16_t>(window_words_).subspan(static_cast<std::size_t>(k * w.record_width));
+      if (const auto ec = protocols::decode_record(cfg_.map, w, words, r)) {
+        const RigError kind = ec == protocols::ProtocolError::out_of_range || ec == protocols::ProtocolError::not_finite
+                                  ? RigError::out_of_range : RigError::protocol_error;
+        health_.record_error(kind);
+        return kind;
+      }
+      const auto c = static_cast<std::uint32_t>(r[counter_at]);
+      if (k == 0 && (!have_window_counter_ || static_cast<std::int32_t>(c - window_counter_) < 0)) {
+        // The first block, or the controller restarted its counter: its clock starts here.
+        if (have_window_counter_) spdlog::warn("{}: the controller's sample counter went back; its clock is re-anchored", describe());
+        have_window_counter_ = true;
+        window_counter_ = c - 1;
+        anchor_time_s_ = now_s;
+        anchor_counter64_ = window_counter64_ = static_cast<std::int64_t>(c) - 1;
+        fresh = 1;
+        reached = true;
+        break;
+      }
+      if (static_cast<std::int32_t>(c - window_counter_) <= 0) {
+        reached = true;
+        break;
+      }
+      ++fresh;
+    }
+  }
+  succeed();
+  return {};
+}
+
+// Fresh records to samples, oldest first, timed by the controller's counter.
+void ModbusRig::emit_window(int fresh, std::vector<RigSample>& out) noexcept {
+  const protocols::SampleWindow& w = *cfg_.map.sample_window();
+  const auto at = [](const protocols::SignalArray& r, Signal s) { return r[static_cast<std::size_t>(s)]; };
+  const int room = static_cast<int>(std::min<std::size_t>(out.capacity(), static_cast<std::size_t>(fresh)));
+  if (room < fresh) health_.record_lost(static_cast<std::uint64_t>(fresh - room));  // the caller's buffer is the limit
+  for (int k = room - 1; k >= 0; --k) {
+    const protocols::SignalArray& r = window_records_[static_cast<std::size_t>(k)];
+    const auto c = static_cast<std::uint32_t>(at(r, Signal::sample_counter));
+    window_counter64_ += static_cast<std::int32_t>(c - window_counter_);
+    window_counter_ = c;
+    const double command = cfg_.map.find(Signal::command_mm) && !std::isnan(at(r, Signal::command_mm)) ? at(r, Signal::command_mm) : 0.0;
+    out.push_back(RigSample{anchor_time_s_ + static_cast<double>(window_counter64_ - anchor_counter64_) * w.period_s, command,
+                            at(r, Signal::displacement_mm), at(r, Signal::force_N), static_cast<std::uint16_t>(at(r, Signal::status_word)),
+                            static_cast<std::uint16_t>(at(r, Signal::fault_code)), c, c});
+  }
+}
+
+std::error_code ModbusRig::read_samples(double now_s, std::vector<RigSample>& out) noexcept {
+  if (!cfg_.block_reads) return Rig::read_samples(now_s, out);
+  out.clear();
+  if (auto ec = ensure_connected(now_s)) return ec;
+  int fresh = 0;
+  bool reached = false;
+  const std::uint32_t before = window_counter_;
+  if (auto ec = take_window(now_s, fresh, reached)) return ec;
+  if (!reached && fresh > 0) {  // the whole window is newer than what was taken: the rest is gone
+    const auto newest = static_cast<std::uint32_t>(window_records_[0][static_cast<std::size_t>(Signal::sample_counter)]);
+    health_.record_lost(static_cast<std::uint64_t>(static_cast<std::uint32_t>(newest - before)) - static_cast<std::uint64_t>(fresh));
+    window_counter_ = newest - static_cast<std::uint32_t>(fresh);  // the gap is counted, the time axis keeps it
+    window_counter64_ += static_cast<std::int32_t>(window_counter_ - before);
+  }
+  emit_window(fresh, out);
+  return check_stale(now_s, window_counter_);
 }
 
 std::error_code ModbusRig::read_shaker(double now_s, ShakerSample& out) noexcept {

@@ -73,7 +73,7 @@ std::unique_ptr<Rig> make_rig(const json& config, const std::string& where, cons
   const Reader r(config, where);
   r.only({"name", "transport", "rig", "host", "port", "device", "baud", "parity", "data_bits", "stop_bits", "map", "slave",
           "response_timeout_ms", "byte_timeout_ms", "reconnect_min_ms", "reconnect_max_ms", "stale_after_ms",
-          "can_interface", "can_fd", "can_node", "status_timeout_ms"});
+          "can_interface", "can_fd", "can_node", "status_timeout_ms", "block_reads"});
   const std::string transport = r.text("transport", "");
   const std::string name = r.text("name", "rig");
   const std::string rig = r.text("rig", "load_frame");
@@ -100,7 +100,15 @@ std::unique_ptr<Rig> make_rig(const json& config, const std::string& where, cons
     c.reconnect_max_s = static_cast<double>(r.integer("reconnect_max_ms", 2000, 1, 600000)) / 1e3;
     c.stale_after_s = static_cast<double>(r.integer("stale_after_ms", 500, 1, 600000)) / 1e3;
     c.map = load_map(r, kind, base);
-    return std::make_unique<ModbusRig>(std::move(c));
+    if (r.has("block_reads")) {
+      if (!r.at("block_reads").is_boolean()) r.fail("block_reads", "must be true or false");
+      c.block_reads = r.at("block_reads").get<bool>();
+    }
+    try {
+      return std::make_unique<ModbusRig>(std::move(c));
+    } catch (const std::invalid_argument& e) {
+      r.fail("block_reads", std::string("cannot be used: ") + e.what());
+    }
   }
   if (transport == "can") {
     CanRigConfig c;

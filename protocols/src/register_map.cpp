@@ -40,6 +40,12 @@ double finite_number(const json& v, const std::string& where) {
   return v.get<double>();
 }
 
+std::uint16_t parse_address(const json& j, const std::string& where) {
+  if (!j.is_number_integer() || j.get<long long>() < 0 || j.get<long long>() > 65535)
+    fail(where + " must be an integer from 0 to 65535");
+  return static_cast<std::uint16_t>(j.get<long long>());
+}
+
 MapEntry parse_entry(Signal s, const json& j) {
   const std::string where = "signals." + std::string(signal_name(s));
   if (!j.is_object()) fail(where + " must be an object");
@@ -55,10 +61,8 @@ MapEntry parse_entry(Signal s, const json& j) {
                                {"discrete_input", ModbusTable::discrete_input},
                                {"holding_register", ModbusTable::holding_register},
                                {"input_register", ModbusTable::input_register}});
-  if (!j.contains("address") || !j["address"].is_number_integer() || j["address"].get<long long>() < 0 ||
-      j["address"].get<long long>() > 65535)
-    fail(where + ".address must be an integer from 0 to 65535");
-  e.address = static_cast<std::uint16_t>(j["address"].get<long long>());
+  if (!j.contains("address")) fail(where + ".address must be an integer from 0 to 65535");
+  e.address = parse_address(j["address"], where + ".address");
   const json type = j.value("type", json(is_bit_table(e.table) ? "bool" : "uint16"));
   e.type = pick<ValueType>(type, where + ".type",
                            {{"bool", ValueType::boolean}, {"int16", ValueType::int16}, {"uint16", ValueType::uint16},
@@ -80,6 +84,47 @@ MapEntry parse_entry(Signal s, const json& j) {
     fail(where + " is a command: it must be in a writable table (coil or holding_register)");
   if (static_cast<int>(e.address) + e.width() > 65536) fail(where + " runs past address 65535");
   return e;
+}
+
+// The optional "sample_window": where, how deep, at what period, and which signals a record holds.
+SampleWindow parse_window(const json& j, const RegisterMap& m) {
+  const std::string where = "sample_window";
+  if (!j.is_object()) fail(where + " must be an object");
+  for (const auto& [key, _] : j.items())
+    if (key != "table" && key != "address" && key != "records" && key != "period_s" && key != "fields")
+      fail(where + " has an unknown field '" + key + "'");
+  SampleWindow w;
+  w.table = pick<ModbusTable>(j.value("table", json("input_register")), where + ".table",
+                              {{"holding_register", ModbusTable::holding_register}, {"input_register", ModbusTable::input_register}});
+  if (!j.contains("address")) fail(where + ".address is missing");
+  w.address = parse_address(j["address"], where + ".address");
+  if (!j.contains("records") || !j["records"].is_number_integer() || j["records"].get<long long>() < 1 ||
+      j["records"].get<long long>() > 10000)
+    fail(where + ".records must be an integer from 1 to 10000");
+  w.records = j["records"].get<int>();
+  if (!j.contains("period_s")) fail(where + ".period_s is missing");
+  w.period_s = finite_number(j["period_s"], where + ".period_s");
+  if (!(w.period_s > 0)) fail(where + ".period_s must be > 0");
+  if (!j.contains("fields") || !j["fields"].is_array() || j["fields"].empty()) fail(where + ".fields must be a non-empty array of signal names");
+  for (const json& f : j["fields"]) {
+    const auto s = f.is_string() ? signal_from_name(f.get<std::string>()) : std::nullopt;
+    if (!s) fail(where + ".fields has " + f.dump() + ", which is not a signal");
+    const MapEntry* e = m.find(*s);
+    if (!e) fail(where + ".fields has '" + f.get<std::string>() + "', which 'signals' does not define (its encoding comes from there)");
+    if (is_command(*s) || e->type == ValueType::boolean) fail(where + ".fields has '" + f.get<std::string>() + "', which is not a register measurement");
+    if (std::find(w.fields.begin(), w.fields.end(), *s) != w.fields.end()) fail(where + ".fields has '" + f.get<std::string>() + "' twice");
+    w.fields.push_back(*s);
+    w.record_width += e->width();
+  }
+  if (std::find(w.fields.begin(), w.fields.end(), Signal::sample_counter) == w.fields.end())
+    fail(where + ".fields must hold sample_counter (a record's time is its counter x period_s)");
+  if (w.record_width > 125) fail(where + ": a record of " + std::to_string(w.record_width) + " registers does not fit in one Modbus read (125)");
+  const long end = static_cast<long>(w.address) + static_cast<long>(w.records) * w.record_width;
+  if (end > 65536) fail(where + " runs past address 65535");
+  for (const MapEntry& e : m.entries())
+    if (e.table == w.table && e.address + e.width() > w.address && e.address < end)
+      fail(where + " overlaps signals." + std::string(signal_name(e.signal)) + " at " + table_name(e.table) + " " + std::to_string(e.address));
+  return w;
 }
 
 }  // namespace
@@ -145,6 +190,7 @@ RegisterMap RegisterMap::parse_map(std::string_view text) {
     if (hi - lo + 1 > (is_bit_table(t) ? 2000 : 125)) fail(std::string("measurements in ") + table_name(t) + " span more than one Modbus read");
     m.blocks_.push_back(ReadBlock{t, static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi - lo + 1)});
   }
+  if (j.contains("sample_window")) m.window_ = parse_window(j["sample_window"], m);
   return m;
 }
 

@@ -24,7 +24,7 @@ std::map<std::string, std::int64_t> campaigns_by_state(db::Store& store) {
 json health_json(const drivers::IoHealthSnapshot& h) {
   json errors = json::object();
   for (std::size_t k = 1; k < drivers::kRigErrorCount; ++k) errors[kErrorNames[k]] = h.errors[k];
-  return {{"reads", h.reads}, {"writes", h.writes}, {"reconnects", h.reconnects}, {"errors", errors},
+  return {{"reads", h.reads}, {"writes", h.writes}, {"reconnects", h.reconnects}, {"lost_samples", h.lost_samples}, {"errors", errors},
           {"last_transaction_us", h.last_transaction_us}, {"max_transaction_us", h.max_transaction_us},
           {"latency_histogram_us", h.latency_histogram}};
 }
@@ -34,7 +34,7 @@ json rig_json(const daemon::Daemon& d, std::size_t k) {
   const daemon::RigLive& live = d.rig_live(k);
   json j{{"id", info.id}, {"index", k}, {"name", info.name}, {"kind", info.kind}, {"description", info.description},
          {"simulated", info.simulated}, {"campaign", live.campaign.load()}, {"samples", live.samples.load()},
-         {"missed_deadlines", live.missed_deadlines.load()}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
+         {"missed_deadlines", live.missed_deadlines.load()}, {"late_wakeups", live.late_wakeups.load()}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
   const std::uint64_t h = live.ring.head();
   daemon::LiveSample s;
   if (h > 0 && live.ring.get(h - 1, s)) {
@@ -81,8 +81,10 @@ std::string metrics_text(ApiContext& c) {
   line("hystlab_writer_commits_total", "", static_cast<double>(w.commits));
   metric(o, "hystlab_samples_acquired_total", "counter", "Samples acquired during campaigns.");
   for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_samples_acquired_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_live(k).samples.load()));
-  metric(o, "hystlab_missed_deadlines_total", "counter", "Acquisition periods that started more than a period late.");
+  metric(o, "hystlab_missed_deadlines_total", "counter", "Samples not taken in time: late periods when polling, lost samples with block reads.");
   for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_missed_deadlines_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_live(k).missed_deadlines.load()));
+  metric(o, "hystlab_late_wakeups_total", "counter", "Acquisition periods that started more than a period late.");
+  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_late_wakeups_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_live(k).late_wakeups.load()));
   std::vector<std::pair<std::string, drivers::IoHealthSnapshot>> rigs;  // one read per rig: families stay consistent
   for (std::size_t k = 0; k < d.rig_count(); ++k) rigs.emplace_back("rig=\"" + label(d.rig_info(k).name) + "\"", d.rig_health(k));
   auto family = [&](const char* name, const char* type, const char* help, auto value) {
@@ -92,6 +94,7 @@ std::string metrics_text(ApiContext& c) {
   family("hystlab_rig_reads_total", "counter", "Rig read transactions.", [](const auto& h) { return h.reads; });
   family("hystlab_rig_writes_total", "counter", "Rig write transactions.", [](const auto& h) { return h.writes; });
   family("hystlab_rig_reconnects_total", "counter", "Rig reconnections.", [](const auto& h) { return h.reconnects; });
+  family("hystlab_rig_lost_samples_total", "counter", "Samples a controller's buffer lost before a block read.", [](const auto& h) { return h.lost_samples; });
   family("hystlab_rig_transaction_max_seconds", "gauge", "Longest rig transaction.", [](const auto& h) { return h.max_transaction_us * 1e-6; });
   metric(o, "hystlab_rig_errors_total", "counter", "Rig I/O errors by kind.");
   for (const auto& [rl, h] : rigs)

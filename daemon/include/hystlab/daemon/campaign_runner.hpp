@@ -42,7 +42,10 @@ struct RunnerContext {
 struct RunnerResult {
   std::string state, reason;
   std::int64_t run_id = 0;
-  std::uint64_t samples = 0, missed_deadlines = 0, dropped = 0;
+  // missed_deadlines: samples not taken in time. Polling the latest value, that is a loop period
+  // started a whole period late (a late wake-up); with block reads, a sample lost because the
+  // controller's buffer overran before it was read. Late wake-ups are counted in both modes.
+  std::uint64_t samples = 0, missed_deadlines = 0, late_wakeups = 0, dropped = 0;
   std::size_t nodes = 0;
   std::optional<std::int64_t> table_id, lsq_table_id;
 };

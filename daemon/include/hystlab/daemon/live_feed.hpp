@@ -84,7 +84,7 @@ class LiveSampleRing {
 // One rig's live view: the sample ring and the acquisition counters (for /metrics).
 struct RigLive {
   LiveSampleRing ring;
-  std::atomic<std::uint64_t> samples{0}, missed_deadlines{0};
+  std::atomic<std::uint64_t> samples{0}, missed_deadlines{0}, late_wakeups{0};
   std::atomic<std::int64_t> campaign{0}, run{0};
   std::atomic<double> sample_rate_hz{0};
 };

@@ -14,6 +14,7 @@ inline constexpr std::size_t kLatencyBuckets = 16;  // bucket k: [2^k, 2^(k+1)) 
 
 struct IoHealthSnapshot {
   std::uint64_t reads = 0, writes = 0, reconnects = 0;
+  std::uint64_t lost_samples = 0;  // gaps in a controller's sample counter that no block read filled
   std::array<std::uint64_t, kRigErrorCount> errors{};  // index = RigError value (0 unused)
   double last_transaction_us = 0, max_transaction_us = 0, total_transaction_us = 0;
   std::array<std::uint64_t, kLatencyBuckets> latency_histogram{};
@@ -26,10 +27,11 @@ class IoHealth {
   void record_transaction(bool write, double micros) noexcept;
   void record_error(RigError e) noexcept { errors_[static_cast<std::size_t>(e)].fetch_add(1, std::memory_order_relaxed); }
   void record_reconnect() noexcept { reconnects_.fetch_add(1, std::memory_order_relaxed); }
+  void record_lost(std::uint64_t n) noexcept { lost_.fetch_add(n, std::memory_order_relaxed); }
   [[nodiscard]] IoHealthSnapshot snapshot() const noexcept;
 
  private:
-  std::atomic<std::uint64_t> reads_{0}, writes_{0}, reconnects_{0};
+  std::atomic<std::uint64_t> reads_{0}, writes_{0}, reconnects_{0}, lost_{0};
   std::array<std::atomic<std::uint64_t>, kRigErrorCount> errors_{};
   std::atomic<double> last_us_{0}, max_us_{0}, total_us_{0};
   std::array<std::atomic<std::uint64_t>, kLatencyBuckets> histogram_{};

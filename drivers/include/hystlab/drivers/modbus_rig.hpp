@@ -7,6 +7,7 @@
 
 #include "hystlab/drivers/rig.hpp"
 #include "hystlab/protocols/register_map.hpp"
+#include "hystlab/protocols/sample_record.hpp"
 
 struct _modbus;  // libmodbus context
 
@@ -25,6 +26,7 @@ struct ModbusRigConfig {
   double byte_timeout_s = 0.01;       // between bytes of one answer
   double reconnect_min_s = 0.05, reconnect_max_s = 2.0;  // back-off, doubling
   double stale_after_s = 0.5;         // sample counter unchanged this long: stale_data
+  bool block_reads = false;           // read_samples() reads the map's sample_window (required then)
   protocols::RegisterMap map;
   std::string name = "modbus rig";
 };
@@ -43,6 +45,8 @@ class ModbusRig final : public Rig {
   std::error_code hold(bool on) noexcept override;
   std::error_code estop(bool on) noexcept override;
   std::error_code read_sample(double now_s, RigSample& out) noexcept override;
+  std::error_code read_samples(double now_s, std::vector<RigSample>& out) noexcept override;
+  [[nodiscard]] bool block_reads() const noexcept override { return cfg_.block_reads; }
   std::error_code command_shaker(double frequency_hz, double amplitude_mm, bool enable) noexcept override;
   std::error_code read_shaker(double now_s, ShakerSample& out) noexcept override;
   [[nodiscard]] IoHealthSnapshot health() const noexcept override { return health_.snapshot(); }
@@ -60,6 +64,9 @@ class ModbusRig final : public Rig {
   std::error_code fail(int err, const char* op) noexcept;  // classify errno, count, log once per episode
   void succeed() noexcept;
   std::error_code check_stale(double now_s, std::uint32_t counter) noexcept;
+  std::error_code read_window_page(int first, int count) noexcept;
+  std::error_code take_window(double now_s, int& fresh, bool& reached) noexcept;
+  void emit_window(int fresh, std::vector<RigSample>& out) noexcept;
 
   ModbusRigConfig cfg_;
   _modbus* ctx_ = nullptr;
@@ -71,6 +78,14 @@ class ModbusRig final : public Rig {
   std::uint64_t episode_count_ = 0;
   std::uint32_t last_counter_ = 0;
   double counter_changed_at_ = -1;
+  // Block reads: the window's words and decoded records (newest first), and the controller's
+  // clock: the last counter taken, extended to 64 bits, and the host time it was anchored at.
+  std::vector<std::uint16_t> window_words_;
+  std::vector<protocols::SignalArray> window_records_;
+  bool have_window_counter_ = false;
+  std::uint32_t window_counter_ = 0;
+  std::int64_t window_counter64_ = 0, anchor_counter64_ = 0;
+  double anchor_time_s_ = 0;
 };
 
 }  // namespace hystlab::drivers

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "hystlab/drivers/io_health.hpp"
 #include "hystlab/drivers/rig_error.hpp"
@@ -36,6 +37,18 @@ class Rig {
   virtual std::error_code hold(bool on) noexcept = 0;
   virtual std::error_code estop(bool on) noexcept = 0;
   virtual std::error_code read_sample(double now_s, RigSample& out) noexcept = 0;
+  // Every sample since the last call, oldest first (out is cleared; its capacity is reused).
+  // A rig that only knows its latest value gives that one (read_sample). A rig with block reads
+  // gives what its controller buffered on its own clock, time_s from the controller's counter:
+  // a late caller loses nothing until the controller's buffer overruns (counted in health()).
+  virtual std::error_code read_samples(double now_s, std::vector<RigSample>& out) noexcept {
+    out.clear();
+    RigSample s;
+    const std::error_code ec = read_sample(now_s, s);
+    if (!ec && out.capacity() > 0) out.push_back(s);
+    return ec;
+  }
+  [[nodiscard]] virtual bool block_reads() const noexcept { return false; }
   virtual std::error_code command_shaker(double, double, bool) noexcept { return RigError::unsupported; }
   virtual std::error_code read_shaker(double, ShakerSample&) noexcept { return RigError::unsupported; }
   [[nodiscard]] virtual IoHealthSnapshot health() const noexcept = 0;

@@ -33,6 +33,19 @@ struct MapEntry {
   [[nodiscard]] int width() const noexcept;  // registers (or bits) used: 1 or 2
 };
 
+// A controller that samples on its own clock and keeps its newest samples in a window of
+// registers, newest first: the host reads whole blocks of samples, so a late poll loses nothing
+// and every sample carries the controller's time (sample_counter x period_s). Optional.
+struct SampleWindow {
+  ModbusTable table = ModbusTable::input_register;
+  std::uint16_t address = 0;        // record 0 (the newest) starts here
+  int records = 0;                  // depth of the window
+  double period_s = 0;              // the controller's sample period
+  std::vector<Signal> fields;       // one record: these signals, each encoded as its entry says
+  int record_width = 0;             // registers per record
+  [[nodiscard]] int records_per_read() const noexcept { return 125 / record_width; }
+};
+
 struct MapError : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
@@ -57,6 +70,7 @@ class RegisterMap {
   [[nodiscard]] const std::vector<MapEntry>& entries() const noexcept { return entries_; }
   // Blocks covering the measurements (reads) of this map.
   [[nodiscard]] const std::vector<ReadBlock>& measurement_blocks() const noexcept { return blocks_; }
+  [[nodiscard]] const std::optional<SampleWindow>& sample_window() const noexcept { return window_; }
 
  private:
   static RegisterMap parse_map(std::string_view text);
@@ -66,6 +80,7 @@ class RegisterMap {
   std::vector<MapEntry> entries_;
   std::array<int, kSignalCount> index_{};
   std::vector<ReadBlock> blocks_;
+  std::optional<SampleWindow> window_;
 };
 
 // Engineering value -> register words (1 or 2) or a bit (0/1 in words[0]).
