@@ -221,6 +221,8 @@ std::error_code ModbusRig::take_window(double now_s, int& fresh, bool& reached) 
     const int count = std::min(w.records_per_read(), w.records - first);
     if (auto ec = read_window_page(first, count)) return ec;
     for (int k = first; k < first + count; ++k) {
+      // The window may shift between pages (the controller samples on): a record seen on the
+      // previous page shows again, and is skipped. Fresh records are packed at the front.
       protocols::SignalArray& r = window_records_[static_cast<std::size_t>(k)];
       const auto words = std::span<const std::uint16_t>(window_words_).subspan(static_cast<std::size_t>(k * w.record_width));
       if (const auto ec = protocols::decode_record(cfg_.map, w, words, r)) {
@@ -245,6 +247,9 @@ std::error_code ModbusRig::take_window(double now_s, int& fresh, bool& reached) 
         reached = true;
         break;
       }
+      if (fresh > 0 && static_cast<std::int32_t>(c - static_cast<std::uint32_t>(window_records_[static_cast<std::size_t>(fresh - 1)][counter_at])) >= 0)
+        continue;
+      if (fresh != k) window_records_[static_cast<std::size_t>(fresh)] = r;
       ++fresh;
     }
   }

@@ -150,6 +150,54 @@ TEST_CASE("modbus tcp: the second vendor map (scaled integers, swapped words) en
   CHECK((!ec || ec == RigError::timeout));  // TCP servers may ignore the unit id; RTU would not answer
 }
 
+TEST_CASE("modbus tcp, block reads: every sample once, on the controller's clock; a late reader loses nothing") {
+  SimProcess sim({"--port", "0", "--noise", "0"});
+  ModbusRigConfig c = tcp_config(sim.modbus_port);
+  c.block_reads = true;
+  ModbusRig rig(c);
+  REQUIRE(rig.block_reads());
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  std::vector<RigSample> block;
+  block.reserve(256);
+  REQUIRE_FALSE(rig.read_samples(steady_now(), block));
+  REQUIRE(block.size() == 1);  // the first block anchors the controller's clock to ours
+  RigSample last = block.back();
+  std::size_t taken = 0;
+  REQUIRE_FALSE(rig.hold(false));
+  REQUIRE_FALSE(rig.arm(true));
+  REQUIRE_FALSE(rig.command(2.0, 20.0));
+  for (int sleep : {2, 1, 25, 30, 3}) {  // 30 ms: beyond one page of 12 records, within the window of 60
+    sleep_ms(sleep);
+    REQUIRE_FALSE(rig.read_samples(steady_now(), block));
+    CAPTURE(sleep);
+    for (const RigSample& s : block) {
+      CHECK(s.sample_counter == last.sample_counter + 1);
+      CHECK(s.time_s - last.time_s == doctest::Approx(0.001).epsilon(1e-9));
+      last = s;
+    }
+    taken += block.size();
+  }
+  CHECK(taken >= 61);
+  CHECK(rig.health().lost_samples == 0);
+  CHECK(last.command_mm > 0.1);  // the commands still go through: the controller is ramping
+  CHECK(last.displacement_mm > 0.05);
+
+  sleep_ms(150);  // beyond the window: what the controller overwrote is counted, and the time axis keeps the gap
+  REQUIRE_FALSE(rig.read_samples(steady_now(), block));
+  REQUIRE(block.size() == 60);
+  const std::uint32_t gap = block.front().sample_counter - last.sample_counter - 1;
+  CHECK(gap >= 80);
+  CHECK(rig.health().lost_samples == gap);
+  CHECK(block.front().time_s - last.time_s == doctest::Approx(0.001 * (gap + 1)).epsilon(1e-9));
+  for (std::size_t k = 1; k < block.size(); ++k) CHECK(block[k].sample_counter == block[k - 1].sample_counter + 1);
+
+  REQUIRE(sim.control("fault freeze").rfind("ok", 0) == 0);  // the controller stops sampling: stale, as when polling
+  std::error_code ec;
+  for (int k = 0; k < 40 && !ec; ++k, sleep_ms(10)) ec = rig.read_samples(steady_now(), block);
+  CHECK(ec == RigError::stale_data);
+  CHECK(block.empty());
+}
+
 TEST_CASE("modbus rtu on a pty: samples, a CRC error, and recovery") {
   SimProcess sim({"--transport", "rtu", "--noise", "0", "--corner-width", "0"});
   REQUIRE_FALSE(sim.rtu_path.empty());
@@ -254,6 +302,14 @@ TEST_CASE("rigs from configuration: a simulated rig is only a different address"
       "is for another kind of rig");
   bad({{"transport", "can"}}, "exactly one is required");
   bad({{"transport", "modbus-tcp"}, {"baudrate", 9600}}, "rigs[1].baudrate is not a known field");
+  bad({{"transport", "modbus-tcp"}, {"block_reads", "yes"}}, "rigs[1].block_reads must be true or false");
+  bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"map", nlohmann::json::parse(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json"))}},
+      "rigs[1].block_reads cannot be used: rig: block reads need a register map with a sample_window");
+  bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"rig", "shaker"}}, "rigs[1].block_reads cannot be used");
+  auto no_force = nlohmann::json::parse(protocols::kDefaultLoadFrameMap);
+  no_force["sample_window"]["fields"] = {"sample_counter", "displacement_mm", "status_word"};
+  bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"map", no_force}}, "block reads need force_N in the map's sample_window.fields");
+  CHECK_THROWS_WITH_AS(SimProcess({"--port", "0", "--sample-rate", "500"}), doctest::Contains("did not start"), std::runtime_error);
   CHECK_THROWS_WITH_AS((void)make_rig({{"transport", "can"}, {"can_interface", "hystlabnope0"}}),
                        doctest::Contains("cannot open CAN interface"), std::system_error);
 }

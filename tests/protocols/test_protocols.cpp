@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -9,6 +10,7 @@
 #include "hystlab/protocols/can_protocol.hpp"
 #include "hystlab/protocols/modbus_crc.hpp"
 #include "hystlab/protocols/register_map.hpp"
+#include "hystlab/protocols/sample_record.hpp"
 
 using namespace hystlab::protocols;
 
@@ -111,6 +113,62 @@ TEST_CASE("register maps: a bad map is rejected with the field named") {
   CHECK_THROWS_AS((void)RegisterMap::from_json(R"({"format": 3, "version": 1})"), MapError);
   expect([](auto& j) { j["name"] = 7; j["signals"]["force_N"]["unit"] = 3; j["signals"]["force_N"]["address"] = "two"; },
          "signals.force_N.address");
+}
+
+TEST_CASE("sample windows: the shipped map's window, and records that encode and decode back") {
+  const RegisterMap m = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  REQUIRE(m.sample_window());
+  const SampleWindow& w = *m.sample_window();
+  CHECK(w.record_width == 10);  // counter, displacement, force, command (2 each), status, fault
+  CHECK(w.records_per_read() == 12);
+  CHECK(w.period_s == doctest::Approx(0.001));
+  CHECK_FALSE(RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json")).sample_window());
+  SignalArray in{}, out{};
+  out.fill(-7);
+  in[static_cast<std::size_t>(Signal::sample_counter)] = 4000000123.0;
+  in[static_cast<std::size_t>(Signal::displacement_mm)] = -1.25;
+  in[static_cast<std::size_t>(Signal::force_N)] = 312.5;
+  in[static_cast<std::size_t>(Signal::command_mm)] = 0.5;
+  in[static_cast<std::size_t>(Signal::status_word)] = 0x43;
+  in[static_cast<std::size_t>(Signal::fault_code)] = 2;
+  std::uint16_t words[10] = {};
+  REQUIRE_FALSE(encode_record(m, w, in, words));
+  CHECK(words[0] == 0xEE6B);  // the counter, big-endian words: 4000000123 = 0xEE6B287B
+  CHECK(words[1] == 0x287B);
+  REQUIRE_FALSE(decode_record(m, w, words, out));
+  for (const Signal s : w.fields) CHECK(out[static_cast<std::size_t>(s)] == in[static_cast<std::size_t>(s)]);
+  CHECK(out[static_cast<std::size_t>(Signal::heartbeat)] == -7);  // not a field: untouched
+  CHECK(encode_record(m, w, in, std::span<std::uint16_t>(words, 9)) == ProtocolError::wrong_length);
+  in[static_cast<std::size_t>(Signal::force_N)] = std::nan("");
+  CHECK(encode_record(m, w, in, words) == ProtocolError::not_finite);
+  words[4] = 0x7F7F;  // force far beyond the map's max of 5000 N
+  CHECK(decode_record(m, w, words, out) == ProtocolError::out_of_range);
+}
+
+TEST_CASE("sample windows: a bad window is rejected with the field named") {
+  const auto base = nlohmann::json::parse(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  auto expect = [&](auto mutate, const char* needle) {
+    auto j = base;
+    mutate(j);
+    CAPTURE(needle);
+    CHECK_THROWS_WITH_AS((void)RegisterMap::from_json(j.dump()), doctest::Contains(needle), MapError);
+  };
+  expect([](auto& j) { j["sample_window"] = 3; }, "sample_window must be an object");
+  expect([](auto& j) { j["sample_window"]["depth"] = 3; }, "sample_window has an unknown field 'depth'");
+  expect([](auto& j) { j["sample_window"]["table"] = "coil"; }, "sample_window.table");
+  expect([](auto& j) { j["sample_window"].erase("address"); }, "sample_window.address is missing");
+  expect([](auto& j) { j["sample_window"]["address"] = 70000; }, "sample_window.address must be an integer from 0 to 65535");
+  expect([](auto& j) { j["sample_window"]["records"] = 0; }, "sample_window.records must be an integer from 1 to 10000");
+  expect([](auto& j) { j["sample_window"]["period_s"] = -1; }, "sample_window.period_s must be > 0");
+  expect([](auto& j) { j["sample_window"].erase("period_s"); }, "sample_window.period_s is missing");
+  expect([](auto& j) { j["sample_window"]["fields"] = nlohmann::json::array(); }, "sample_window.fields must be a non-empty array");
+  expect([](auto& j) { j["sample_window"]["fields"].push_back("torque"); }, "sample_window.fields has \"torque\", which is not a signal");
+  expect([](auto& j) { j["sample_window"]["fields"].push_back("setpoint_mm"); }, "which is not a register measurement");
+  expect([](auto& j) { j["sample_window"]["fields"].push_back("force_N"); }, "sample_window.fields has 'force_N' twice");
+  expect([](auto& j) { j["sample_window"]["fields"] = {"displacement_mm", "force_N"}; }, "sample_window.fields must hold sample_counter");
+  expect([](auto& j) { j["sample_window"]["address"] = 0; }, "sample_window overlaps signals.command_mm at input_register 4");
+  expect([](auto& j) { j["sample_window"]["address"] = 65000; }, "sample_window runs past address 65535");
+  expect([](auto& j) { j["signals"].erase("command_mm"); }, "'command_mm', which 'signals' does not define");
 }
 
 TEST_CASE("CAN: every frame encodes byte for byte and decodes back") {
