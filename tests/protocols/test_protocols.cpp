@@ -40,6 +40,14 @@ double dec(const MapEntry& e, std::array<std::uint16_t, 2> w) {
   REQUIRE_FALSE(decode(e, w, v));
   return v;
 }
+// The shipped load frame map, changed by mutate, must be refused with needle in the message.
+template <class Mutate>
+void refused_after(Mutate mutate, const char* needle) {
+  auto j = nlohmann::json::parse(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  mutate(j);
+  CAPTURE(needle);
+  CHECK_THROWS_WITH_AS((void)RegisterMap::from_json(j.dump()), doctest::Contains(needle), MapError);
+}
 }  // namespace
 
 TEST_CASE("register encoding: every type and word order, byte for byte") {
@@ -91,27 +99,20 @@ TEST_CASE("register maps: the shipped maps load, with their read blocks") {
 }
 
 TEST_CASE("register maps: a bad map is rejected with the field named") {
-  const auto base = nlohmann::json::parse(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
-  auto expect = [&](auto mutate, const char* needle) {
-    auto j = base;
-    mutate(j);
-    CAPTURE(needle);
-    CHECK_THROWS_WITH_AS((void)RegisterMap::from_json(j.dump()), doctest::Contains(needle), MapError);
-  };
-  expect([](auto& j) { j["signals"]["force_N"]["address"] = 1; }, "overlaps");
-  expect([](auto& j) { j["signals"]["force_N"]["type"] = "float64"; }, "signals.force_N.type");
-  expect([](auto& j) { j["signals"].erase("sample_counter"); }, "missing required signal 'signals.sample_counter'");
-  expect([](auto& j) { j["signals"]["force_N"]["scale"] = 0; }, "signals.force_N.scale must not be 0");
-  expect([](auto& j) { j["signals"]["torque"] = j["signals"]["force_N"]; }, "unknown signal 'signals.torque'");
-  expect([](auto& j) { j["signals"]["enable"]["type"] = "uint16"; }, "does not fit table 'coil'");
-  expect([](auto& j) { j["signals"]["setpoint_mm"]["table"] = "input_register"; }, "writable table");
-  expect([](auto& j) { j["signals"]["force_N"]["word_order"] = "little"; }, "signals.force_N.word_order");
-  expect([](auto& j) { j["version"] = 9; }, "unknown version 9");
+  refused_after([](auto& j) { j["signals"]["force_N"]["address"] = 1; }, "overlaps");
+  refused_after([](auto& j) { j["signals"]["force_N"]["type"] = "float64"; }, "signals.force_N.type");
+  refused_after([](auto& j) { j["signals"].erase("sample_counter"); }, "missing required signal 'signals.sample_counter'");
+  refused_after([](auto& j) { j["signals"]["force_N"]["scale"] = 0; }, "signals.force_N.scale must not be 0");
+  refused_after([](auto& j) { j["signals"]["torque"] = j["signals"]["force_N"]; }, "unknown signal 'signals.torque'");
+  refused_after([](auto& j) { j["signals"]["enable"]["type"] = "uint16"; }, "does not fit table 'coil'");
+  refused_after([](auto& j) { j["signals"]["setpoint_mm"]["table"] = "input_register"; }, "writable table");
+  refused_after([](auto& j) { j["signals"]["force_N"]["word_order"] = "little"; }, "signals.force_N.word_order");
+  refused_after([](auto& j) { j["version"] = 9; }, "unknown version 9");
   CHECK_THROWS_WITH_AS((void)RegisterMap::from_json("{oops"), doctest::Contains("not valid JSON"), MapError);
   // found by the fuzzer: numbers too large for a double, fields of the wrong type
   CHECK_THROWS_AS((void)RegisterMap::from_json(R"({"format": "hystlab-modbus-map", "version": 6e666})"), MapError);
   CHECK_THROWS_AS((void)RegisterMap::from_json(R"({"format": 3, "version": 1})"), MapError);
-  expect([](auto& j) { j["name"] = 7; j["signals"]["force_N"]["unit"] = 3; j["signals"]["force_N"]["address"] = "two"; },
+  refused_after([](auto& j) { j["name"] = 7; j["signals"]["force_N"]["unit"] = 3; j["signals"]["force_N"]["address"] = "two"; },
          "signals.force_N.address");
 }
 
@@ -146,29 +147,22 @@ TEST_CASE("sample windows: the shipped map's window, and records that encode and
 }
 
 TEST_CASE("sample windows: a bad window is rejected with the field named") {
-  const auto base = nlohmann::json::parse(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
-  auto expect = [&](auto mutate, const char* needle) {
-    auto j = base;
-    mutate(j);
-    CAPTURE(needle);
-    CHECK_THROWS_WITH_AS((void)RegisterMap::from_json(j.dump()), doctest::Contains(needle), MapError);
-  };
-  expect([](auto& j) { j["sample_window"] = 3; }, "sample_window must be an object");
-  expect([](auto& j) { j["sample_window"]["depth"] = 3; }, "sample_window has an unknown field 'depth'");
-  expect([](auto& j) { j["sample_window"]["table"] = "coil"; }, "sample_window.table");
-  expect([](auto& j) { j["sample_window"].erase("address"); }, "sample_window.address is missing");
-  expect([](auto& j) { j["sample_window"]["address"] = 70000; }, "sample_window.address must be an integer from 0 to 65535");
-  expect([](auto& j) { j["sample_window"]["records"] = 0; }, "sample_window.records must be an integer from 1 to 10000");
-  expect([](auto& j) { j["sample_window"]["period_s"] = -1; }, "sample_window.period_s must be > 0");
-  expect([](auto& j) { j["sample_window"].erase("period_s"); }, "sample_window.period_s is missing");
-  expect([](auto& j) { j["sample_window"]["fields"] = nlohmann::json::array(); }, "sample_window.fields must be a non-empty array");
-  expect([](auto& j) { j["sample_window"]["fields"].push_back("torque"); }, "sample_window.fields has \"torque\", which is not a signal");
-  expect([](auto& j) { j["sample_window"]["fields"].push_back("setpoint_mm"); }, "which is not a register measurement");
-  expect([](auto& j) { j["sample_window"]["fields"].push_back("force_N"); }, "sample_window.fields has 'force_N' twice");
-  expect([](auto& j) { j["sample_window"]["fields"] = {"displacement_mm", "force_N"}; }, "sample_window.fields must hold sample_counter");
-  expect([](auto& j) { j["sample_window"]["address"] = 0; }, "sample_window overlaps signals.command_mm at input_register 4");
-  expect([](auto& j) { j["sample_window"]["address"] = 65000; }, "sample_window runs past address 65535");
-  expect([](auto& j) { j["signals"].erase("command_mm"); }, "'command_mm', which 'signals' does not define");
+  refused_after([](auto& j) { j["sample_window"] = 3; }, "sample_window must be an object");
+  refused_after([](auto& j) { j["sample_window"]["depth"] = 3; }, "sample_window has an unknown field 'depth'");
+  refused_after([](auto& j) { j["sample_window"]["table"] = "coil"; }, "sample_window.table");
+  refused_after([](auto& j) { j["sample_window"].erase("address"); }, "sample_window.address is missing");
+  refused_after([](auto& j) { j["sample_window"]["address"] = 70000; }, "sample_window.address must be an integer from 0 to 65535");
+  refused_after([](auto& j) { j["sample_window"]["records"] = 0; }, "sample_window.records must be an integer from 1 to 10000");
+  refused_after([](auto& j) { j["sample_window"]["period_s"] = -1; }, "sample_window.period_s must be > 0");
+  refused_after([](auto& j) { j["sample_window"].erase("period_s"); }, "sample_window.period_s is missing");
+  refused_after([](auto& j) { j["sample_window"]["fields"] = nlohmann::json::array(); }, "sample_window.fields must be a non-empty array");
+  refused_after([](auto& j) { j["sample_window"]["fields"].push_back("torque"); }, "sample_window.fields has \"torque\", which is not a signal");
+  refused_after([](auto& j) { j["sample_window"]["fields"].push_back("setpoint_mm"); }, "which is not a register measurement");
+  refused_after([](auto& j) { j["sample_window"]["fields"].push_back("force_N"); }, "sample_window.fields has 'force_N' twice");
+  refused_after([](auto& j) { j["sample_window"]["fields"] = {"displacement_mm", "force_N"}; }, "sample_window.fields must hold sample_counter");
+  refused_after([](auto& j) { j["sample_window"]["address"] = 0; }, "sample_window overlaps signals.command_mm at input_register 4");
+  refused_after([](auto& j) { j["sample_window"]["address"] = 65000; }, "sample_window runs past address 65535");
+  refused_after([](auto& j) { j["signals"].erase("command_mm"); }, "'command_mm', which 'signals' does not define");
 }
 
 TEST_CASE("CAN: every frame encodes byte for byte and decodes back") {
