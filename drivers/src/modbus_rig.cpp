@@ -71,6 +71,7 @@ void ModbusRig::disconnect() noexcept {
 std::error_code ModbusRig::connect(double now_s) noexcept {
   disconnect();
   last_now_ = now_s;
+  have_window_counter_ = false;  // block reads start afresh: what came before is not "lost"
   ctx_ = cfg_.transport == ModbusRigConfig::Transport::tcp
              ? modbus_new_tcp(cfg_.host.c_str(), cfg_.port)
              : modbus_new_rtu(cfg_.device.c_str(), cfg_.baud, cfg_.parity, cfg_.data_bits, cfg_.stop_bits);
