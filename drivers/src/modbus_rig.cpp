@@ -1,6 +1,8 @@
 #include "hystlab/drivers/modbus_rig.hpp"
 
 #include <modbus/modbus.h>
+#include <poll.h>
+#include <unistd.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -108,7 +110,7 @@ std::error_code ModbusRig::fail(int err, const char* op) noexcept {
     connected_ = false;
     next_attempt_ = last_now_ + (backoff_ = backoff_ > 0 ? std::min(backoff_ * 2, cfg_.reconnect_max_s) : cfg_.reconnect_min_s);
   } else if (ctx_ && (kind == RigError::timeout || kind == RigError::crc_error || kind == RigError::protocol_error)) {
-    modbus_flush(ctx_);  // a late or broken answer must not be taken for the next one
+    resync();
   }
   ++episode_count_;
   if (episode_ != static_cast<int>(kind)) {  // once per episode, not once per poll
@@ -117,6 +119,37 @@ std::error_code ModbusRig::fail(int err, const char* op) noexcept {
     episode_ = static_cast<int>(kind);
   }
   return kind;
+}
+
+// libmodbus's flush drops only what has already arrived: an answer to a timed-out request that
+// arrives later is taken for the next request's, and the one after it, for ever (a TCP mismatch
+// of transaction ids; on RTU it would pass as valid). TCP: a fresh connection cannot carry it.
+// RTU: wait until the line is quiet, then drop what came.
+void ModbusRig::resync() noexcept {
+  if (cfg_.transport == ModbusRigConfig::Transport::rtu) {
+    drain_line();
+    return;
+  }
+  modbus_close(ctx_);
+  health_.record_reconnect();
+  if (modbus_connect(ctx_) == -1) {
+    health_.record_error(RigError::connection_lost);
+    connected_ = false;
+    next_attempt_ = last_now_ + (backoff_ = backoff_ > 0 ? std::min(backoff_ * 2, cfg_.reconnect_max_s) : cfg_.reconnect_min_s);
+  }
+}
+
+void ModbusRig::drain_line() noexcept {
+  const int fd = modbus_get_socket(ctx_);
+  if (fd < 0) return;
+  auto wait_ms = static_cast<int>(std::ceil(cfg_.response_timeout_s * 1e3));  // a late answer starts within this
+  std::uint8_t junk[256];
+  for (int guard = 0; guard < 64; ++guard) {  // bounded: a chattering line cannot hold us here
+    pollfd p{fd, POLLIN, 0};
+    if (poll(&p, 1, wait_ms) <= 0 || read(fd, junk, sizeof junk) <= 0) break;
+    wait_ms = static_cast<int>(std::ceil(cfg_.byte_timeout_s * 1e3));  // ... and ends with a quiet gap
+  }
+  modbus_flush(ctx_);
 }
 
 void ModbusRig::succeed() noexcept {
