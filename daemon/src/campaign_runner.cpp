@@ -1,5 +1,6 @@
 #include "hystlab/daemon/campaign_runner.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -32,6 +33,7 @@ struct Loop {
   std::uint32_t last_counter = 0;
   bool have_counter = false, paused = false, watchdog_holding = false;
   double pause_started = 0;
+  double answered_at = -1e300;  // polling: when the last read's answer came (rig seconds)
 
   void state(const std::string& to, const std::string& reason) {
     const std::string now = ctx.now_iso();
@@ -109,7 +111,7 @@ bool on_sample(Loop& L, const drivers::RigSample& s, double wall0) {
     live->ring.push({mono_now(), s.time_s, s.command_mm, s.displacement_mm, s.force_N, L.run, s.status_word});
     live->samples.fetch_add(1, std::memory_order_relaxed);
   }
-  if (auto trip = L.safety.check(s.displacement_mm, s.force_N, s.time_s)) {
+  if (auto trip = L.safety.check(s.displacement_mm, s.force_N, s.time_s, std::max(s.time_s, L.answered_at))) {
     L.result.reason = "safety trip: " + *trip;
     go_safe(L, wall0);
     L.result.state = "aborted";
@@ -244,6 +246,7 @@ RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerCont
       continue;
     }
     if (blocks) count_lost(L, lost_before);
+    else L.answered_at = (mono_now() - wall0) * ctx.time_scale;  // a polled sample is stamped when asked
     bool fresh = false;
     for (const drivers::RigSample& s : block) {
       if (L.have_counter && s.sample_counter == L.last_counter) continue;

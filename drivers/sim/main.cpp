@@ -15,6 +15,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "can_endpoint.hpp"
@@ -206,6 +207,7 @@ int run(const Args& a) {
     pfds.clear();
     for (int fd : fds) pfds.push_back(pollfd{fd, POLLIN, 0});
     if (poll(pfds.data(), pfds.size(), wait_ms) <= 0) continue;
+    if (modbus && faults.stall_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(faults.stall_ms));
     if (modbus) advance(wall());
     for (const pollfd& p : pfds) {
       if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;

@@ -26,19 +26,20 @@ std::string Faults::apply(const std::string& spec) {
   }
   if (name == "drop") drop = true;
   else if (name == "delay") delay_ms = value > 0 ? value : 200;
+  else if (name == "stall") stall_ms = value > 0 ? value : 30;
   else if (name == "exception") exception = value > 0 ? value : 4;
   else if (name == "crc") crc = true;
   else if (name == "freeze") freeze = true;
   else if (name == "overload") overload = true;
   else if (name == "can-silent") can_silent = true;
   else if (name == "clear") *this = Faults{};
-  else return "unknown fault '" + name + "' (drop, delay=MS, exception=CODE, crc, freeze, overload, can-silent, clear)";
+  else return "unknown fault '" + name + "' (drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload, can-silent, clear)";
   return "";
 }
 
 std::string Faults::describe() const {
   std::ostringstream s;
-  s << "drop=" << drop << " delay=" << delay_ms << " exception=" << exception << " crc=" << crc << " freeze=" << freeze
+  s << "drop=" << drop << " delay=" << delay_ms << " stall=" << stall_ms << " exception=" << exception << " crc=" << crc << " freeze=" << freeze
     << " overload=" << overload << " can-silent=" << can_silent;
   return s.str();
 }

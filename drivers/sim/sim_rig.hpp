@@ -16,7 +16,8 @@ using SignalValues = std::array<double, protocols::kSignalCount>;
 
 struct Faults {
   bool drop = false;        // close every Modbus connection and refuse new ones
-  int delay_ms = 0;         // answer late
+  int delay_ms = 0;         // answer late, with the values of when the request came
+  int stall_ms = 0;         // stop this long before each answer (physics too), like a starved process
   int exception = 0;        // answer every request with this Modbus exception code
   bool crc = false;         // RTU: corrupt the CRC of every answer
   bool freeze = false;      // the measurements (and the sample counter) stop updating

@@ -243,6 +243,32 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
   }
 }
 
+TEST_CASE("a stalled controller answers late: the campaign goes on, no false rate trip") {
+  // As in a CI run: the simulator, starved of CPU at time scale 10, answered 44 ms late with the
+  // position of that moment; timed by the request alone, that was 23 mm/s against a 20 mm/s limit.
+  SimProcess sim({"--port", "0", "--time-scale", "10", "--noise", "0"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  nlohmann::json source = fot_plan(4, 1.0);
+  source["limits"]["rate_mm_s"] = 5;
+  const auto plan = daemon::parse_plan(source);
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 10);
+  std::thread fault([&] {
+    for (int k = 0; k < 8; ++k) {  // eight stalls of 35 ms within the campaign's first 2 s
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      sim.control("fault stall 35");
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      sim.control("clear");
+    }
+  });
+  const auto r = daemon::run_campaign(id, plan, ctx);
+  fault.join();
+  CAPTURE(r.reason);
+  CHECK(r.state == "completed");
+  CHECK(rig->health().max_transaction_us > 30'000);  // the stalls did happen
+}
+
 TEST_CASE("a full writer queue is counted and never blocks acquisition") {
   SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
   Bench b(64);  // far smaller than 100 ms of samples
@@ -299,6 +325,40 @@ TEST_CASE("safety envelope: limits on every sample; the rate over a window, not 
   daemon::SafetyEnvelope env2(l);
   CHECK(env2.check(1.0, 150.0, 0.0)->find("force") != std::string::npos);
   CHECK(env2.check(6.0, 0.0, 0.001)->find("displacement") != std::string::npos);
+}
+
+TEST_CASE("safety envelope: a slow answer is no fast motion; a runaway with slow answers still trips") {
+  daemon::Limits l;
+  l.displacement_min_mm = -1;
+  l.displacement_max_mm = 5;
+  l.force_max_N = 100;
+  l.rate_max_mm_s = 5;
+  // 1 mm/s, polled every 10 ms of rig time; one request waits 440 ms (a starved controller at
+  // time scale 10, seen in CI) and comes back with the position of that moment.
+  auto run = [&](bool bracketed) {
+    daemon::SafetyEnvelope env(l);
+    std::optional<std::string> trip;
+    double asked = 0;
+    for (int k = 0; k < 200 && !trip; ++k) {
+      const double answered = asked + (k == 100 ? 0.44 : 0.0005);
+      const double x = 1.0 * answered;
+      trip = bracketed ? env.check(x, 10.0, asked, answered) : env.check(x, 10.0, asked);
+      asked = answered + 0.0095;  // the next request goes out once this answer is in
+    }
+    return trip;
+  };
+  CHECK_FALSE(run(true));
+  const auto unbracketed = run(false);  // timed by the request alone: 23 mm/s that never happened
+  REQUIRE(unbracketed);
+  CHECK(unbracketed->find("rate") != std::string::npos);
+  // A real runaway at 50 mm/s, every answer 3 ms late: trips within a few windows.
+  daemon::SafetyEnvelope env(l);
+  std::optional<std::string> trip;
+  double asked = 0;
+  for (int k = 0; k < 100 && !trip; ++k, asked += 0.004) trip = env.check(50.0 * (asked + 0.003), 10.0, asked, asked + 0.003);
+  REQUIRE(trip);
+  CHECK(trip->find("rate") != std::string::npos);
+  CHECK(asked < 0.1);
 }
 
 TEST_CASE("plans: an error names the field and the reason") {

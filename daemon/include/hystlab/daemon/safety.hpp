@@ -14,8 +14,13 @@ class SafetyEnvelope {
   // rate_window_s: the rate is measured over at least this much rig time. Two reads can come
   // microseconds apart yet straddle one of the rig's own steps; their quotient is no velocity.
   explicit SafetyEnvelope(Limits limits, double rate_window_s = 0.02) : l_(limits), window_(rate_window_s) {}
-  // A reason to trip, or nothing. t: rig seconds of this sample.
-  [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double t_s);
+  // A reason to trip, or nothing. asked_s: rig seconds when the sample was asked for;
+  // answered_s: when its answer came. A polled value was taken somewhere between the two; a
+  // sample timed by the controller's own clock has them equal.
+  [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double asked_s, double answered_s);
+  [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double t_s) {
+    return check(displacement_mm, force_N, t_s, t_s);
+  }
   [[nodiscard]] const Limits& limits() const noexcept { return l_; }
 
  private:
