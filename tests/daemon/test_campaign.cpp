@@ -86,6 +86,29 @@ daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double s
   if (c) ctx.next_control = [c] { return c->pop(); };
   return ctx;
 }
+// Limits for the envelope tests: -1..5 mm, 100 N, and the rate limit given.
+daemon::Limits envelope_limits(double rate_mm_s) {
+  daemon::Limits l;
+  l.displacement_min_mm = -1;
+  l.displacement_max_mm = 5;
+  l.force_max_N = 100;
+  l.rate_max_mm_s = rate_mm_s;
+  return l;
+}
+
+// Runs a campaign while another thread sends the simulator faults: (wait in ms, command) in turn.
+daemon::RunnerResult run_with_faults(std::int64_t id, const daemon::Plan& plan, daemon::RunnerContext& ctx, SimProcess& sim,
+                                     const std::vector<std::pair<int, std::string>>& schedule) {
+  std::thread fault([&] {
+    for (const auto& [wait_ms, command] : schedule) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms));
+      sim.control(command);
+    }
+  });
+  const daemon::RunnerResult r = daemon::run_campaign(id, plan, ctx);
+  fault.join();
+  return r;
+}
 }  // namespace
 
 TEST_CASE("fot campaign n = 12: the online table equals the offline one and the specimen's") {
@@ -215,12 +238,7 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
     const auto id = b.submit(plan.source);
     auto ctx = context(*rig, b, nullptr, 200);
     ctx.watchdog_fail_periods = 200;
-    std::thread fault([&] {
-      std::this_thread::sleep_for(std::chrono::milliseconds(300));
-      sim.control("fault drop");
-    });
-    const auto r = daemon::run_campaign(id, plan, ctx);
-    fault.join();
+    const auto r = run_with_faults(id, plan, ctx, sim, {{300, "fault drop"}});
     CHECK(r.state == "failed");
     CHECK(r.reason.find("watchdog") != std::string::npos);
     sim.control("clear");
@@ -229,14 +247,7 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
     const auto id = b.submit(plan.source);
     auto ctx = context(*rig, b, nullptr, 200);
     ctx.watchdog_fail_periods = 2000;
-    std::thread fault([&] {
-      std::this_thread::sleep_for(std::chrono::milliseconds(300));
-      sim.control("fault drop");
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      sim.control("clear");
-    });
-    const auto r = daemon::run_campaign(id, plan, ctx);
-    fault.join();
+    const auto r = run_with_faults(id, plan, ctx, sim, {{300, "fault drop"}, {100, "clear"}});
     CAPTURE(r.reason);
     CHECK(r.state == "completed");
     CHECK(rig->health().errors_of(drivers::RigError::connection_lost) >= 1);
@@ -254,16 +265,9 @@ TEST_CASE("a stalled controller answers late: the campaign goes on, no false rat
   const auto plan = daemon::parse_plan(source);
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 10);
-  std::thread fault([&] {
-    for (int k = 0; k < 8; ++k) {  // eight stalls of 35 ms within the campaign's first 2 s
-      std::this_thread::sleep_for(std::chrono::milliseconds(250));
-      sim.control("fault stall 35");
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      sim.control("clear");
-    }
-  });
-  const auto r = daemon::run_campaign(id, plan, ctx);
-  fault.join();
+  std::vector<std::pair<int, std::string>> stalls;  // eight stalls of 35 ms within the campaign's first 2 s
+  for (int k = 0; k < 8; ++k) stalls.insert(stalls.end(), {{250, "fault stall 35"}, {5, "clear"}});
+  const auto r = run_with_faults(id, plan, ctx, sim, stalls);
   CAPTURE(r.reason);
   CHECK(r.state == "completed");
   CHECK(rig->health().max_transaction_us > 30'000);  // the stalls did happen
@@ -300,11 +304,7 @@ TEST_CASE("fot campaign over CAN (socketpair)") {
 }
 
 TEST_CASE("safety envelope: limits on every sample; the rate over a window, not between two reads") {
-  daemon::Limits l;
-  l.displacement_min_mm = -1;
-  l.displacement_max_mm = 5;
-  l.force_max_N = 100;
-  l.rate_max_mm_s = 10;
+  const daemon::Limits l = envelope_limits(10);
   daemon::SafetyEnvelope env(l);
   // Steady 2 mm/s sampled with a jittery clock, the rig moving in 1 ms steps: reads 5 µs apart
   // may straddle one step (0.002 mm / 5 µs = 400 mm/s between them). Must not trip.
@@ -328,11 +328,7 @@ TEST_CASE("safety envelope: limits on every sample; the rate over a window, not 
 }
 
 TEST_CASE("safety envelope: a slow answer is no fast motion; a runaway with slow answers still trips") {
-  daemon::Limits l;
-  l.displacement_min_mm = -1;
-  l.displacement_max_mm = 5;
-  l.force_max_N = 100;
-  l.rate_max_mm_s = 5;
+  const daemon::Limits l = envelope_limits(5);
   // 1 mm/s, polled every 10 ms of rig time; one request waits 440 ms (a starved controller at
   // time scale 10, seen in CI) and comes back with the position of that moment.
   auto run = [&](bool bracketed) {

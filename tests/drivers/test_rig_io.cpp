@@ -59,6 +59,16 @@ RigSample move_to(Rig& rig, double mm) {
   }
   return s;
 }
+// The simulator and a driver connected to it, one good read done.
+struct ConnectedRig {
+  SimProcess sim{std::vector<std::string>{"--port", "0", "--noise", "0"}};
+  ModbusRig rig{tcp_config(sim.modbus_port)};
+  RigSample s;
+  ConnectedRig() {
+    REQUIRE_FALSE(rig.connect(steady_now()));
+    REQUIRE_FALSE(rig.read_sample(steady_now(), s));
+  }
+};
 }  // namespace
 
 TEST_CASE("modbus tcp: samples, commands and the specimen's force through the default map") {
@@ -91,11 +101,8 @@ TEST_CASE("modbus tcp: samples, commands and the specimen's force through the de
 }
 
 TEST_CASE("modbus tcp: every injected fault is its typed error, and the driver recovers") {
-  SimProcess sim({"--port", "0", "--noise", "0"});
-  ModbusRig rig(tcp_config(sim.modbus_port));
-  REQUIRE_FALSE(rig.connect(steady_now()));
-  RigSample s;
-  REQUIRE_FALSE(rig.read_sample(steady_now(), s));
+  ConnectedRig connected;
+  auto& [sim, rig, s] = connected;
 
   struct Case {
     const char* fault;
@@ -133,11 +140,8 @@ TEST_CASE("modbus tcp: every injected fault is its typed error, and the driver r
 TEST_CASE("modbus tcp: a late answer to a timed-out read is never taken for the next one's") {
   // libmodbus flushes only what has arrived; an answer arriving after that flush would answer
   // the next request, and the one after, for ever (seen in CI: 2000 reads refused in a row).
-  SimProcess sim({"--port", "0", "--noise", "0"});
-  ModbusRig rig(tcp_config(sim.modbus_port));
-  REQUIRE_FALSE(rig.connect(steady_now()));
-  RigSample s;
-  REQUIRE_FALSE(rig.read_sample(steady_now(), s));
+  ConnectedRig connected;
+  auto& [sim, rig, s] = connected;
   REQUIRE(sim.control("fault delay 80").rfind("ok", 0) == 0);
   sleep_ms(10);
   CHECK(rig.read_sample(steady_now(), s) == RigError::timeout);
