@@ -85,8 +85,7 @@ std::error_code ModbusRig::connect(double now_s) noexcept {
     const int err = errno;
     modbus_free(ctx_);
     ctx_ = nullptr;
-    backoff_ = backoff_ > 0 ? std::min(backoff_ * 2, cfg_.reconnect_max_s) : cfg_.reconnect_min_s;
-    next_attempt_ = now_s + backoff_;
+    back_off();
     return fail(err == ETIMEDOUT ? ECONNREFUSED : err, "connect");
   }
   connected_ = true;
@@ -107,8 +106,7 @@ std::error_code ModbusRig::fail(int err, const char* op) noexcept {
   health_.record_error(kind);
   if (kind == RigError::connection_lost && ctx_) {
     modbus_close(ctx_);
-    connected_ = false;
-    next_attempt_ = last_now_ + (backoff_ = backoff_ > 0 ? std::min(backoff_ * 2, cfg_.reconnect_max_s) : cfg_.reconnect_min_s);
+    back_off();
   } else if (ctx_ && (kind == RigError::timeout || kind == RigError::crc_error || kind == RigError::protocol_error)) {
     resync();
   }
@@ -134,9 +132,15 @@ void ModbusRig::resync() noexcept {
   health_.record_reconnect();
   if (modbus_connect(ctx_) == -1) {
     health_.record_error(RigError::connection_lost);
-    connected_ = false;
-    next_attempt_ = last_now_ + (backoff_ = backoff_ > 0 ? std::min(backoff_ * 2, cfg_.reconnect_max_s) : cfg_.reconnect_min_s);
+    back_off();
   }
+}
+
+// Not connected: the next attempt waits a back-off that doubles up to reconnect_max_s.
+void ModbusRig::back_off() noexcept {
+  connected_ = false;
+  backoff_ = backoff_ > 0 ? std::min(backoff_ * 2, cfg_.reconnect_max_s) : cfg_.reconnect_min_s;
+  next_attempt_ = last_now_ + backoff_;
 }
 
 void ModbusRig::drain_line() noexcept {

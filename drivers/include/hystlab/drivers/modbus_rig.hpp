@@ -64,6 +64,7 @@ class ModbusRig final : public Rig {
   std::error_code fail(int err, const char* op) noexcept;  // classify errno, count, log once per episode
   void resync() noexcept;  // after a timeout or a broken answer: no late answer may follow
   void drain_line() noexcept;
+  void back_off() noexcept;
   void succeed() noexcept;
   std::error_code check_stale(double now_s, std::uint32_t counter) noexcept;
   std::error_code read_window_page(int first, int count) noexcept;
