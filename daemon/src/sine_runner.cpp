@@ -57,10 +57,12 @@ RunnerResult run_sine_campaign(std::int64_t campaign_id, const Plan& plan, Runne
       next += period;
       sleep_until(next);
       if (mono_now() - next > period) {
-        ++r.missed_deadlines;
+        ++r.missed_deadlines;  // polling: a late wake-up is a sample not taken in time
         ++r.late_wakeups;
-        if (ctx.live) ctx.live->missed_deadlines.fetch_add(1, std::memory_order_relaxed);
-        if (ctx.live) ctx.live->late_wakeups.fetch_add(1, std::memory_order_relaxed);
+        if (ctx.live) {
+          ctx.live->missed_deadlines.fetch_add(1, std::memory_order_relaxed);
+          ctx.live->late_wakeups.fetch_add(1, std::memory_order_relaxed);
+        }
       }
       t = (mono_now() - wall0) * ctx.time_scale;
       if (ctx.stop && ctx.stop->load()) r.state = "interrupted", r.reason = "the daemon is stopping";
