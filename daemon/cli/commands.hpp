@@ -16,6 +16,7 @@ int run_check(const Args& args);
 int run_compare(const Args& args);
 int run_demo(const Args& args);
 int run_campaign_cmd(const Args& args);
+int run_rig_cmd(const Args& args);
 int run_tables_cmd(const Args& args);
 int run_runs_cmd(const Args& args);
 int run_simulate(const Args& args);

@@ -31,6 +31,7 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
   compare    accuracy of a table or model against a record
   demo       the paper's §3.3 study on Table 1, with a report and plots
   campaign   submit, list, show, pause, resume, abort campaigns of hystlabd (on its db file)
+  rig        reset or estop one of hystlabd's rigs (on its db file)
   tables     list and export the tables hystlabd identified
   runs       export a run's samples as CSV
   simulate   the base-excited isolator (sdof): time histories, transmissibility sweeps
@@ -47,6 +48,7 @@ int dispatch(const std::string& verb, const Args& args) {
   if (verb == "compare") return run_compare(args);
   if (verb == "demo") return run_demo(args);
   if (verb == "campaign") return run_campaign_cmd(args);
+  if (verb == "rig") return run_rig_cmd(args);
   if (verb == "tables") return run_tables_cmd(args);
   if (verb == "runs") return run_runs_cmd(args);
   if (verb == "simulate") return run_simulate(args);

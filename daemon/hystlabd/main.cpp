@@ -78,7 +78,12 @@ int main(int argc, char** argv) {
     hystlab::daemon::check_http_security(cfg.http, std::getenv("HYSTLAB_TOKEN"));
     hystlab::daemon::Daemon daemon(cfg);
     std::unique_ptr<hystlab::web::HttpApi> http;
-    if (cfg.http.enabled) http = std::make_unique<hystlab::web::HttpApi>(daemon, cfg.http);
+    try {
+      if (cfg.http.enabled) http = std::make_unique<hystlab::web::HttpApi>(daemon, cfg.http);
+    } catch (const std::runtime_error& e) {  // the port is taken (another daemon?): refused, nothing ran
+      std::cerr << "hystlabd: error: " << e.what() << "\n";
+      return 2;
+    }
     daemon.run(g_stop);
     if (http) http->stop();
     return 0;

@@ -5,8 +5,11 @@
 #include <chrono>
 #include <condition_variable>
 #include <future>
+#include <limits>
 #include <mutex>
+#include <set>
 
+#include "finisher.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "rig_worker.hpp"
@@ -19,16 +22,18 @@ struct Daemon::Impl {
   db::Store store;  // the main loop's connection
   std::vector<std::unique_ptr<RigWorker>> workers;
   std::unique_ptr<db::SampleWriter> writer;
+  std::unique_ptr<Finisher> finisher;
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
   std::mutex mu;
   std::condition_variable cv;
   std::deque<std::function<void()>> jobs;  // from other threads, run by the main loop
   bool accepting = true;
-  const std::atomic<bool>* stop = nullptr;
+  std::set<std::int64_t> dispatched;  // campaigns handed to a rig's thread (main loop only)
+  double db_backoff_s = 0;            // a busy or failing database: retried, reported once per episode
 
   explicit Impl(const DaemonConfig& c) : config(c), store(c.db_path) {}
 
-  // Runs f on the main loop with its store and waits for it (at most a few seconds).
+  // Runs f on the main loop with its store and waits for it (at most 10 s).
   template <class R>
   R on_main(std::function<R()> f) {
     auto task = std::make_shared<std::packaged_task<R()>>(std::move(f));
@@ -40,25 +45,82 @@ struct Daemon::Impl {
     }
     cv.notify_one();
     if (fut.wait_for(std::chrono::seconds(10)) != std::future_status::ready)
-      throw std::runtime_error("the daemon did not answer within 10 s");
+      throw std::runtime_error("the daemon did not answer within 10 s (is the database busy?)");
     return fut.get();
   }
 
-  // An operator command, as the CLI's (db) and the API's (queue) both arrive.
-  void route(std::int64_t campaign, const std::string& verb) {
-    const auto row = store.campaign(campaign);
-    if (!row) return;
+  RigWorker* worker_of(std::int64_t rig_id) {
+    for (auto& w : workers)
+      if (w->info.id == rig_id) return w.get();
+    return nullptr;
+  }
+
+  // A campaign's command that its rig's thread carries out now; false when it is not running.
+  bool direct(std::int64_t campaign, const std::string& verb) {
+    const Control c = verb == "pause" ? Control::pause : verb == "resume" ? Control::resume : verb == "estop" ? Control::estop : Control::abort;
     for (auto& w : workers)
       if (w->running_campaign == campaign) {
-        w->push(verb == "pause" ? Control::pause : verb == "resume" ? Control::resume : verb == "estop" ? Control::estop : Control::abort);
+        w->push_control(c);
+        const std::string now = now_iso();
+        writer->post([campaign, verb, now](db::Store& s) { s.add_event(campaign, "command", verb, now); });
+        return true;
+      }
+    return false;
+  }
+
+  // An operator command that found no running campaign: the main loop, with the database.
+  void route(std::int64_t campaign, const std::string& verb) {
+    if (direct(campaign, verb)) return;
+    const auto row = store.campaign(campaign);
+    if (!row) return;
+    RigWorker* w = worker_of(row->rig_id);
+    if (verb == "estop" && w) w->push_rig_command(RigCommand::estop);
+    if (verb == "resume" && (row->state == "interrupted" || row->state == "paused" || row->state == "held")) {
+      dispatched.erase(campaign);
+      store.transition(campaign, "queued",
+                       row->state == "held" ? "released by the operator" : "re-queued to resume: wipe-out preamble, then the rows not yet measured",
+                       now_iso());
+    } else if ((verb == "abort" || verb == "estop") && (row->state == "queued" || row->state == "held")) {
+      if (w && w->has_queued(campaign) && !w->cancel_queued(campaign)) {  // it just started: stop it there
+        (void)direct(campaign, verb);
         return;
       }
-    if (verb == "resume" && (row->state == "interrupted" || row->state == "paused"))
-      store.transition(campaign, "queued", "re-queued to resume: wipe-out preamble, then the rows not yet measured", now_iso());
-    else if ((verb == "abort" || verb == "estop") && row->state == "queued")
       store.transition(campaign, "aborted", "aborted by the operator before it started", now_iso());
-    else
+    } else {
       store.add_event(campaign, "command", "'" + verb + "' ignored: the campaign is " + row->state, now_iso());
+    }
+  }
+
+  // Hands queued campaigns to their rigs' threads, once each, with the plan checked against the
+  // rig's envelope and what earlier runs measured.
+  void dispatch() {
+    for (auto& w : workers)
+      for (const std::int64_t id : store.queued_campaigns(w->info.id)) {
+        if (dispatched.count(id)) continue;
+        dispatched.insert(id);
+        auto job = make_job(*w, id);
+        if (job) w->push_job(std::move(*job));
+      }
+  }
+
+  std::optional<CampaignJob> make_job(RigWorker& w, std::int64_t id) {
+    const auto row = store.campaign(id);
+    if (!row) return std::nullopt;
+    CampaignJob job;
+    job.id = id;
+    try {
+      job.plan = parse_plan(json::parse(row->plan));
+      job.plan.limits = check_plan_against(job.plan, w.entry.envelope, w.entry.supervision, w.info.kind == "shaker");
+    } catch (const std::exception& e) {  // a plan stored by an older or foreign tool: fail it, say why
+      store.transition(id, "failed", e.what(), now_iso());
+      return std::nullopt;
+    }
+    for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) job.prior_nodes.push_back({a, b, fa, fab});
+    if (job.plan.kind == "fot" && !job.prior_nodes.empty())  // the fits after a resume use every run
+      for (const std::int64_t run : store.runs_of_campaign(id))
+        store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(),
+                              [&job](const db::SampleRow& r) { job.prior_series.add(r.disp, r.force); });
+    return job;
   }
 
   void store_io_stats() {
@@ -68,28 +130,43 @@ struct Daemon::Impl {
                        {"max_transaction_us", h.max_transaction_us}};
       const auto id = w->info.id;
       const std::string now = now_iso();
-      writer->post([id, stats, now](db::Store& s) {
-        db::Statement st(s.database(), "INSERT INTO io_stats(rig_id, at, stats) VALUES(?,?,?)");
-        st.bind(1, id).bind(2, now).bind(3, stats.dump());
-        st.step();
-      });
+      writer->post([id, stats, now](db::Store& s) { s.add_io_stats(id, stats.dump(), now); });
     }
   }
 
-  void run_jobs() {
+  void run_jobs(double wait_s) {
     std::deque<std::function<void()>> todo;
     {
       std::unique_lock lk(mu);
-      cv.wait_for(lk, std::chrono::milliseconds(100), [this] { return !jobs.empty(); });
+      cv.wait_for(lk, std::chrono::duration<double>(wait_s), [this] { return !jobs.empty(); });
       todo.swap(jobs);
     }
     for (auto& j : todo) j();
+  }
+
+  // One pass over what the database brings: the CLI's commands, queued campaigns. A busy or
+  // failing database is retried with back-off and reported once per episode; it never ends run().
+  void poll_database() {
+    try {
+      for (const auto& c : store.take_commands(now_iso())) route(c.campaign_id, c.command);
+      for (const auto& c : store.take_rig_commands(now_iso()))
+        for (auto& w : workers)
+          if (w->info.name == c.rig) w->push_rig_command(c.command == "reset" ? RigCommand::reset : RigCommand::estop);
+      dispatch();
+      if (db_backoff_s > 0) spdlog::info("the database answers again");
+      db_backoff_s = 0;
+    } catch (const std::exception& e) {
+      if (db_backoff_s == 0) spdlog::error("the database refused the main loop ({}); retrying with back-off", e.what());
+      db_backoff_s = std::min(2.0, std::max(0.1, 2 * db_backoff_s));
+    }
   }
 };
 
 Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config)) {
   auto& d = *impl_;
   if (const int n = d.store.mark_interrupted(now_iso())) spdlog::warn("{} campaign(s) were left running: now interrupted", n);
+  if (const int n = d.store.hold_queued(now_iso()))
+    spdlog::warn("{} queued campaign(s) held after the restart: nothing moves until an operator releases them (resume)", n);
   for (const RigEntry& e : config.rigs) {
     auto w = std::make_unique<RigWorker>();
     w->entry = e;
@@ -115,6 +192,7 @@ Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config
   // acquisition's wake-ups by milliseconds.
   const bool moved = avoid_cpu(resolve_cpu(config.acquisition.cpu));
   d.writer = std::make_unique<db::SampleWriter>(config.db_path);
+  d.finisher = std::make_unique<Finisher>(*d.writer);
   if (moved) (void)avoid_cpu(-1);
 }
 
@@ -126,6 +204,7 @@ Daemon::~Daemon() {
   }
   for (auto& w : d.workers)
     if (w->thread.joinable()) w->thread.join();
+  d.finisher.reset();  // what was handed over is finished
   d.writer->flush();
   for (auto& w : d.workers)
     if (w->sim) w->sim->stop();
@@ -133,16 +212,21 @@ Daemon::~Daemon() {
 
 void Daemon::run(const std::atomic<bool>& stop) {
   auto& d = *impl_;
+  const std::function<void(FinishJob)> finish = [&d](FinishJob j) { d.finisher->submit(std::move(j)); };
   for (auto& w : d.workers)
-    w->thread = std::thread(rig_thread, std::ref(*w), d.config.db_path, std::ref(*d.writer), std::cref(stop), d.config.base_dir);
+    w->thread = std::thread(rig_thread, std::ref(*w), std::ref(*d.writer), finish, std::cref(stop), d.config.base_dir);
   spdlog::info("hystlabd running: database {}", d.config.db_path);
   auto last_stats = std::chrono::steady_clock::now();
   while (!stop) {
-    d.run_jobs();
-    for (const auto& c : d.store.take_commands(now_iso())) d.route(c.campaign_id, c.command);
-    if (std::chrono::steady_clock::now() - last_stats > std::chrono::seconds(10)) {
-      last_stats = std::chrono::steady_clock::now();
-      d.store_io_stats();
+    try {
+      d.run_jobs(d.db_backoff_s > 0 ? d.db_backoff_s : 0.1);
+      d.poll_database();
+      if (std::chrono::steady_clock::now() - last_stats > std::chrono::seconds(10)) {
+        last_stats = std::chrono::steady_clock::now();
+        d.store_io_stats();
+      }
+    } catch (const std::exception& e) {  // never out of run(): the HTTP server and the rigs depend on it
+      spdlog::error("main loop: {}", e.what());
     }
   }
   spdlog::info("hystlabd stopping: holding rigs, finishing the write batch");
@@ -150,8 +234,13 @@ void Daemon::run(const std::atomic<bool>& stop) {
     std::lock_guard lk(d.mu);
     d.accepting = false;
   }
-  d.run_jobs();  // what was accepted is carried out (or its caller times out)
+  try {
+    d.run_jobs(0);  // what was accepted is carried out (or its caller times out)
+  } catch (const std::exception& e) {
+    spdlog::error("main loop: {}", e.what());
+  }
   for (auto& w : d.workers) w->thread.join();  // each holds its rig and marks its campaign interrupted
+  d.finisher.reset();
   d.writer->flush();
 }
 
@@ -160,26 +249,33 @@ std::size_t Daemon::rig_count() const noexcept { return impl_->workers.size(); }
 const RigInfo& Daemon::rig_info(std::size_t k) const { return impl_->workers.at(k)->info; }
 const RigLive& Daemon::rig_live(std::size_t k) const { return impl_->workers.at(k)->live; }
 drivers::IoHealthSnapshot Daemon::rig_health(std::size_t k) const { return impl_->workers.at(k)->rig->health(); }
+RigSupervision Daemon::rig_supervision(std::size_t k) const { return impl_->workers.at(k)->snapshot(); }
 db::WriterStats Daemon::writer_stats() const { return impl_->writer->stats(); }
 double Daemon::uptime_s() const noexcept {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - impl_->started).count();
 }
 
-std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) {
-  const Plan plan = parse_plan(plan_json);  // PlanError names the field
-  const RigWorker* rig = nullptr;
-  if (rig_name.empty()) {
-    if (impl_->workers.size() != 1) throw std::invalid_argument("rig: several rigs are configured; name one");
-    rig = impl_->workers.front().get();
-  } else {
-    for (const auto& w : impl_->workers)
-      if (w->info.name == rig_name) rig = w.get();
-    if (!rig) throw std::invalid_argument("rig: no rig named '" + rig_name + "'");
+std::size_t Daemon::rig_index(const std::string& name) const {
+  const auto& ws = impl_->workers;
+  if (name.empty()) {
+    if (ws.size() != 1) throw std::invalid_argument("rig: several rigs are configured; name one");
+    return 0;
   }
-  const bool shaker_plan = plan.kind == "sine";
-  if (shaker_plan != (rig->info.kind == "shaker"))
-    throw std::invalid_argument("plan.kind: a " + plan.kind + " plan cannot run on rig '" + rig->info.name + "', a " + rig->info.kind);
-  const std::int64_t rig_id = rig->info.id;
+  for (std::size_t k = 0; k < ws.size(); ++k)
+    if (ws[k]->info.name == name) return k;
+  throw std::invalid_argument("rig: no rig named '" + name + "'");
+}
+
+std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) {
+  Plan plan = parse_plan(plan_json);  // PlanError names the field
+  RigWorker& rig = *impl_->workers.at(rig_index(rig_name));
+  const bool shaker = rig.info.kind == "shaker";
+  if ((plan.kind == "sine") != shaker)
+    throw std::invalid_argument("plan.kind: a " + plan.kind + " plan cannot run on rig '" + rig.info.name + "', a " + rig.info.kind);
+  (void)check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, shaker);  // PlanError names the field
+  if (const RigSupervision s = rig.snapshot(); s.latched)
+    throw std::invalid_argument("rig: '" + rig.info.name + "' is " + s.state + " (" + s.latch_reason + "): reset it first");
+  const std::int64_t rig_id = rig.info.id;
   const std::string kind = plan.kind, text = plan_json.dump();
   return impl_->on_main<std::int64_t>([this, rig_id, kind, text] { return impl_->store.create_campaign(rig_id, kind, text, now_iso()); });
 }
@@ -187,11 +283,14 @@ std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) 
 void Daemon::command(std::int64_t campaign_id, const std::string& verb) {
   if (verb != "pause" && verb != "resume" && verb != "abort" && verb != "estop")
     throw std::invalid_argument("command: '" + verb + "' is not pause, resume, abort or estop");
+  if (impl_->direct(campaign_id, verb)) return;  // no database on the way to a running campaign
   impl_->on_main<int>([this, campaign_id, verb] {
     impl_->route(campaign_id, verb);
     return 0;
   });
 }
+
+void Daemon::rig_command(std::size_t rig, RigCommand c) { impl_->workers.at(rig)->push_rig_command(c); }
 
 int run_daemon(const DaemonConfig& config, const std::atomic<bool>& stop) {
   Daemon d(config);

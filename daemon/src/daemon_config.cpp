@@ -70,7 +70,7 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
   DaemonConfig c;
   c.base_dir = base_dir;
   if (j.is_null()) {  // embedded defaults: one simulated load frame
-    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}});
+    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}});
     return c;
   }
   if (!j.is_object()) fail("", "must be a JSON object");
@@ -83,7 +83,7 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
     c.db_path = j["db"].get<std::string>();
   }
   if (!j.contains("rigs")) {
-    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}});
+    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}});
     return c;
   }
   if (!j["rigs"].is_array() || j["rigs"].empty()) fail("rigs", "must be a non-empty array");
@@ -118,6 +118,15 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
       }
       r.erase("simulate");
     }  // driver fields are checked by make_rig when the daemon creates the rigs, before anything runs
+    const bool shaker = e.simulated ? e.sim.rig == "shaker" : r.value("rig", std::string("load_frame")) == "shaker";
+    try {
+      e.envelope = parse_envelope(r.value("envelope", json()), where + ".envelope", shaker);
+      e.supervision = parse_supervision(r.value("supervision", json()), where + ".supervision");
+    } catch (const RigConfigError& err) {
+      throw ConfigError(err.what());
+    }
+    r.erase("envelope");
+    r.erase("supervision");
     e.driver = r;
     c.rigs.push_back(e);
   }

@@ -40,85 +40,214 @@ void RigWorker::build_rig(const std::string& base) {
   info.simulated = entry.simulated;
   info.kind = cfg.value("rig", std::string("load_frame"));
   info.description = rig->describe();
+  const bool shaker = info.kind == "shaker";
+  if (supervisor) supervisor->rebind(*rig);
+  else supervisor = std::make_unique<Supervisor>(*rig, entry.supervision, shaker, [this](const RigTransition& t) { record(t); });
+  std::lock_guard lk(mu_);
+  snap_.envelope = envelope_json(entry.envelope, shaker);
+  snap_.supervision = supervision_json(entry.supervision);
 }
 
-void RigWorker::push(Control c) {
-  std::lock_guard lk(mu);
-  controls.push_back(c);
+void RigWorker::push_job(CampaignJob job) {
+  {
+    std::lock_guard lk(mu_);
+    jobs_.push_back(std::move(job));
+  }
+  cv_.notify_all();
 }
-
-std::optional<Control> RigWorker::pop() {
-  std::lock_guard lk(mu);
-  if (controls.empty()) return std::nullopt;
-  const Control c = controls.front();
-  controls.pop_front();
+void RigWorker::push_control(Control c) {
+  {
+    std::lock_guard lk(mu_);
+    controls_.push_back(c);
+  }
+  cv_.notify_all();
+}
+void RigWorker::push_rig_command(RigCommand c) {
+  {
+    std::lock_guard lk(mu_);
+    rig_commands_.push_back(c);
+  }
+  cv_.notify_all();
+}
+bool RigWorker::cancel_queued(std::int64_t id) {
+  std::lock_guard lk(mu_);
+  for (auto it = jobs_.begin(); it != jobs_.end(); ++it)
+    if (it->id == id) {
+      jobs_.erase(it);
+      return true;
+    }
+  return false;
+}
+bool RigWorker::has_queued(std::int64_t id) {
+  std::lock_guard lk(mu_);
+  for (const auto& j : jobs_)
+    if (j.id == id) return true;
+  return running_campaign == id;
+}
+std::optional<CampaignJob> RigWorker::pop_job() {
+  std::lock_guard lk(mu_);
+  if (jobs_.empty()) return std::nullopt;
+  CampaignJob j = std::move(jobs_.front());
+  jobs_.pop_front();
+  running_campaign = j.id;  // under the lock: a command sees it queued or running, never neither
+  controls_.clear();        // commands meant for an earlier campaign
+  return j;
+}
+std::optional<Control> RigWorker::pop_control() {
+  std::lock_guard lk(mu_);
+  if (controls_.empty()) return std::nullopt;
+  const Control c = controls_.front();
+  controls_.pop_front();
   return c;
+}
+std::optional<RigCommand> RigWorker::pop_rig_command() {
+  std::lock_guard lk(mu_);
+  if (rig_commands_.empty()) return std::nullopt;
+  const RigCommand c = rig_commands_.front();
+  rig_commands_.pop_front();
+  return c;
+}
+void RigWorker::wait(double seconds) {
+  std::unique_lock lk(mu_);
+  cv_.wait_for(lk, std::chrono::duration<double>(seconds), [this] { return !jobs_.empty() || !rig_commands_.empty(); });
+}
+
+void RigWorker::record(const RigTransition& t) {
+  const bool bad = t.to == RigState::estopped || t.to == RigState::faulted || t.to == RigState::disconnected;
+  spdlog::log(bad ? spdlog::level::warn : spdlog::level::info, "rig '{}': {} -> {}: {}", entry.name, to_string(t.from), to_string(t.to), t.reason);
+  std::lock_guard lk(mu_);
+  snap_.state = std::string(to_string(t.to));
+  snap_.latched = t.to == RigState::estopped || t.to == RigState::faulted;
+  if (snap_.latched) snap_.latch_reason = t.reason;
+  snap_.recent.push_back({{"at", now_iso()}, {"t", t.t}, {"from", to_string(t.from)}, {"to", to_string(t.to)}, {"reason", t.reason}});
+  if (snap_.recent.size() > 50) snap_.recent.erase(snap_.recent.begin());
+  ++snap_.transitions;
+}
+
+void RigWorker::update_snapshot(const StatusView& v, double x, double f, bool have) {
+  const Supervisor& s = *supervisor;
+  const std::string text = v.fault_code ? rig->fault_text(v.fault_code) : std::string();
+  std::lock_guard lk(mu_);
+  snap_.state = std::string(to_string(s.state()));
+  snap_.latched = s.latched();
+  snap_.latch_reason = s.latch_reason();
+  snap_.latched_fault_code = s.fault_code();
+  snap_.resetting = s.resetting();
+  snap_.reset_refusal = s.reset_refusal();
+  snap_.link_losses = s.link_losses();
+  if (!have) return;
+  snap_.have_sample = true;
+  snap_.status_word = v.status;
+  snap_.fault_code = v.fault_code;
+  snap_.fault_text = text;
+  snap_.position_mm = x;
+  snap_.force_N = f;
+}
+
+RigSupervision RigWorker::snapshot() const {
+  std::lock_guard lk(mu_);
+  return snap_;
 }
 
 namespace {
-void run_one(RigWorker& w, std::int64_t id, db::Store& store, db::SampleWriter& writer, const std::atomic<bool>& stop,
-             const std::string& base) {
-  const auto row = store.campaign(id);
-  if (!row) return;
-  Plan plan;
-  try {
-    plan = parse_plan(json::parse(row->plan));
-  } catch (const std::exception& e) {  // a plan stored by an older or foreign tool: fail it, say why
-    store.transition(id, "failed", e.what(), now_iso());
-    return;
-  }
-  if (w.entry.simulated && w.sim && w.sim->ensure_running() != w.sim->port()) w.build_rig(base);
-  {
-    std::lock_guard lk(w.mu);
-    w.controls.clear();  // commands meant for an earlier campaign
-  }
-  RunnerContext ctx(*w.rig, writer, store);
+
+void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish,
+             const std::atomic<bool>& stop, double epoch) {
+  SteadyClock clock;
+  RunnerContext ctx(*w.rig, *w.supervisor, writer, clock);
   ctx.time_scale = w.entry.time_scale;
   ctx.stop = &stop;
   ctx.now_iso = now_iso;
-  ctx.next_control = [&w] { return w.pop(); };
+  ctx.next_control = [&w] { return w.pop_control(); };
   ctx.live = &w.live;
-  for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) ctx.prior_nodes.push_back({a, b, fa, fab});
+  ctx.finish = finish;
+  ctx.epoch = epoch;
+  const auto id = job.id;
   ctx.on_state = [&w, id](const std::string& s) { spdlog::info("rig '{}': campaign {} {}", w.entry.name, id, s); };
-  w.live.sample_rate_hz = plan.sample_rate_hz;
+  w.live.sample_rate_hz = job.plan.sample_rate_hz;
   w.live.campaign = id;
-  w.running_campaign = id;
-  const RunnerResult r = run_campaign(id, plan, ctx);
-  w.running_campaign = 0;
+  const RunnerResult r = run_campaign(job, ctx);
   w.live.campaign = 0;
-  spdlog::info("rig '{}': campaign {} ended {} ({} samples, {} missed deadlines, {} late wake-ups, {} dropped){}{}", w.entry.name, id,
-               r.state, r.samples, r.missed_deadlines, r.late_wakeups, r.dropped, r.reason.empty() ? "" : ": ", r.reason);
+  spdlog::info("rig '{}': campaign {} ended {} ({} samples, {} missed deadlines, {} late wake-ups, {} gaps, {} dropped){}{}", w.entry.name,
+               id, to_string(r.end), r.samples, r.missed_deadlines, r.late_wakeups, r.gaps, r.dropped, r.reason.empty() ? "" : ": ", r.reason);
 }
 
-// Between campaigns: one read, shown live (run 0). Errors are the driver's to count and log.
-void idle_sample(RigWorker& w, double t) {
+void rig_command(RigWorker& w, RigCommand c, double t) {
+  if (c == RigCommand::estop) w.supervisor->estop(t, "e-stop by the operator");
+  else w.supervisor->begin_reset(t);
+}
+
+// Between campaigns: one supervised read, shown live (run 0); the simulator restarted if it died.
+void idle_tick(RigWorker& w, double t, const std::string& base) {
+  if (w.sim && !w.sim->alive()) {
+    spdlog::warn("rig '{}': the simulator died; starting a new one", w.entry.name);
+    w.build_rig(base);
+  }
+  StatusView v;
+  double x = 0, f = 0;
+  std::error_code ec;
   if (w.info.kind == "shaker") {
     drivers::ShakerSample s;
-    if (!w.rig->read_shaker(t, s))
-      w.live.ring.push({mono_now(), t, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, 0, s.status_word});
-    return;
+    ec = w.rig->read_shaker(t, s);
+    v = {s.status_word, s.fault_code, 0.0};
+    x = s.mass_displacement_mm, f = s.mass_accel_m_s2;
+    if (!ec) w.live.ring.push({mono_now(), t, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, 0, s.status_word});
+  } else {
+    drivers::RigSample s;
+    ec = w.rig->read_sample(t, s);
+    v = {s.status_word, s.fault_code, s.displacement_mm};
+    x = s.displacement_mm, f = s.force_N;
+    if (!ec) w.live.ring.push({mono_now(), t, s.command_mm, s.displacement_mm, s.force_N, 0, s.status_word});
   }
-  drivers::RigSample s;
-  if (!w.rig->read_sample(t, s)) w.live.ring.push({mono_now(), t, s.command_mm, s.displacement_mm, s.force_N, 0, s.status_word});
+  if (ec) w.supervisor->on_link_error(t, ec);
+  else (void)w.supervisor->on_status(t, v);
+  w.supervisor->heartbeat(t);
+  w.update_snapshot(v, x, f, !ec);
 }
 
+// An exception escaped a campaign or a tick: hold the rig, fail the campaign, keep the thread.
+void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, double t) {
+  spdlog::error("rig '{}': {}: rig held", w.entry.name, what);
+  try {
+    if (w.supervisor) w.supervisor->disarm(t, "error on the acquisition thread: " + what);
+  } catch (...) {  // nothing more to do here; the next tick re-asserts the hold
+  }
+  if (const std::int64_t id = w.running_campaign.exchange(0)) {
+    const std::string now = now_iso(), reason = "error on the acquisition thread: " + what + "; the rig is held";
+    writer.post([id, reason, now](db::Store& s) { s.transition(id, "failed", reason, now); });
+  }
+  w.live.campaign = 0;
+}
 }  // namespace
 
-void rig_thread(RigWorker& w, const std::string& db_path, db::SampleWriter& writer, const std::atomic<bool>& stop,
+void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish, const std::atomic<bool>& stop,
                 const std::string& base) {
   // Ahead of everything else in the process when the system allows it; otherwise it says so once.
   spdlog::info("rig '{}': acquisition thread at {}", w.entry.name, enter_acquisition_thread(w.acquisition));
-  db::Store store(db_path);
   const double t0 = mono_now();
+  auto rig_time = [&] { return (mono_now() - t0) * w.entry.time_scale; };
   (void)w.rig->connect(0.0);
   while (!stop) {
-    const auto queued = store.queued_campaigns(w.info.id);
-    if (!queued.empty()) {
-      run_one(w, queued.front(), store, writer, stop, base);
-      continue;
+    try {
+      while (auto c = w.pop_rig_command()) rig_command(w, *c, rig_time());
+      if (auto job = w.pop_job()) {
+        run_job(w, std::move(*job), writer, finish, stop, t0);
+        w.running_campaign = 0;
+        continue;
+      }
+      idle_tick(w, rig_time(), base);
+      w.wait(0.05);
+    } catch (const std::exception& e) {
+      contain(w, writer, e.what(), rig_time());
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    } catch (...) {
+      contain(w, writer, "unknown exception", rig_time());
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
-    idle_sample(w, (mono_now() - t0) * w.entry.time_scale);
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  try {
+    w.supervisor->disarm(rig_time(), "the daemon is stopping");
+  } catch (...) {  // stopping anyway
   }
 }
 

@@ -1,7 +1,10 @@
 #pragma once
-// One rig inside the daemon: its driver (and supervised simulator), its acquisition thread that
-// runs the rig's queued campaigns one after another, and the controls queued for the campaign.
+// One rig inside the daemon: its driver (and supervised simulator), its supervisor, and its
+// acquisition thread, which takes campaigns and operator commands from in-process queues (never
+// from the database) and runs them one after another. Everything it stores goes through the
+// writer thread; the final fits through the finisher.
 #include <atomic>
+#include <condition_variable>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -11,7 +14,9 @@
 
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/daemon.hpp"
+#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/live_feed.hpp"
+#include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/drivers/rig.hpp"
 #include "sim_child.hpp"
@@ -26,20 +31,42 @@ struct RigWorker {
   RigInfo info;
   std::unique_ptr<SimChild> sim;
   std::unique_ptr<drivers::Rig> rig;
+  std::unique_ptr<Supervisor> supervisor;
   RigLive live;
-  std::mutex mu;
-  std::deque<Control> controls;
-  std::atomic<std::int64_t> running_campaign{0};
   std::thread thread;
+  std::atomic<std::int64_t> running_campaign{0};
 
   void build_rig(const std::string& base);  // throws drivers::RigConfigError
-  void push(Control c);
-  std::optional<Control> pop();
+  // From other threads: a campaign, a campaign control, a rig command. Never blocks on I/O.
+  void push_job(CampaignJob job);
+  void push_control(Control c);
+  void push_rig_command(RigCommand c);
+  // Takes a queued (not yet started) campaign out of the queue; false when it is not there.
+  bool cancel_queued(std::int64_t campaign);
+  [[nodiscard]] bool has_queued(std::int64_t campaign);
+  [[nodiscard]] RigSupervision snapshot() const;
+
+  // The acquisition thread's side.
+  std::optional<CampaignJob> pop_job();
+  std::optional<Control> pop_control();
+  std::optional<RigCommand> pop_rig_command();
+  void wait(double seconds);
+  void record(const RigTransition& t);  // the supervisor's transitions, for the API and the log
+  void update_snapshot(const StatusView& v, double x, double f, bool have_sample);
+
+ private:
+  mutable std::mutex mu_;
+  std::condition_variable cv_;
+  std::deque<CampaignJob> jobs_;
+  std::deque<Control> controls_;
+  std::deque<RigCommand> rig_commands_;
+  RigSupervision snap_;
 };
 
-// The rig's acquisition thread: queued campaigns in order; between them, a sample now and then
-// so the rig's live view stays fresh.
-void rig_thread(RigWorker& w, const std::string& db_path, db::SampleWriter& writer, const std::atomic<bool>& stop,
-                const std::string& base);
+// The rig's acquisition thread: operator commands first, then queued campaigns in order; between
+// them the rig is sampled every 50 ms (supervised, shown live). Every exception is caught here:
+// the rig is held, the campaign failed with the reason, and the thread goes on.
+void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish,
+                const std::atomic<bool>& stop, const std::string& base);
 
 }  // namespace hystlab::daemon

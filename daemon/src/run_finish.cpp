@@ -1,6 +1,8 @@
 #include "run_finish.hpp"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "hystlab/models/accuracy.hpp"
 #include "hystlab/models/fot_identification.hpp"
@@ -40,41 +42,62 @@ void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const mode
   });
 }
 
-void finish_run(RunnerResult& r, std::int64_t campaign, const Plan& plan, const models::OnlineTableBuilder* builder,
-                OnlineFot* fot, const RunSeries& series, RunnerContext& ctx) {
-  if (fot) {
-    fot->finish();  // the last descent ends here: evaluate it like the others
-    if (fot->take_descent_completed() && builder) post_evaluation(ctx.writer, campaign, *builder, series, ctx.now_iso());
+namespace {
+// The fot tables of a finished campaign: the calibrated table from every node, with its accuracy
+// on every sample of every run, drift and provenance; and the constrained least-squares table.
+std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const std::string& now, std::string& note) {
+  std::vector<db::Store::TableRecord> out;
+  const Plan& plan = j.plan;
+  const models::EverettTable table = j.builder->table();
+  const models::DriftReport drift = models::drift_report(*j.builder);
+  const json acc = accuracy_json(evaluate(table, j.series.x, j.series.f));
+  const std::string source = "campaign " + std::to_string(j.campaign), run = "run " + std::to_string(j.result.run_id);
+  models::TableProvenance prov{source, "fot", now, run,
+                               {{"accuracy", acc}, {"drift_max_spread_N", drift.max_spread}, {"drift_pooled_std_N", drift.pooled_std}}};
+  out.push_back({"fot", plan.subdivisions, plan.lo_mm, plan.hi_mm, acc.dump(), models::table_to_json(table, prov).dump()});
+  const int n = std::min(plan.subdivisions, 24);
+  try {
+    const models::LsqFitResult fit = models::fit_preisach_lsq(j.series.x, j.series.f, models::Grid::make(plan.lo_mm, plan.hi_mm, n));
+    const json lacc = accuracy_json(evaluate(fit.table, j.series.x, j.series.f));
+    models::TableProvenance lp{source, "lsq", now, run, {{"accuracy", lacc}, {"lambda", fit.lambda}, {"rms_residual_N", fit.rms_residual}}};
+    out.push_back({"lsq", n, plan.lo_mm, plan.hi_mm, lacc.dump(), models::table_to_json(fit.table, lp).dump()});
+  } catch (const std::invalid_argument& e) {
+    note = std::string("; least-squares table skipped: ") + e.what();
   }
-  ctx.writer.flush();  // every sample, node and event of the run is on disk before the tables
-  const std::string now = ctx.now_iso();
-  if (r.state == "completed" && builder) {
-    if (!builder->complete()) {
-      r.state = "failed";
-      r.reason = "the input ended with " + std::to_string(builder->identified_nodes()) + " of " +
-                 std::to_string(builder->required_nodes()) + " FOT nodes measured";
+  return out;
+}
+}  // namespace
+
+RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::function<std::string()>& now_iso) {
+  RunnerResult r = j.result;
+  const std::string now = now_iso();
+  std::vector<db::Store::TableRecord> tables;
+  std::string note;
+  if (r.end == CampaignEnd::completed && j.builder) {
+    if (!j.builder->complete()) {
+      r.end = CampaignEnd::failed;
+      r.reason = "the input ended with " + std::to_string(j.builder->identified_nodes()) + " of " +
+                 std::to_string(j.builder->required_nodes()) + " FOT nodes measured";
     } else {
-      const models::EverettTable table = builder->table();
-      const models::DriftReport drift = models::drift_report(*builder);
-      const json acc = accuracy_json(evaluate(table, series.x, series.f));
-      models::TableProvenance prov{"campaign " + std::to_string(campaign), "fot", now, "run " + std::to_string(r.run_id),
-                                   {{"accuracy", acc}, {"drift_max_spread_N", drift.max_spread}, {"drift_pooled_std_N", drift.pooled_std}}};
-      r.table_id = ctx.store.add_table(campaign, r.run_id, "fot", plan.subdivisions, plan.lo_mm, plan.hi_mm, now, acc.dump(),
-                                       models::table_to_json(table, prov).dump());
-      const int n = std::min(plan.subdivisions, 24);
-      try {
-        const models::LsqFitResult fit = models::fit_preisach_lsq(series.x, series.f, models::Grid::make(plan.lo_mm, plan.hi_mm, n));
-        const json lacc = accuracy_json(evaluate(fit.table, series.x, series.f));
-        models::TableProvenance lp{"campaign " + std::to_string(campaign), "lsq", now, "run " + std::to_string(r.run_id),
-                                   {{"accuracy", lacc}, {"lambda", fit.lambda}, {"rms_residual_N", fit.rms_residual}}};
-        r.lsq_table_id = ctx.store.add_table(campaign, r.run_id, "lsq", n, plan.lo_mm, plan.hi_mm, now, lacc.dump(),
-                                             models::table_to_json(fit.table, lp).dump());
-      } catch (const std::invalid_argument& e) {
-        ctx.store.add_event(campaign, "fit", json{{"lsq_skipped", e.what()}}.dump(), now);
-      }
+      tables = fot_tables(j, now, note);
     }
   }
-  ctx.store.end_run(r.run_id, r.state, now);
+  const std::string state = to_string(r.end);
+  const std::string reason = (r.reason.empty() ? std::string("finished") : r.reason) + note;
+  const auto campaign = j.campaign, run = r.run_id;
+  // Retried: a busy database delays the end of a campaign, it never loses it.
+  for (int attempt = 0; attempt < 30; ++attempt) {
+    auto ids = writer.call<std::vector<std::int64_t>>(
+        [campaign, run, tables, state, reason, now](db::Store& s) { return s.finish_run(campaign, run, tables, state, reason, now); }, 10.0);
+    if (ids) {
+      if (ids->size() > 0) r.table_id = (*ids)[0];
+      if (ids->size() > 1) r.lsq_table_id = (*ids)[1];
+      r.reason = reason == "finished" ? "" : reason;
+      return r;
+    }
+  }
+  r.reason = reason + "; the database did not take the end of the campaign";
+  return r;
 }
 
 }  // namespace hystlab::daemon

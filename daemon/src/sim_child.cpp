@@ -27,6 +27,14 @@ std::string find_simulator() {
   return "hystlab-sim";
 }
 
+bool SimChild::alive() {
+  if (pid_ <= 0) return false;
+  int st = 0;
+  if (waitpid(pid_, &st, WNOHANG) == 0) return true;
+  pid_ = -1;
+  return false;
+}
+
 int SimChild::ensure_running() {
   if (pid_ > 0) {
     int st = 0;

@@ -17,6 +17,7 @@ class SimChild {
   // Starts it (again) if it is not running; returns its Modbus TCP port. Throws on failure.
   int ensure_running();
   void stop();
+  [[nodiscard]] bool alive();  // false once it has exited (reaped here)
   [[nodiscard]] int port() const noexcept { return port_; }
 
  private:

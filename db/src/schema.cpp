@@ -50,6 +50,11 @@ CREATE TABLE commands(
   created_at TEXT NOT NULL, handled_at TEXT);
 CREATE INDEX commands_pending ON commands(handled_at, id);
 )sql",
+    // 3: operator commands for a rig (reset, estop), apart from any campaign.
+    R"sql(
+CREATE TABLE rig_commands(
+  id INTEGER PRIMARY KEY, rig TEXT NOT NULL, command TEXT NOT NULL, created_at TEXT NOT NULL, handled_at TEXT);
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof kMigrations / sizeof kMigrations[0]);
 static_assert(kMigrationCount == kSchemaVersion);

@@ -12,8 +12,8 @@
 namespace hystlab::db {
 namespace {
 std::atomic<std::uint64_t> g_records{0};
-void records_changed() noexcept { g_records.fetch_add(1, std::memory_order_release); }
 }  // namespace
+void records_changed() noexcept { g_records.fetch_add(1, std::memory_order_release); }
 
 std::uint64_t record_generation() noexcept { return g_records.load(std::memory_order_acquire); }
 namespace {
@@ -77,6 +77,12 @@ std::int64_t Store::create_campaign(std::int64_t rig, const std::string& kind, c
 
 void Store::transition(std::int64_t id, const std::string& to, const std::string& reason, const std::string& now) {
   Transaction tx(db_);
+  transition_in(id, to, reason, now);
+  tx.commit();
+  records_changed();
+}
+
+void Store::transition_in(std::int64_t id, const std::string& to, const std::string& reason, const std::string& now) {
   Statement cur(db_, "SELECT state FROM campaigns WHERE id = ?");
   cur.bind(1, id);
   if (!cur.step()) throw DbError("no campaign " + std::to_string(id), 0);
@@ -87,8 +93,6 @@ void Store::transition(std::int64_t id, const std::string& to, const std::string
   Statement ev(db_, "INSERT INTO events(campaign_id, at, kind, from_state, to_state, detail) VALUES(?,?,'state',?,?,?)");
   ev.bind(1, id).bind(2, now).bind(3, from).bind(4, to).bind(5, reason);
   ev.step();
-  tx.commit();
-  records_changed();
 }
 
 std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, double wall, double mono) {
@@ -148,7 +152,9 @@ int Store::mark_interrupted(const std::string& now) {
     Statement st(db_, "SELECT id FROM campaigns WHERE state IN ('arming', 'running', 'paused')");
     while (st.step()) ids.push_back(st.column_int(0));
   }
-  for (auto id : ids) transition(id, "interrupted", "the daemon stopped without finishing it", now);
+  for (auto id : ids)
+    if (table_count(id) > 0) transition(id, "completed", "its tables were stored before the daemon stopped", now);
+    else transition(id, "interrupted", "the daemon stopped without finishing it", now);
   Statement runs(db_, "UPDATE runs SET state = 'interrupted', ended_at = ? WHERE state = 'running'");
   runs.bind(1, now);
   runs.step();

@@ -29,6 +29,8 @@ void CanEndpoint::receive(SimRig& rig) {
       set(Signal::enable, c->enable);
       set(Signal::hold, c->hold);
       set(Signal::estop, c->estop);
+      set(Signal::fault_reset, c->fault_reset);
+      set(Signal::mode, c->mode);
     } else if (const auto* s = std::get_if<can::ShakerCommand>(&m)) {
       set(Signal::drive_frequency_hz, s->frequency_hz);
       set(Signal::drive_amplitude_mm, s->amplitude_mm);

@@ -23,52 +23,65 @@ double SmoothedSpecimen::step(double x) noexcept {
 }
 
 LoadFrameSim::LoadFrameSim(std::unique_ptr<models::HysteresisModel> specimen, LoadFrameParams params)
-    : p_(params), specimen_(std::move(specimen), params.corner_width_mm), rng_(params.seed) {
-  state_.status_word = st::ready;
+    : p_(params), specimen_(std::move(specimen), params.corner_width_mm), ctl_(params.controller), rng_(params.seed) {
+  state_.status_word = static_cast<std::uint16_t>(ctl_.status_bits());
 }
 
 void LoadFrameSim::set_commands(const LoadFrameCommands& c) noexcept {
   cmd_ = c;
-  if (c.estop && !tripped_) {
-    tripped_ = true;
-    state_.fault_code = kEstopPressed;
-  }
+  ctl_.command(HostCommands{c.enable, c.estop, c.fault_reset, c.mode, c.host_heartbeat}, state_.time_s, limit_cause_present());
+  publish_status(false);  // a host reading right after its write sees the latch or the reset
 }
 
-void LoadFrameSim::reset_fault() noexcept {
-  if (cmd_.estop) return;
-  tripped_ = false;
-  state_.fault_code = kNoFault;
+void LoadFrameSim::press_estop() noexcept {
+  ctl_.press_estop();
+  publish_status(false);
+}
+
+void LoadFrameSim::latch_fault(std::uint16_t code) noexcept {
+  ctl_.latch(code);
+  publish_status(false);
+}
+
+// A reset cannot clear a limit trip while the frame is still beyond the limit.
+bool LoadFrameSim::limit_cause_present() const noexcept {
+  const std::uint16_t code = ctl_.fault_code();
+  return (code == kDisplacementLimit && std::fabs(state_.displacement_mm) > p_.limit_mm) ||
+         (code == kForceLimit && std::fabs(state_.force_N) > p_.load_cell_range_N);
+}
+
+void LoadFrameSim::check_limits() noexcept {
+  if (std::fabs(state_.displacement_mm) > p_.limit_mm) ctl_.latch(kDisplacementLimit);
+  if (std::fabs(state_.force_N) > p_.load_cell_range_N) ctl_.latch(kForceLimit);
+}
+
+void LoadFrameSim::publish_status(bool driving) noexcept {
+  const LoadFrameState& s = state_;
+  // Inside the dead band the servo has stopped correcting: that is not motion.
+  const double settled = std::max(1e-4, p_.deadband_mm);
+  const bool moving = std::fabs(s.command_mm - s.displacement_mm) > settled || (driving && s.command_mm != cmd_.setpoint_mm);
+  state_.fault_code = ctl_.fault_code();
+  state_.status_word = static_cast<std::uint16_t>(ctl_.status_bits() | (cmd_.hold ? st::holding : 0U) | (moving ? st::moving : 0U));
 }
 
 void LoadFrameSim::step(double dt) noexcept {
   LoadFrameState& s = state_;
   s.time_s += dt;
-  const bool driving = cmd_.enable && !cmd_.hold && !tripped_;
+  const bool driving = ctl_.drive_on() && !cmd_.hold;
   if (driving) {  // command moves toward the setpoint at the ramp rate (and never faster than the valve)
     const double rate = std::min(std::fabs(cmd_.ramp_rate_mm_s), p_.max_rate_mm_s);
     const double step = std::clamp(cmd_.setpoint_mm - s.command_mm, -rate * dt, rate * dt);
     s.command_mm += step;
-  } else if (tripped_) {
-    s.command_mm = s.displacement_mm;  // e-stop: the actuator holds where it is
+  } else if (ctl_.stopped()) {
+    s.command_mm = s.displacement_mm;  // a latched fault or e-stop: the actuator holds where it is
   }
-  s.displacement_mm += (s.command_mm - s.displacement_mm) * (1.0 - std::exp(-dt / p_.lag_s));
+  const double error = s.command_mm - s.displacement_mm;
+  if (std::fabs(error) >= p_.deadband_mm) s.displacement_mm += error * (1.0 - std::exp(-dt / p_.lag_s));
   const double f = specimen_.step(s.displacement_mm);
   s.force_N = f + p_.noise_N * noise_(rng_) + p_.drift_N_per_s * s.time_s;
-  if (!tripped_ && std::fabs(s.displacement_mm) > p_.limit_mm) {
-    tripped_ = true;
-    s.fault_code = kDisplacementLimit;
-  }
-  if (!tripped_ && std::fabs(s.force_N) > p_.load_cell_range_N) {
-    tripped_ = true;
-    s.fault_code = kForceLimit;
-  }
-  const bool moving = std::fabs(s.command_mm - s.displacement_mm) > 1e-4 || (driving && s.command_mm != cmd_.setpoint_mm);
-  s.status_word = static_cast<std::uint16_t>(
-      st::ready | (cmd_.enable && !tripped_ ? st::enabled : 0U) | (cmd_.hold ? st::holding : 0U) |
-      (cmd_.estop || s.fault_code == kEstopPressed ? st::estop : 0U) |
-      (s.fault_code == kDisplacementLimit || s.fault_code == kForceLimit ? st::limit_tripped : 0U) |
-      (tripped_ ? st::fault : 0U) | (moving ? st::moving : 0U));
+  check_limits();
+  ctl_.watch(s.time_s);
+  publish_status(ctl_.drive_on() && !cmd_.hold);
   ++s.heartbeat;
   ++s.sample_counter;
 }

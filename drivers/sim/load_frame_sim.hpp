@@ -1,12 +1,13 @@
 #pragma once
 // A virtual servo-hydraulic load frame: the actuator command follows the setpoint at the ramp
 // rate, the actuator follows the command with a first-order lag, the specimen (any hystlab
-// model) gives the force, the load cell adds noise and drift. Hard limits trip an e-stop.
-// Pure: time is passed in.
+// model) gives the force, the load cell adds noise and drift. Hard limits, the e-stop and the
+// host watchdog latch faults (Controller). Pure: time is passed in.
 #include <cstdint>
 #include <memory>
 #include <random>
 
+#include "controller.hpp"
 #include "hystlab/models/hysteresis_model.hpp"
 
 namespace hystlab::sim {
@@ -19,7 +20,9 @@ struct LoadFrameParams {
   double noise_N = 0.05;             // load cell noise, 1 σ
   double drift_N_per_s = 0.0;        // slow load cell drift
   double corner_width_mm = 0.05;      // corner smoothing of the specimen (0: none)
+  double deadband_mm = 0;            // the servo stops correcting when |command - displacement| < this
   std::uint64_t seed = 1;
+  ControllerParams controller;       // mode interlock and host watchdog (default: neither)
 };
 
 // The specimen's force with its corners rounded: a first-order filter in displacement (not in
@@ -38,6 +41,9 @@ class SmoothedSpecimen {
 struct LoadFrameCommands {
   double setpoint_mm = 0, ramp_rate_mm_s = 1;
   bool enable = false, hold = false, estop = false;
+  bool fault_reset = false;
+  std::uint16_t mode = 0;
+  std::uint32_t host_heartbeat = 0;
 };
 
 struct LoadFrameState {
@@ -46,24 +52,30 @@ struct LoadFrameState {
   std::uint32_t heartbeat = 0, sample_counter = 0;
 };
 
-enum FaultCode : std::uint16_t { kNoFault = 0, kDisplacementLimit = 1, kForceLimit = 2, kEstopPressed = 3 };
-
 class LoadFrameSim {
  public:
   LoadFrameSim(std::unique_ptr<models::HysteresisModel> specimen, LoadFrameParams params);
+  // The host's commands as last written (fault_reset acts on its rising edge).
   void set_commands(const LoadFrameCommands& c) noexcept;
   // Advances by dt (simulated seconds) and takes one sample.
   void step(double dt) noexcept;
   [[nodiscard]] const LoadFrameState& state() const noexcept { return state_; }
-  // Clears a tripped limit or e-stop once the e-stop is released (the operator's reset).
-  void reset_fault() noexcept;
+  // The operator: the e-stop button, a latched fault with its code, the servo's dead band.
+  void press_estop() noexcept;
+  void latch_fault(std::uint16_t code) noexcept;
+  void set_deadband(double mm) noexcept { p_.deadband_mm = mm; }
+  [[nodiscard]] double deadband() const noexcept { return p_.deadband_mm; }
+  [[nodiscard]] const Controller& controller() const noexcept { return ctl_; }
 
  private:
+  [[nodiscard]] bool limit_cause_present() const noexcept;
+  void check_limits() noexcept;
+  void publish_status(bool driving) noexcept;
   LoadFrameParams p_;
   SmoothedSpecimen specimen_;
   LoadFrameCommands cmd_;
   LoadFrameState state_;
-  bool tripped_ = false;
+  Controller ctl_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};
 };

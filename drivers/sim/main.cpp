@@ -42,7 +42,13 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --seed N  --noise N  --drift N_PER_S      load cell noise (1 sigma, N) and drift
   --params P.json | --table T.json          the specimen (default: Table 1, corners smoothed)
   --corner-width MM              corner smoothing width of the specimen (default 0.05; 0: none)
-  --fault SPEC                   start with a fault: drop, delay=MS, exception=CODE, crc, freeze, overload, can-silent
+  --fault SPEC                   start with a fault: drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload,
+                                 can-silent, or a controller event: estop, latch=CODE, deadband=MM
+  --deadband-mm D                load frame servo dead band: no correction while |command - displacement| < D (default 0)
+  --mode N                       the controller moves only while the map's mode register (CAN: the command's mode)
+                                 holds N (default 1; a map without mode has no interlock). It starts at 0
+  --host-timeout-ms T            stop with fault 4 when the host's host_heartbeat has not changed for T simulated ms
+                                 while the drive is on (default 0: off; a real controller would have it on)
   --control-port P               text control channel on 127.0.0.1 (default 0: any free port)
   --duration S                   stop after S wall-clock seconds (default: run until SIGTERM or 'quit')
   --exit-with-parent 1           stop when the process that started it is gone (a supervising daemon)
@@ -58,6 +64,7 @@ struct Args {
   std::string rig = "load_frame", transport = "tcp", address = "127.0.0.1", map, params, table;
   int port = 1502, can_fd = -1, can_node = 1, control_port = 0, realtime = 0;
   double time_scale = 1, sample_rate = 1000, can_rate = 1000, noise = 0.05, drift = 0, corner = 0.05, duration = 0;
+  double deadband_mm = 0, host_timeout_ms = 0, mode = 1;
   bool exit_with_parent = false;
   std::uint64_t seed = 1;
   std::vector<std::string> faults;
@@ -108,6 +115,9 @@ Args parse(int argc, char** argv) {
     else if (o == "--table") a.table = v;
     else if (o == "--corner-width") a.corner = num();
     else if (o == "--fault") a.faults.push_back(v);
+    else if (o == "--deadband-mm") a.deadband_mm = num();
+    else if (o == "--mode") a.mode = num();
+    else if (o == "--host-timeout-ms") a.host_timeout_ms = num();
     else if (o == "--control-port") a.control_port = static_cast<int>(num());
     else if (o == "--duration") a.duration = num();
     else if (o == "--exit-with-parent") a.exit_with_parent = num() != 0;
@@ -118,6 +128,9 @@ Args parse(int argc, char** argv) {
   if (a.transport != "tcp" && a.transport != "rtu" && a.transport != "can") throw std::runtime_error("--transport must be tcp, rtu or can");
   if (a.transport == "can" && a.can_fd < 0) throw std::runtime_error("--transport can needs --can-fd");
   if (!(a.time_scale > 0) || !(a.sample_rate > 0) || !(a.can_rate > 0)) throw std::runtime_error("rates and time scale must be > 0");
+  if (!(a.deadband_mm >= 0) || !std::isfinite(a.deadband_mm)) throw std::runtime_error("--deadband-mm must be a number >= 0");
+  if (!(a.host_timeout_ms >= 0) || !std::isfinite(a.host_timeout_ms)) throw std::runtime_error("--host-timeout-ms must be a number >= 0");
+  if (a.mode < 0 || a.mode > 65535 || a.mode != std::floor(a.mode)) throw std::runtime_error("--mode must be a whole number from 0 to 65535");
   return a;
 }
 
@@ -127,34 +140,57 @@ std::unique_ptr<models::HysteresisModel> specimen(const Args& a) {
   return std::make_unique<models::SimplifiedSmaModel>(p);
 }
 
-sim::SimRig make_rig(const Args& a) {
-  if (a.rig == "shaker") return sim::SimRig(std::make_unique<sim::ShakerSim>(*specimen(a), sim::ShakerParams{}));
+// The Modbus map (none on CAN), checked against the rig and the sample rate.
+std::optional<protocols::RegisterMap> load_map(const Args& a) {
+  if (a.transport == "can") return std::nullopt;
+  const std::string text = a.map.empty() ? (a.rig == "shaker" ? protocols::kDefaultShakerMap : protocols::kDefaultLoadFrameMap) : read_file(a.map);
+  protocols::RegisterMap map = protocols::RegisterMap::from_json(text);
+  if ((map.kind() == protocols::RigKind::shaker) != (a.rig == "shaker")) throw std::runtime_error("the map is for another kind of rig than --rig " + a.rig);
+  if (const auto& w = map.sample_window(); w && std::fabs(w->period_s * a.sample_rate - 1.0) > 1e-9)
+    throw std::runtime_error("the map's sample_window.period_s (" + std::to_string(w->period_s) + " s) is not the period of --sample-rate " +
+                             std::to_string(a.sample_rate) + " Hz");
+  return map;
+}
+
+// The interlocks exist where the protocol carries their signals: CAN's load frame command has a
+// mode (its shaker command has none).
+sim::ControllerParams controller_params(const Args& a, const std::optional<protocols::RegisterMap>& map) {
+  sim::ControllerParams c;
+  c.mode = static_cast<std::uint16_t>(a.mode);
+  c.mode_interlock = map ? map->find(protocols::Signal::mode) != nullptr : a.rig == "load_frame";
+  c.host_timeout_s = map && map->find(protocols::Signal::host_heartbeat) ? a.host_timeout_ms * 1e-3 : 0.0;
+  return c;
+}
+
+sim::SimRig make_rig(const Args& a, const sim::ControllerParams& controller) {
+  if (a.rig == "shaker") {
+    sim::ShakerParams p;
+    p.controller = controller;
+    return sim::SimRig(std::make_unique<sim::ShakerSim>(*specimen(a), p));
+  }
   sim::LoadFrameParams p;
   p.noise_N = a.noise;
   p.drift_N_per_s = a.drift;
   p.corner_width_mm = a.corner;
+  p.deadband_mm = a.deadband_mm;
   p.seed = a.seed;
+  p.controller = controller;
   return sim::SimRig(std::make_unique<sim::LoadFrameSim>(specimen(a), p));
 }
 
 int run(const Args& a) {
-  sim::SimRig rig = make_rig(a);
+  std::optional<protocols::RegisterMap> map = load_map(a);
+  sim::SimRig rig = make_rig(a, controller_params(a, map));
   sim::Faults faults;
   for (const auto& f : a.faults)
-    if (const std::string err = faults.apply(f); !err.empty()) throw std::runtime_error(err);
+    if (const std::string err = sim::apply_fault(f, faults, rig); !err.empty()) throw std::runtime_error(err);
   std::optional<sim::ModbusEndpoint> modbus;
   std::optional<sim::CanEndpoint> can;
   if (a.transport == "can") {
     can.emplace(a.can_fd, a.can_node, a.can_rate);
   } else {
-    const std::string text = a.map.empty() ? (a.rig == "shaker" ? protocols::kDefaultShakerMap : protocols::kDefaultLoadFrameMap) : read_file(a.map);
-    protocols::RegisterMap map = protocols::RegisterMap::from_json(text);
-    if (map.kind() != rig.kind()) throw std::runtime_error("the map is for another kind of rig than --rig " + a.rig);
-    if (const auto& w = map.sample_window(); w && std::fabs(w->period_s * a.sample_rate - 1.0) > 1e-9)
-      throw std::runtime_error("the map's sample_window.period_s (" + std::to_string(w->period_s) + " s) is not the period of --sample-rate " +
-                               std::to_string(a.sample_rate) + " Hz");
     modbus.emplace(a.transport == "tcp" ? sim::ModbusEndpoint::Transport::tcp : sim::ModbusEndpoint::Transport::rtu,
-                   a.address, a.port, std::move(map));
+                   a.address, a.port, std::move(*map));
     std::cout << modbus->where() << "\n";
   }
   if (a.realtime > 0) {
@@ -214,7 +250,7 @@ int run(const Args& a) {
       if (control.owns(p.fd)) {
         std::ostringstream status;
         status << "t=" << rig.time_s();
-        if (control.handle(p.fd, faults, status.str())) g_stop = 1;
+        if (control.handle(p.fd, faults, rig, status.str())) g_stop = 1;
       } else if (can && p.fd == can->fd()) {
         can->receive(rig);
       } else if (modbus) {

@@ -129,7 +129,17 @@ void ModbusEndpoint::serve(int fd, const Faults& faults, SimRig& rig) {
   }
   modbus_reply(ctx_, query, rc, mapping_);
   const int fn = query[modbus_get_header_length(ctx_)];
-  if (fn == 0x05 || fn == 0x06 || fn == 0x0F || fn == 0x10) rig.apply(written_commands());
+  if (fn == 0x05 || fn == 0x06 || fn == 0x0F || fn == 0x10) {
+    rig.apply(written_commands());
+    show_enable(rig);
+  }
+}
+
+// A reset drops the drive's enable; the coil says so, and the host must write it again (an
+// edge) before the drive moves, as on a real controller.
+void ModbusEndpoint::show_enable(const SimRig& rig) {
+  const protocols::MapEntry* e = map_.find(rig.enable_signal());
+  if (e && e->table == ModbusTable::coil) mapping_->tab_bits[e->address] = rig.enable_command() ? 1 : 0;
 }
 
 // An RTU answer of the right shape whose CRC is wrong (fault injection).

@@ -34,6 +34,7 @@ class ModbusEndpoint {
 
  private:
   void serve(int fd, const Faults& faults, SimRig& rig);
+  void show_enable(const SimRig& rig);
   void reply_with_bad_crc(const std::uint8_t* query, int length);
   SignalValues written_commands() const;
 

@@ -11,7 +11,7 @@ namespace {
 constexpr double kG = 9.81;
 }
 
-ShakerSim::ShakerSim(const models::HysteresisModel& spring, ShakerParams params) : p_(params) {
+ShakerSim::ShakerSim(const models::HysteresisModel& spring, ShakerParams params) : p_(params), ctl_(params.controller) {
   if (!(p_.mass_kg > 0) || p_.springs < 1 || !(p_.dt_s > 0)) throw std::invalid_argument("shaker: mass, springs and dt must be > 0");
   const double omega = std::sqrt(p_.springs * p_.k_max_N_per_mm * 1e3 / p_.mass_kg);
   if (omega * p_.dt_s > 0.5) throw std::invalid_argument("shaker: time step too large for the spring stiffness (dt·ω > 0.5)");
@@ -29,22 +29,49 @@ ShakerSim::ShakerSim(const models::HysteresisModel& spring, ShakerParams params)
     springs_.back()->reset();
     springs_.back()->step(preload_mm_);
   }
-  state_.status_word = protocols::status::ready;
+  publish_status();
+}
+
+void ShakerSim::set_commands(const ShakerCommands& c) noexcept {
+  cmd_ = c;
+  ctl_.command(HostCommands{c.enable, c.estop, c.fault_reset, c.mode, c.host_heartbeat}, state_.time_s, false);
+  publish_status();
 }
 
 void ShakerSim::set_drive(double frequency_hz, double amplitude_mm, bool enable) noexcept {
-  frequency_ = frequency_hz;
-  amplitude_m_ = amplitude_mm * 1e-3;
-  enable_ = enable;
+  ShakerCommands c = cmd_;
+  c.frequency_hz = frequency_hz;
+  c.amplitude_mm = amplitude_mm;
+  c.enable = enable;
+  set_commands(c);
+}
+
+void ShakerSim::press_estop() noexcept {
+  ctl_.press_estop();
+  publish_status();
+}
+
+void ShakerSim::latch_fault(std::uint16_t code) noexcept {
+  ctl_.latch(code);
+  publish_status();
+}
+
+void ShakerSim::publish_status() noexcept {
+  const bool shaking = ctl_.drive_on() && cmd_.amplitude_mm > 0 && cmd_.frequency_hz > 0;
+  state_.fault_code = ctl_.fault_code();
+  state_.status_word = static_cast<std::uint16_t>(ctl_.status_bits() | (shaking ? protocols::status::moving : 0U));
 }
 
 void ShakerSim::integrate_once() noexcept {
   const double dt = p_.dt_s;
-  const double w = 2 * std::numbers::pi * frequency_;
-  if (enable_) phase_ += w * dt;
-  const double y = enable_ ? amplitude_m_ * std::sin(phase_) : 0.0;
-  const double yd = enable_ ? amplitude_m_ * w * std::cos(phase_) : 0.0;
-  const double ydd = enable_ ? -amplitude_m_ * w * w * std::sin(phase_) : 0.0;
+  const double w = 2 * std::numbers::pi * cmd_.frequency_hz;
+  // Off, faulted or e-stopped: the drive goes to zero amplitude.
+  const bool on = ctl_.drive_on();
+  const double amplitude_m = cmd_.amplitude_mm * 1e-3;
+  if (on) phase_ += w * dt;
+  const double y = on ? amplitude_m * std::sin(phase_) : 0.0;
+  const double yd = on ? amplitude_m * w * std::cos(phase_) : 0.0;
+  const double ydd = on ? -amplitude_m * w * w * std::sin(phase_) : 0.0;
   const double compression_mm = preload_mm_ - (x_ - y) * 1e3;
   double force = 0;
   for (auto& s : springs_) force += s->step(compression_mm);
@@ -64,7 +91,8 @@ void ShakerSim::step(double dt) noexcept {
     carry_ -= p_.dt_s;
   }
   state_.time_s += dt;
-  state_.status_word = static_cast<std::uint16_t>(protocols::status::ready | (enable_ ? protocols::status::enabled : 0U));
+  ctl_.watch(state_.time_s);
+  publish_status();
   ++state_.heartbeat;
   ++state_.sample_counter;
 }

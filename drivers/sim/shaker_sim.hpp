@@ -2,10 +2,12 @@
 // A virtual shaker: sine base excitation drives a mass on N SMA springs (the paper's Part II:
 // a mass on layers of tubes). Fixed-step semi-implicit Euler; each spring's hysteretic force is
 // updated once per step. Stable while dt·sqrt(N·k_max/m) << 2 (checked at construction).
+// The controller's latches (Controller) stop the drive: zero amplitude, enable ignored.
 #include <cstdint>
 #include <memory>
 #include <vector>
 
+#include "controller.hpp"
 #include "hystlab/models/hysteresis_model.hpp"
 
 namespace hystlab::sim {
@@ -16,6 +18,14 @@ struct ShakerParams {
   double damping_N_s_per_m = 2.0;  // a little structural damping
   double k_max_N_per_mm = 150;     // stiffest line of the spring model, for the stability check
   double dt_s = 1e-4;
+  ControllerParams controller;     // mode interlock and host watchdog (default: neither)
+};
+
+struct ShakerCommands {
+  double frequency_hz = 0, amplitude_mm = 0;
+  bool enable = false, estop = false, fault_reset = false;
+  std::uint16_t mode = 0;
+  std::uint32_t host_heartbeat = 0;
 };
 
 struct ShakerState {
@@ -28,18 +38,26 @@ class ShakerSim {
  public:
   // spring: prototype of one spring's model (compression in mm -> force in N); cloned N times.
   ShakerSim(const models::HysteresisModel& spring, ShakerParams params);  // throws if unstable
+  // The host's commands as last written (fault_reset acts on its rising edge).
+  void set_commands(const ShakerCommands& c) noexcept;
+  // Only the drive; the other commands stay as they were.
   void set_drive(double frequency_hz, double amplitude_mm, bool enable) noexcept;
   void step(double dt) noexcept;  // advances by dt in fixed internal steps
+  void press_estop() noexcept;
+  void latch_fault(std::uint16_t code) noexcept;
+  [[nodiscard]] const Controller& controller() const noexcept { return ctl_; }
   [[nodiscard]] const ShakerState& state() const noexcept { return state_; }
   [[nodiscard]] double preload_mm() const noexcept { return preload_mm_; }
 
  private:
   void integrate_once() noexcept;
+  void publish_status() noexcept;
   ShakerParams p_;
+  ShakerCommands cmd_;
+  Controller ctl_;
   std::vector<std::unique_ptr<models::HysteresisModel>> springs_;
   ShakerState state_;
-  double frequency_ = 0, amplitude_m_ = 0, phase_ = 0, carry_ = 0;
-  bool enable_ = false;
+  double phase_ = 0, carry_ = 0;
   double x_ = 0, v_ = 0, preload_mm_ = 0;  // mass displacement (m, from static equilibrium) and velocity
 };
 

@@ -1,5 +1,6 @@
 #include "sim_rig.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -11,38 +12,18 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 double& at(SignalValues& v, Signal s) { return v[static_cast<std::size_t>(s)]; }
 double at(const SignalValues& v, Signal s) { return v[static_cast<std::size_t>(s)]; }
+
+// The controller's commands common to both rigs; a value not given keeps the last one.
+template <class Commands>
+void apply_controller_commands(const SignalValues& v, Commands& c) {
+  auto given = [&](Signal s) { return !std::isnan(at(v, s)); };
+  if (given(Signal::estop)) c.estop = at(v, Signal::estop) != 0;
+  if (given(Signal::fault_reset)) c.fault_reset = at(v, Signal::fault_reset) != 0;
+  if (given(Signal::mode)) c.mode = static_cast<std::uint16_t>(std::clamp(at(v, Signal::mode), 0.0, 65535.0));
+  if (given(Signal::host_heartbeat))
+    c.host_heartbeat = static_cast<std::uint32_t>(std::clamp(at(v, Signal::host_heartbeat), 0.0, 4294967295.0));
+}
 }  // namespace
-
-std::string Faults::apply(const std::string& spec) {
-  const auto eq = spec.find('=');
-  const std::string name = spec.substr(0, eq);
-  int value = 0;
-  if (eq != std::string::npos) {
-    try {
-      value = std::stoi(spec.substr(eq + 1));
-    } catch (...) {
-      return "fault '" + name + "': value '" + spec.substr(eq + 1) + "' is not a whole number";
-    }
-  }
-  if (name == "drop") drop = true;
-  else if (name == "delay") delay_ms = value > 0 ? value : 200;
-  else if (name == "stall") stall_ms = value > 0 ? value : 30;
-  else if (name == "exception") exception = value > 0 ? value : 4;
-  else if (name == "crc") crc = true;
-  else if (name == "freeze") freeze = true;
-  else if (name == "overload") overload = true;
-  else if (name == "can-silent") can_silent = true;
-  else if (name == "clear") *this = Faults{};
-  else return "unknown fault '" + name + "' (drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload, can-silent, clear)";
-  return "";
-}
-
-std::string Faults::describe() const {
-  std::ostringstream s;
-  s << "drop=" << drop << " delay=" << delay_ms << " stall=" << stall_ms << " exception=" << exception << " crc=" << crc << " freeze=" << freeze
-    << " overload=" << overload << " can-silent=" << can_silent;
-  return s.str();
-}
 
 void SimRig::step(double dt) noexcept {
   if (frame_) frame_->step(dt);
@@ -56,20 +37,41 @@ void SimRig::apply(const SignalValues& v) noexcept {
     if (given(Signal::ramp_rate_mm_s)) frame_cmd_.ramp_rate_mm_s = at(v, Signal::ramp_rate_mm_s);
     if (given(Signal::enable)) frame_cmd_.enable = at(v, Signal::enable) != 0;
     if (given(Signal::hold)) frame_cmd_.hold = at(v, Signal::hold) != 0;
-    if (given(Signal::estop)) {
-      const bool was = frame_cmd_.estop;
-      frame_cmd_.estop = at(v, Signal::estop) != 0;
-      frame_->set_commands(frame_cmd_);
-      if (was && !frame_cmd_.estop) frame_->reset_fault();  // releasing the e-stop resets the trip
-    }
+    apply_controller_commands(v, frame_cmd_);
     frame_->set_commands(frame_cmd_);
     return;
   }
-  if (given(Signal::drive_frequency_hz)) freq_ = at(v, Signal::drive_frequency_hz);
-  if (given(Signal::drive_amplitude_mm)) amp_ = at(v, Signal::drive_amplitude_mm);
-  if (given(Signal::shaker_enable)) shaker_on_ = at(v, Signal::shaker_enable) != 0;
-  if (given(Signal::estop) && at(v, Signal::estop) != 0) shaker_on_ = false;
-  shaker_->set_drive(freq_, amp_, shaker_on_);
+  if (given(Signal::drive_frequency_hz)) shaker_cmd_.frequency_hz = at(v, Signal::drive_frequency_hz);
+  if (given(Signal::drive_amplitude_mm)) shaker_cmd_.amplitude_mm = at(v, Signal::drive_amplitude_mm);
+  if (given(Signal::shaker_enable)) shaker_cmd_.enable = at(v, Signal::shaker_enable) != 0;
+  apply_controller_commands(v, shaker_cmd_);
+  shaker_->set_commands(shaker_cmd_);
+}
+
+void SimRig::press_estop() noexcept {
+  if (frame_) frame_->press_estop();
+  else shaker_->press_estop();
+}
+
+void SimRig::latch_fault(std::uint16_t code) noexcept {
+  if (frame_) frame_->latch_fault(code);
+  else shaker_->latch_fault(code);
+}
+
+std::string SimRig::set_deadband(double mm) {
+  if (!frame_) return "fault 'deadband': a shaker has no position servo";
+  frame_->set_deadband(mm);
+  return "";
+}
+
+bool SimRig::enable_command() const noexcept { return controller().enable_command(); }
+
+std::string SimRig::describe_controller() const {
+  std::ostringstream s;
+  const Controller& c = controller();
+  s << "fault_code=" << c.fault_code() << " stopped=" << c.stopped() << " enable=" << c.enable_command() << " mode_ok=" << c.mode_ok();
+  if (frame_) s << " deadband=" << frame_->deadband();
+  return s.str();
 }
 
 SignalValues SimRig::measurements(const Faults& faults) const noexcept {

@@ -1,11 +1,12 @@
 #pragma once
 // The simulated rig as the servers see it: signal values in, signal values out, whatever the
-// physics behind (load frame or shaker). Also the faults a test can inject.
+// physics behind (load frame or shaker), and the operator's controller events.
 #include <array>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "faults.hpp"
 #include "hystlab/protocols/signals.hpp"
 #include "load_frame_sim.hpp"
 #include "shaker_sim.hpp"
@@ -13,20 +14,6 @@
 namespace hystlab::sim {
 
 using SignalValues = std::array<double, protocols::kSignalCount>;
-
-struct Faults {
-  bool drop = false;        // close every Modbus connection and refuse new ones
-  int delay_ms = 0;         // answer late, with the values of when the request came
-  int stall_ms = 0;         // stop this long before each answer (physics too), like a starved process
-  int exception = 0;        // answer every request with this Modbus exception code
-  bool crc = false;         // RTU: corrupt the CRC of every answer
-  bool freeze = false;      // the measurements (and the sample counter) stop updating
-  bool overload = false;    // the force reads far beyond the load cell's range
-  bool can_silent = false;  // stop sending CAN status frames
-  // "drop", "delay=200", "exception=4", ...; returns an error message or "" when applied.
-  std::string apply(const std::string& spec);
-  [[nodiscard]] std::string describe() const;
-};
 
 class SimRig {
  public:
@@ -42,12 +29,24 @@ class SimRig {
   [[nodiscard]] SignalValues measurements(const Faults& faults) const noexcept;
   [[nodiscard]] double time_s() const noexcept { return frame_ ? frame_->state().time_s : shaker_->state().time_s; }
 
+  // The operator's controller events (control channel, --fault).
+  void press_estop() noexcept;
+  void latch_fault(std::uint16_t code) noexcept;
+  std::string set_deadband(double mm);  // an error message for a rig without a servo
+  // The enable command as the controller holds it: a reset drops it, and a Modbus server shows
+  // that in the enable coil, so the host must write enable again.
+  [[nodiscard]] protocols::Signal enable_signal() const noexcept {
+    return frame_ ? protocols::Signal::enable : protocols::Signal::shaker_enable;
+  }
+  [[nodiscard]] bool enable_command() const noexcept;
+  [[nodiscard]] std::string describe_controller() const;
+
  private:
+  [[nodiscard]] const Controller& controller() const noexcept { return frame_ ? frame_->controller() : shaker_->controller(); }
   std::unique_ptr<LoadFrameSim> frame_;
   std::unique_ptr<ShakerSim> shaker_;
   LoadFrameCommands frame_cmd_;
-  double freq_ = 0, amp_ = 0;
-  bool shaker_on_ = false;
+  ShakerCommands shaker_cmd_;
 };
 
 }  // namespace hystlab::sim

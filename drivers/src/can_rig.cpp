@@ -116,6 +116,23 @@ std::error_code CanRig::estop(bool on) noexcept {
   cmd_.estop = on;
   return send_command();
 }
+std::error_code CanRig::set_mode(std::uint16_t mode) noexcept {
+  if (mode > static_cast<std::uint16_t>(can::kMaxMode)) return RigError::out_of_range;
+  cmd_.mode = static_cast<std::uint8_t>(mode);
+  return send_command();
+}
+// Releases the e-stop and pulses the reset flag. The rig drops its drive's enable on the reset,
+// so ours goes to 0 too: the next arm(true) is the edge the rig needs to move again.
+std::error_code CanRig::reset_faults() noexcept {
+  cmd_.estop = false;
+  cmd_.enable = false;
+  if (auto ec = send_command()) return ec;
+  cmd_.fault_reset = true;
+  const std::error_code ec = send_command();
+  cmd_.fault_reset = false;
+  if (ec) return ec;
+  return send_command();
+}
 std::error_code CanRig::command_shaker(double f, double a, bool enable) noexcept {
   return send(can::ShakerCommand{f, a, enable});
 }

@@ -382,6 +382,23 @@ std::error_code ModbusRig::estop(bool on) noexcept { return write_signals({{Sign
 std::error_code ModbusRig::command(double setpoint_mm, double rate) noexcept {
   return write_signals({{Signal::setpoint_mm, setpoint_mm}, {Signal::ramp_rate_mm_s, rate}});
 }
+std::error_code ModbusRig::set_mode(std::uint16_t mode) noexcept {
+  if (!cfg_.map.find(Signal::mode)) return RigError::unsupported;
+  return write_signals({{Signal::mode, static_cast<double>(mode)}});
+}
+// Release the e-stop first: a controller ignores the reset while its e-stop signal is on.
+std::error_code ModbusRig::reset_faults() noexcept {
+  if (auto ec = estop(false)) return ec;
+  if (!cfg_.map.find(Signal::fault_reset)) return {};
+  if (auto ec = write_signals({{Signal::fault_reset, 1.0}})) return ec;
+  return write_signals({{Signal::fault_reset, 0.0}});  // the pulse ends: the next reset is a new edge
+}
+std::error_code ModbusRig::write_host_heartbeat(std::uint32_t value) noexcept {
+  const protocols::MapEntry* e = cfg_.map.find(Signal::host_heartbeat);
+  if (!e) return RigError::unsupported;
+  // A counter wraps: a 16-bit register carries the low 16 bits.
+  return write_signals({{Signal::host_heartbeat, static_cast<double>(e->width() == 1 ? value & 0xFFFFU : value)}});
+}
 std::error_code ModbusRig::command_shaker(double f, double a, bool enable) noexcept {
   return write_signals({{Signal::drive_frequency_hz, f}, {Signal::drive_amplitude_mm, a}, {Signal::shaker_enable, enable ? 1.0 : 0.0}});
 }

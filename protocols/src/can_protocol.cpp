@@ -50,7 +50,7 @@ std::error_code encode(const Message& m, int node, can_frame& f) noexcept {
     start(f, kCommand, node, 8);
     put(f, 0, sp);
     put(f, 4, rate);
-    f.data[6] = static_cast<std::uint8_t>((c->enable ? 1 : 0) | (c->hold ? 2 : 0) | (c->estop ? 4 : 0));
+    f.data[6] = static_cast<std::uint8_t>((c->enable ? 1 : 0) | (c->hold ? 2 : 0) | (c->estop ? 4 : 0) | (c->fault_reset ? 8 : 0));
     f.data[7] = c->mode;
   } else if (const auto* a = std::get_if<StatusA>(&m)) {
     std::int32_t d = 0, fo = 0;
@@ -100,10 +100,10 @@ std::error_code decode(const can_frame& f, int node, Message& out) noexcept {
   switch (id - static_cast<std::uint32_t>(node)) {
     case kCommand: {
       if (!need(8)) return ProtocolError::wrong_length;
-      if (f.data[6] & ~0x07U) return ProtocolError::reserved_bits;
+      if (f.data[6] & ~0x0FU) return ProtocolError::reserved_bits;
       if (f.data[7] > kMaxMode) return ProtocolError::out_of_range;
       out = Command{get<std::int32_t>(f, 0) * 1e-3, get<std::uint16_t>(f, 4) * 1e-2, (f.data[6] & 1) != 0,
-                    (f.data[6] & 2) != 0, (f.data[6] & 4) != 0, f.data[7]};
+                    (f.data[6] & 2) != 0, (f.data[6] & 4) != 0, f.data[7], (f.data[6] & 8) != 0};
       return {};
     }
     case kStatusA:

@@ -83,7 +83,25 @@ MapEntry parse_entry(Signal s, const json& j) {
   if (is_command(s) ? e.table == ModbusTable::discrete_input || e.table == ModbusTable::input_register : false)
     fail(where + " is a command: it must be in a writable table (coil or holding_register)");
   if (static_cast<int>(e.address) + e.width() > 65536) fail(where + " runs past address 65535");
+  // A reset is a pulse the controller sees as an edge: a bit. A heartbeat is a counter.
+  if (s == Signal::fault_reset && e.table != ModbusTable::coil) fail(where + " must be a coil (a reset is a bit the host pulses)");
+  if (s == Signal::host_heartbeat && (e.table != ModbusTable::holding_register || (e.type != ValueType::uint16 && e.type != ValueType::uint32)))
+    fail(where + " must be a holding_register of type uint16 or uint32 (a counter the host writes)");
   return e;
+}
+
+// The optional "fault_codes": {"1": "displacement limit tripped", ...}, decimal codes 1..65535.
+std::map<std::uint16_t, std::string> parse_fault_codes(const json& j) {
+  if (!j.is_object()) fail("fault_codes must be an object from fault codes (\"1\" to \"65535\") to texts");
+  std::map<std::uint16_t, std::string> codes;
+  for (const auto& [key, text] : j.items()) {
+    const std::string where = "fault_codes.\"" + key + "\"";
+    const bool digits = !key.empty() && key.size() <= 5 && key.find_first_not_of("0123456789") == std::string::npos && key[0] != '0';
+    if (!digits || std::stol(key) > 65535) fail(where + ": the code must be a decimal integer from 1 to 65535");
+    if (!text.is_string() || text.get<std::string>().empty()) fail(where + " must be a non-empty string");
+    codes[static_cast<std::uint16_t>(std::stol(key))] = text.get<std::string>();
+  }
+  return codes;
 }
 
 // The optional "sample_window": where, how deep, at what period, and which signals a record holds.
@@ -191,7 +209,13 @@ RegisterMap RegisterMap::parse_map(std::string_view text) {
     m.blocks_.push_back(ReadBlock{t, static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi - lo + 1)});
   }
   if (j.contains("sample_window")) m.window_ = parse_window(j["sample_window"], m);
+  if (j.contains("fault_codes")) m.fault_codes_ = parse_fault_codes(j["fault_codes"]);
   return m;
+}
+
+std::string RegisterMap::fault_text(std::uint16_t code) const {
+  const auto it = fault_codes_.find(code);
+  return it == fault_codes_.end() ? std::string{} : it->second;
 }
 
 const MapEntry* RegisterMap::find(Signal s) const noexcept {

@@ -4,9 +4,12 @@ namespace hystlab::protocols {
 namespace {
 constexpr std::array<std::string_view, kSignalCount> kNames = {
     "setpoint_mm",     "ramp_rate_mm_s",  "enable",          "hold",           "estop",
-    "mode",            "drive_frequency_hz", "drive_amplitude_mm", "shaker_enable", "displacement_mm",
+    "mode",            "drive_frequency_hz", "drive_amplitude_mm", "shaker_enable", "fault_reset",
+    "host_heartbeat",  "displacement_mm",
     "force_N",         "command_mm",      "status_word",     "fault_code",     "heartbeat",
     "sample_counter",  "base_accel_m_s2", "mass_accel_m_s2", "base_displacement_mm", "mass_displacement_mm"};
+// A name left out would leave a trailing entry empty: every Signal must have its name.
+static_assert(!kNames.back().empty(), "kNames must name every Signal, in the enum's order");
 }
 
 std::string_view signal_name(Signal s) noexcept { return kNames[static_cast<std::size_t>(s)]; }
@@ -17,7 +20,7 @@ std::optional<Signal> signal_from_name(std::string_view name) noexcept {
   return std::nullopt;
 }
 
-bool is_command(Signal s) noexcept { return s <= Signal::shaker_enable; }
+bool is_command(Signal s) noexcept { return s <= Signal::host_heartbeat; }
 
 bool is_required(Signal s, RigKind kind) noexcept {
   switch (s) {

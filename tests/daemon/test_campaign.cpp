@@ -13,6 +13,8 @@
 
 #include "../drivers/sim_process.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
+#include "hystlab/daemon/envelope.hpp"
+#include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/daemon/online_fot.hpp"
@@ -51,6 +53,8 @@ struct Bench {  // a db file, a writer, and a campaign row
   std::unique_ptr<db::Store> store;
   std::unique_ptr<db::SampleWriter> writer;
   std::int64_t rig_id = 0;
+  daemon::SteadyClock clock;
+  std::unique_ptr<daemon::Supervisor> sup;  // one per rig, as in the daemon
 };
 
 struct Controls {  // what the HTTP threads will do: queue commands for the acquisition thread
@@ -79,8 +83,9 @@ std::unique_ptr<drivers::Rig> tcp_rig(int port) {
                             {"reconnect_max_ms", 20}, {"stale_after_ms", 5000}});
 }
 
-daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale) {
-  daemon::RunnerContext ctx{rig, *b.writer, *b.store};
+daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale, bool shaker = false) {
+  b.sup = std::make_unique<daemon::Supervisor>(rig, daemon::SupervisionSettings{}, shaker);
+  daemon::RunnerContext ctx{rig, *b.sup, *b.writer, b.clock};
   ctx.time_scale = scale;
   ctx.now_iso = [] { return std::string("2026-11-23T00:00:00Z"); };
   if (c) ctx.next_control = [c] { return c->pop(); };
@@ -96,6 +101,16 @@ daemon::Limits envelope_limits(double rate_mm_s) {
   return l;
 }
 
+// A campaign as the daemon hands it over: the plan within the rig's envelope (the defaults).
+daemon::RunnerResult run(std::int64_t id, const daemon::Plan& plan, daemon::RunnerContext& ctx) {
+  daemon::CampaignJob j;
+  j.id = id;
+  j.plan = plan;
+  j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, plan.kind == "sine");
+  return daemon::run_campaign(j, ctx);
+}
+std::string st(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }
+
 // Runs a campaign while another thread sends the simulator faults: (wait in ms, command) in turn.
 daemon::RunnerResult run_with_faults(std::int64_t id, const daemon::Plan& plan, daemon::RunnerContext& ctx, SimProcess& sim,
                                      const std::vector<std::pair<int, std::string>>& schedule) {
@@ -105,7 +120,7 @@ daemon::RunnerResult run_with_faults(std::int64_t id, const daemon::Plan& plan, 
       sim.control(command);
     }
   });
-  const daemon::RunnerResult r = daemon::run_campaign(id, plan, ctx);
+  const daemon::RunnerResult r = run(id, plan, ctx);
   fault.join();
   return r;
 }
@@ -118,10 +133,10 @@ TEST_CASE("fot campaign n = 12: the online table equals the offline one and the 
   const auto plan = daemon::parse_plan(fot_plan(12));
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
-  const daemon::RunnerResult r = daemon::run_campaign(id, plan, ctx);
+  const daemon::RunnerResult r = run(id, plan, ctx);
   b.writer->flush();
   CAPTURE(r.reason);
-  REQUIRE(r.state == "completed");
+  REQUIRE(st(r) == "completed");
   CHECK(r.nodes == 78);
   REQUIRE(r.table_id);
   CHECK(r.lsq_table_id);
@@ -166,9 +181,9 @@ TEST_CASE("safety: a force-limit trip aborts to the safe position, with the reas
   const auto plan = daemon::parse_plan(j);
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
-  const auto r = daemon::run_campaign(id, plan, ctx);
+  const auto r = run(id, plan, ctx);
   b.writer->flush();
-  CHECK(r.state == "aborted");
+  CHECK(st(r) == "aborted");
   CHECK(r.reason.find("force") != std::string::npos);
   drivers::RigSample s;
   REQUIRE_FALSE(rig->read_sample(0, s));
@@ -198,10 +213,10 @@ TEST_CASE("operator: pause, a long pause's memory-aware resume, then abort") {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     c.push(daemon::Control::abort);
   });
-  const auto r = daemon::run_campaign(id, plan, ctx);
+  const auto r = run(id, plan, ctx);
   operator_thread.join();
   b.writer->flush();
-  CHECK(r.state == "aborted");
+  CHECK(st(r) == "aborted");
   CHECK(seen == std::vector<std::string>{"arming", "running", "paused", "running", "aborted"});
   bool preamble = false;
   for (const auto& e : b.store->events(id)) preamble |= e.detail.find("wipe-out preamble") != std::string::npos;
@@ -220,9 +235,9 @@ TEST_CASE("operator e-stop: passed to the rig at once, the campaign aborted") {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     c.push(daemon::Control::estop);
   });
-  const auto r = daemon::run_campaign(id, plan, ctx);
+  const auto r = run(id, plan, ctx);
   op.join();
-  CHECK(r.state == "aborted");
+  CHECK(st(r) == "aborted");
   CHECK(r.reason == "e-stop by the operator");
   drivers::RigSample s;
   REQUIRE_FALSE(rig->read_sample(0, s));
@@ -239,7 +254,7 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
     auto ctx = context(*rig, b, nullptr, 200);
     ctx.watchdog_fail_periods = 200;
     const auto r = run_with_faults(id, plan, ctx, sim, {{300, "fault drop"}});
-    CHECK(r.state == "failed");
+    CHECK(st(r) == "failed");
     CHECK(r.reason.find("watchdog") != std::string::npos);
     sim.control("clear");
   }
@@ -249,7 +264,7 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
     ctx.watchdog_fail_periods = 2000;
     const auto r = run_with_faults(id, plan, ctx, sim, {{300, "fault drop"}, {100, "clear"}});
     CAPTURE(r.reason);
-    CHECK(r.state == "completed");
+    CHECK(st(r) == "completed");
     CHECK(rig->health().errors_of(drivers::RigError::connection_lost) >= 1);
   }
 }
@@ -269,7 +284,7 @@ TEST_CASE("a stalled controller answers late: the campaign goes on, no false rat
   for (int k = 0; k < 8; ++k) stalls.insert(stalls.end(), {{250, "fault stall 35"}, {5, "clear"}});
   const auto r = run_with_faults(id, plan, ctx, sim, stalls);
   CAPTURE(r.reason);
-  CHECK(r.state == "completed");
+  CHECK(st(r) == "completed");
   CHECK(rig->health().max_transaction_us > 30'000);  // the stalls did happen
 }
 
@@ -280,9 +295,9 @@ TEST_CASE("a full writer queue is counted and never blocks acquisition") {
   const auto plan = daemon::parse_plan(fot_plan(3, 0.4));
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
-  const auto r = daemon::run_campaign(id, plan, ctx);
+  const auto r = run(id, plan, ctx);
   b.writer->flush();
-  CHECK(r.state == "completed");
+  CHECK(st(r) == "completed");
   CHECK(r.dropped > 0);
   CHECK(b.writer->stats().dropped_full == r.dropped);
 }
@@ -297,9 +312,9 @@ TEST_CASE("fot campaign over CAN (socketpair)") {
   const auto plan = daemon::parse_plan(fot_plan(4, 0.2));
   const auto id = b.submit(plan.source);
   auto ctx = context(rig, b, nullptr, 100);
-  const auto r = daemon::run_campaign(id, plan, ctx);
+  const auto r = run(id, plan, ctx);
   CAPTURE(r.reason);
-  CHECK(r.state == "completed");
+  CHECK(st(r) == "completed");
   CHECK(r.nodes == 10);
 }
 
@@ -379,10 +394,10 @@ TEST_CASE("sine campaign on the simulated shaker: transmissibility per frequency
   const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {10, 40, 60}}, {"amplitude_mm", 0.2},
                                         {"settle_cycles", 10}, {"measured_cycles", 10}, {"sample_rate_hz", 1000}});
   const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 1.0);
-  const auto r = daemon::run_sine_campaign(id, plan, ctx);
+  auto ctx = context(*rig, b, nullptr, 1.0, true);
+  const auto r = run(id, plan, ctx);
   CAPTURE(r.reason);
-  REQUIRE(r.state == "completed");
+  REQUIRE(st(r) == "completed");
   db::Statement st(b.store->database(), "SELECT frequency_hz, ratio FROM transmissibility WHERE run_id = ? ORDER BY frequency_hz");
   st.bind(1, r.run_id);
   std::vector<double> ratio;
@@ -396,9 +411,9 @@ TEST_CASE("sine campaign on the simulated shaker: transmissibility per frequency
   SimProcess frame({"--port", "0"});
   auto frame_rig = tcp_rig(frame.modbus_port);
   const auto id2 = b.submit(plan.source);
-  auto ctx2 = context(*frame_rig, b, nullptr, 1.0);
-  const auto r2 = daemon::run_sine_campaign(id2, plan, ctx2);
-  CHECK(r2.state == "failed");
+  auto ctx2 = context(*frame_rig, b, nullptr, 1.0, true);
+  const auto r2 = run(id2, plan, ctx2);
+  CHECK(st(r2) == "failed");
   CHECK(r2.reason.find("not one") != std::string::npos);
 }
 

@@ -170,3 +170,92 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
   for (const auto& e : s.events(1)) preamble |= e.detail.find("wipe-out preamble") != std::string::npos;
   CHECK(preamble);
 }
+
+namespace {
+const char* kShortPlan = R"({"kind": "waveform", "points_mm": [0, 1.0, 0.5], "ramp_rate_mm_s": 1.0, "sample_rate_hz": 500})";
+std::string log_of(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+}  // namespace
+
+TEST_CASE("hystlabd: a campaign queued while the daemon was down is held at start, and runs only when released") {
+  Dir d;
+  d.write("cfg.json", kConfig);
+  d.write("plan.json", kShortPlan);
+  REQUIRE(cli("campaign submit --rig 'sim frame' --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
+  const Reaper reaper{pid};
+  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "held"; }));
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  CHECK(state_of(d.db(), 1) == "held");  // nothing moved by itself
+  {
+    db::Store s(d.db());
+    CHECK(s.runs_of_campaign(1).empty());
+  }
+  REQUIRE(cli("campaign resume 1 --db " + d.db()) == 0);
+  CHECK(eventually([&] { return state_of(d.db(), 1) == "completed"; }));
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+}
+
+TEST_CASE("hystlabd: e-stop latches the rig until a reset; then a campaign completes; a plan beyond the envelope fails named") {
+  Dir d;
+  d.write("cfg.json", kConfig);
+  d.write("plan.json", kShortPlan);
+  d.write("fast.json", R"({"kind": "waveform", "points_mm": [0, 1.0], "ramp_rate_mm_s": 500})");
+  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
+  const Reaper reaper{pid};
+  REQUIRE(eventually([&] { return fs::exists(d.db()) && db::Store(d.db()).rig_names().size() == 1; }));
+  REQUIRE(cli("rig estop 'sim frame' --db " + d.db()) == 0);
+  CHECK(cli("rig reset 'no such rig' --db " + d.db()) == 2);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "failed"; }));
+  bool latched_reason = false;
+  for (const auto& e : db::Store(d.db()).events(1)) latched_reason |= e.detail.find("reset it first") != std::string::npos;
+  CHECK(latched_reason);
+  REQUIRE(cli("rig reset 'sim frame' --db " + d.db()) == 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  CHECK(eventually([&] { return state_of(d.db(), 2) == "completed"; }));
+  REQUIRE(cli("campaign submit --plan " + (d.path / "fast.json").string() + " --db " + d.db()) == 0);
+  REQUIRE(eventually([&] { return state_of(d.db(), 3) == "failed"; }));
+  bool named = false;
+  for (const auto& e : db::Store(d.db()).events(3)) named |= e.detail.find("ramp_rate_mm_s 500 exceeds the rig's maximum speed 20 mm/s") != std::string::npos;
+  CHECK(named);
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+}
+
+TEST_CASE("hystlabd: the supervised simulator killed; the next campaign runs on a new one") {
+  Dir d;
+  d.write("cfg.json", kConfig);
+  d.write("plan.json", kShortPlan);
+  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
+  const Reaper reaper{pid};
+  REQUIRE(eventually([&] { return fs::exists(d.db()) && db::Store(d.db()).rig_names().size() == 1; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  REQUIRE(std::system(("pkill -KILL -P " + std::to_string(pid) + " hystlab-sim").c_str()) == 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  CHECK(eventually([&] { return state_of(d.db(), 1) == "completed"; }));
+  CHECK(log_of(d.path / "log").find("the simulator died") != std::string::npos);
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+}
+
+TEST_CASE("hystlabd: a second daemon on a port already taken is refused at start (exit 2)") {
+  Dir d;
+  d.write("cfg.json", kConfig);
+  const std::string port = std::to_string(20000 + getpid() % 20000);
+  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", port}, d.path / "log");
+  const Reaper reaper{pid};
+  REQUIRE(eventually([&] { return log_of(d.path / "log").find("http: serving") != std::string::npos; }));
+  Dir d2;
+  const int rc = wait_exit(spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d2.db(), "--port", port}, d2.path / "log"));
+  CHECK(rc == 2);
+  CHECK(log_of(d2.path / "log").find("cannot listen") != std::string::npos);
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+}

@@ -79,6 +79,7 @@ TEST_CASE("modbus tcp: samples, commands and the specimen's force through the de
   REQUIRE_FALSE(rig.read_sample(steady_now(), s));
   CHECK((s.status_word & protocols::status::ready) != 0);
   const auto first = s.sample_counter;
+  REQUIRE_FALSE(rig.set_mode(1));  // the simulator moves only in mode 1 (its --mode)
   REQUIRE_FALSE(rig.arm(true));
   const RigSample at2 = move_to(rig, 2.0);
   CHECK(at2.displacement_mm == doctest::Approx(2.0).epsilon(0.01));
@@ -162,6 +163,8 @@ TEST_CASE("modbus tcp: the second vendor map (scaled integers, swapped words) en
   SimProcess sim({"--port", "0", "--time-scale", "10", "--noise", "0", "--map", HYSTLAB_MAPS "/vendor_b_load_frame.json"});
   ModbusRig rig(tcp_config(sim.modbus_port, map));
   REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.set_mode(1));  // vendor B's map has a mode register too
+  CHECK(rig.write_host_heartbeat(1) == RigError::unsupported);  // ... but no host heartbeat
   REQUIRE_FALSE(rig.arm(true));
   const RigSample s = move_to(rig, 1.25);
   CHECK(s.displacement_mm == doctest::Approx(1.25).epsilon(0.01));
@@ -191,6 +194,7 @@ TEST_CASE("modbus tcp, block reads: every sample once, on the controller's clock
   RigSample last = block.back();
   std::size_t taken = 0;
   REQUIRE_FALSE(rig.hold(false));
+  REQUIRE_FALSE(rig.set_mode(1));
   REQUIRE_FALSE(rig.arm(true));
   REQUIRE_FALSE(rig.command(2.0, 20.0));
   for (int sleep : {2, 1, 25, 30, 3}) {  // 30 ms: beyond one page of 12 records, within the window of 60
@@ -243,6 +247,7 @@ TEST_CASE("modbus rtu on a pty: samples, a CRC error, and recovery") {
   RigSample s;
   REQUIRE_FALSE(read_until_ok(rig, s));
   CHECK((s.status_word & protocols::status::ready) != 0);
+  REQUIRE_FALSE(rig.set_mode(1));
   REQUIRE_FALSE(rig.arm(true));
   const RigSample at = move_to(rig, 0.5);
   CHECK(at.force_N == doctest::Approx(20.0).epsilon(0.05));  // austenite line: 40 N/mm
@@ -265,10 +270,28 @@ TEST_CASE("can over a socketpair: the real driver code, a silent rig, recovery")
   close(sv[1]);
   CanRig rig(std::make_unique<FdCanChannel>(sv[0], "socketpair"), CanRigConfig{1, 100, 20, 0.5, "sim over can"});
   REQUIRE_FALSE(rig.connect(steady_now()));
+  CHECK(rig.set_mode(4) == RigError::out_of_range);  // the frame's mode field is 0..3
+  REQUIRE_FALSE(rig.set_mode(1));
   REQUIRE_FALSE(rig.arm(true));
-  const RigSample s = move_to(rig, 1.5);
+  RigSample s = move_to(rig, 1.5);
   CHECK(s.displacement_mm == doctest::Approx(1.5).epsilon(0.01));
   CHECK(s.force_N > 40.0);
+  // The e-stop latches over CAN too; the reset flag clears it, and arm(true) is the new edge.
+  // Status frames already queued may predate a command: read until the rig's answer shows (~2 s at most).
+  auto fault_after = [&](std::uint16_t want) {
+    for (int k = 0; k < 100 && (rig.read_sample(steady_now(), s) || s.fault_code != want); ++k) sleep_ms(20);
+    return s.fault_code;
+  };
+  REQUIRE_FALSE(rig.estop(true));
+  REQUIRE_FALSE(rig.estop(false));
+  CHECK(fault_after(3) == 3);
+  sleep_ms(50);
+  CHECK(fault_after(3) == 3);  // releasing the e-stop did not clear it
+  REQUIRE_FALSE(rig.reset_faults());
+  CHECK(fault_after(0) == 0);
+  REQUIRE_FALSE(rig.arm(true));
+  s = move_to(rig, 1.0);
+  CHECK(s.displacement_mm == doctest::Approx(1.0).epsilon(0.01));
   REQUIRE(sim.control("fault can-silent").rfind("ok", 0) == 0);
   sleep_ms(30);
   RigSample t;
@@ -312,6 +335,28 @@ TEST_CASE("shaker over modbus: base excitation moves the mass") {
   CHECK(mass_max > 0.1);
   RigSample r;
   CHECK(rig.read_sample(steady_now(), r) == RigError::unsupported);
+  CHECK(rig.set_mode(1) == RigError::unsupported);  // the shaker's map has no mode: no interlock either
+  // The operator's e-stop: zero amplitude, enable ignored, until reset_faults and a new enable.
+  REQUIRE(sim.control("fault estop").rfind("ok", 0) == 0);
+  REQUIRE_FALSE(rig.command_shaker(10.0, 0.5, true));
+  sleep_ms(30);
+  REQUIRE_FALSE(rig.read_shaker(steady_now(), s));
+  CHECK(s.base_displacement_mm == 0.0);
+  CHECK(s.fault_code == 3);
+  CHECK(rig.fault_text(s.fault_code) == "e-stop pressed");
+  CHECK((s.status_word & protocols::status::estop) != 0);
+  REQUIRE_FALSE(rig.reset_faults());
+  REQUIRE_FALSE(rig.command_shaker(10.0, 0.5, true));
+  base_max = 0;
+  int good = 0;
+  for (int k = 0; k < 100; ++k, sleep_ms(2))
+    if (!rig.read_shaker(steady_now(), s)) {  // a timeout on a loaded machine is not what this tests
+      ++good;
+      base_max = std::max(base_max, std::fabs(s.base_displacement_mm));
+    }
+  CHECK(good > 50);
+  CHECK(base_max == doctest::Approx(0.5).epsilon(0.05));
+  CHECK(s.fault_code == 0);
 }
 
 TEST_CASE("rigs from configuration: a simulated rig is only a different address") {
@@ -346,4 +391,151 @@ TEST_CASE("rigs from configuration: a simulated rig is only a different address"
   CHECK_THROWS_WITH_AS(SimProcess({"--port", "0", "--sample-rate", "500"}), doctest::Contains("did not start"), std::runtime_error);
   CHECK_THROWS_WITH_AS((void)make_rig({{"transport", "can"}, {"can_interface", "hystlabnope0"}}),
                        doctest::Contains("cannot open CAN interface"), std::system_error);
+}
+
+// --- The controller's latches and interlocks, over the real simulator process ---
+
+namespace {
+RigSample read_now(Rig& rig) {
+  RigSample s;
+  REQUIRE_FALSE(rig.read_sample(steady_now(), s));
+  return s;
+}
+// Reads until pred holds (or ~4 s pass); returns the last sample.
+template <class Pred>
+RigSample read_until(Rig& rig, Pred pred) {
+  RigSample s;
+  for (int k = 0; k < 400; ++k, sleep_ms(10))
+    if (!rig.read_sample(steady_now(), s) && pred(s)) break;
+  return s;
+}
+}  // namespace
+
+TEST_CASE("controller: the e-stop and a latched fault stay until reset_faults; after it, enable must be written again") {
+  SimProcess sim({"--port", "0", "--noise", "0", "--time-scale", "10"});
+  ModbusRig rig(tcp_config(sim.modbus_port));
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.set_mode(1));
+  REQUIRE_FALSE(rig.arm(true));
+  RigSample s = move_to(rig, 1.0);
+  REQUIRE_FALSE(rig.estop(true));
+  REQUIRE_FALSE(rig.estop(false));  // released: the latch stays
+  sleep_ms(30);
+  s = read_now(rig);
+  CHECK((s.status_word & protocols::status::estop) != 0);
+  CHECK((s.status_word & (protocols::status::ready | protocols::status::enabled)) == 0);
+  CHECK(s.fault_code == 3);
+  CHECK(rig.fault_text(s.fault_code) == "e-stop pressed");
+  REQUIRE_FALSE(rig.reset_faults());
+  s = read_now(rig);
+  CHECK(s.fault_code == 0);
+  CHECK((s.status_word & (protocols::status::estop | protocols::status::fault)) == 0);
+  CHECK((s.status_word & protocols::status::ready) != 0);
+  CHECK((s.status_word & protocols::status::enabled) == 0);  // the reset dropped enable
+  REQUIRE_FALSE(rig.command(2.0, 20.0));
+  sleep_ms(100);  // 1 s simulated: 20 mm/s would have arrived
+  CHECK(read_now(rig).displacement_mm == doctest::Approx(1.0).epsilon(0.01));
+  REQUIRE_FALSE(rig.arm(true));
+  s = move_to(rig, 2.0);
+  CHECK(s.displacement_mm == doctest::Approx(2.0).epsilon(0.01));
+
+  REQUIRE(sim.control("fault latch 7").rfind("ok", 0) == 0);
+  REQUIRE_FALSE(rig.command(3.0, 20.0));
+  sleep_ms(100);
+  s = read_now(rig);
+  CHECK(s.fault_code == 7);
+  CHECK((s.status_word & protocols::status::fault) != 0);
+  CHECK((s.status_word & (protocols::status::ready | protocols::status::enabled)) == 0);
+  CHECK(s.displacement_mm == doctest::Approx(2.0).epsilon(0.01));  // held
+  CHECK(rig.fault_text(7).empty());  // not in the map's fault_codes
+  REQUIRE(sim.control("clear").rfind("ok", 0) == 0);  // clears communication faults, not the controller's
+  CHECK(read_now(rig).fault_code == 7);
+  REQUIRE_FALSE(rig.reset_faults());
+  CHECK(read_now(rig).fault_code == 0);
+  REQUIRE_FALSE(rig.arm(true));
+  CHECK(move_to(rig, 3.0).displacement_mm == doctest::Approx(3.0).epsilon(0.01));
+  CHECK(sim.control("fault latch 0").rfind("error fault 'latch'", 0) == 0);
+}
+
+TEST_CASE("controller: a limit trip stays latched after a reset while the frame is beyond the limit") {
+  SimProcess sim({"--port", "0", "--noise", "0", "--time-scale", "10"});
+  ModbusRig rig(tcp_config(sim.modbus_port));
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.set_mode(1));
+  REQUIRE_FALSE(rig.arm(true));
+  REQUIRE_FALSE(rig.command(14.0, 50.0));
+  RigSample s = read_until(rig, [](const RigSample& r) { return r.fault_code != 0; });
+  REQUIRE(s.fault_code == 1);
+  CHECK(rig.fault_text(1) == "displacement limit tripped");
+  CHECK(s.displacement_mm > 12.0);
+  CHECK((s.status_word & protocols::status::limit_tripped) != 0);
+  REQUIRE_FALSE(rig.reset_faults());
+  sleep_ms(20);
+  s = read_now(rig);
+  CHECK(s.fault_code == 1);
+  CHECK((s.status_word & (protocols::status::limit_tripped | protocols::status::fault)) ==
+        (protocols::status::limit_tripped | protocols::status::fault));
+  CHECK(s.displacement_mm < 12.2);  // held where it tripped
+}
+
+TEST_CASE("controller: the servo dead band leaves the frame short of its target, not moving") {
+  SimProcess sim({"--port", "0", "--noise", "0", "--time-scale", "10", "--deadband-mm", "0.02"});
+  ModbusRig rig(tcp_config(sim.modbus_port));
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.set_mode(1));
+  REQUIRE_FALSE(rig.arm(true));
+  REQUIRE_FALSE(rig.command(4.0, 20.0));
+  sleep_ms(50);
+  RigSample s = read_until(rig, [](const RigSample& r) { return (r.status_word & protocols::status::moving) == 0; });
+  sleep_ms(50);  // half a simulated second more: it stays there
+  s = read_now(rig);
+  CHECK(s.command_mm == doctest::Approx(4.0));
+  CHECK(4.0 - s.displacement_mm < 0.02);
+  CHECK(4.0 - s.displacement_mm > 0.015);
+  CHECK((s.status_word & protocols::status::moving) == 0);
+  REQUIRE(sim.control("fault deadband 0").rfind("ok", 0) == 0);
+  sleep_ms(50);
+  CHECK(read_now(rig).displacement_mm == doctest::Approx(4.0).epsilon(1e-4));
+  CHECK(sim.control("fault deadband -1").rfind("error fault 'deadband'", 0) == 0);
+}
+
+TEST_CASE("controller: the mode interlock: no motion until the host sets the mode") {
+  SimProcess sim({"--port", "0", "--noise", "0", "--time-scale", "10"});
+  ModbusRig rig(tcp_config(sim.modbus_port));
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.arm(true));
+  REQUIRE_FALSE(rig.command(1.0, 20.0));
+  sleep_ms(100);
+  RigSample s = read_now(rig);
+  CHECK(s.displacement_mm == 0.0);
+  CHECK((s.status_word & protocols::status::enabled) == 0);
+  CHECK((s.status_word & protocols::status::ready) != 0);
+  REQUIRE_FALSE(rig.set_mode(1));
+  s = move_to(rig, 1.0);
+  CHECK(s.displacement_mm == doctest::Approx(1.0).epsilon(0.01));
+  CHECK((s.status_word & protocols::status::enabled) != 0);
+}
+
+TEST_CASE("controller: the host heartbeat watchdog stops the frame with fault 4 when the host goes quiet") {
+  // 1 s: well beyond a loaded test machine's scheduling hiccups, which the watchdog would see.
+  SimProcess sim({"--port", "0", "--noise", "0", "--host-timeout-ms", "1000"});
+  ModbusRig rig(tcp_config(sim.modbus_port));
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  REQUIRE_FALSE(rig.set_mode(1));
+  REQUIRE_FALSE(rig.arm(true));
+  REQUIRE_FALSE(rig.command(10.0, 2.0));
+  for (std::uint32_t k = 1; k <= 10; ++k, sleep_ms(40)) REQUIRE_FALSE(rig.write_host_heartbeat(70000 + k));  // wraps to 16 bits
+  RigSample s = read_now(rig);
+  CHECK(s.fault_code == 0);
+  CHECK((s.status_word & protocols::status::enabled) != 0);
+  s = read_until(rig, [](const RigSample& r) { return r.fault_code != 0; });
+  CHECK(s.fault_code == 4);
+  CHECK(rig.fault_text(s.fault_code) == "host heartbeat lost");
+  CHECK((s.status_word & protocols::status::fault) != 0);
+  const double at = s.displacement_mm;
+  sleep_ms(200);
+  CHECK(read_now(rig).displacement_mm == doctest::Approx(at).epsilon(0.002));
+  CHECK(at < 9.0);  // stopped on its way to the 10 mm it was sent to (2 mm/s)
+  REQUIRE_FALSE(rig.reset_faults());
+  CHECK(read_now(rig).fault_code == 0);
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "hystlab/models/simplified_sma.hpp"
+#include "hystlab/protocols/default_maps.hpp"
+#include "hystlab/protocols/register_map.hpp"
 #include "hystlab/protocols/signals.hpp"
 #include "load_frame_sim.hpp"
 #include "shaker_sim.hpp"
@@ -60,20 +62,149 @@ TEST_CASE("load frame: hard limits and the load cell range trip a safe stop") {
   CHECK(g.state().force_N < 35);
 }
 
-TEST_CASE("load frame: e-stop holds, and releasing it resets the trip") {
+TEST_CASE("load frame: the e-stop latches; only a reset with the e-stop released clears it, and the drive needs enable again") {
   LoadFrameSim f(sma(), quiet());
-  f.set_commands({2.0, 5.0, true, false, false});
+  LoadFrameCommands c{2.0, 5.0, true, false, false};
+  f.set_commands(c);
   run(f, 0.2);
-  f.set_commands({2.0, 5.0, true, false, true});
+  c.estop = true;
+  f.set_commands(c);
   const double at = f.state().displacement_mm;
   run(f, 0.5);
   CHECK(f.state().displacement_mm == doctest::Approx(at).epsilon(0.01));
   CHECK(f.state().fault_code == kEstopPressed);
-  f.set_commands({2.0, 5.0, true, false, false});
-  f.reset_fault();
+  c.estop = false;  // releasing the e-stop signal is not a reset
+  f.set_commands(c);
   run(f, 0.5);
+  CHECK(f.state().fault_code == kEstopPressed);
+  CHECK((f.state().status_word & protocols::status::estop) != 0);
+  CHECK((f.state().status_word & protocols::status::ready) == 0);
+  CHECK(f.state().displacement_mm == doctest::Approx(at).epsilon(0.01));
+  c.estop = true;  // a reset while the e-stop is on does nothing
+  c.fault_reset = true;
+  f.set_commands(c);
+  c.estop = false;
+  f.set_commands(c);  // fault_reset still 1: no new edge
+  CHECK(f.state().fault_code == kEstopPressed);
+  c.fault_reset = false;
+  f.set_commands(c);
+  c.fault_reset = true;  // the rising edge with the e-stop released
+  f.set_commands(c);
   CHECK(f.state().fault_code == kNoFault);
+  CHECK(f.state().status_word == protocols::status::ready);  // enable was dropped by the reset
+  run(f, 0.5);
+  CHECK(f.state().displacement_mm == doctest::Approx(at).epsilon(0.01));  // enable still 1 from before: no edge
+  c.enable = false;
+  f.set_commands(c);
+  c.enable = true;
+  f.set_commands(c);
+  run(f, 0.5);
   CHECK(f.state().displacement_mm > at + 0.5);
+  CHECK((f.state().status_word & protocols::status::enabled) != 0);
+}
+
+TEST_CASE("load frame: a latched fault holds, shows in the status word, and needs the reset") {
+  LoadFrameSim f(sma(), quiet());
+  LoadFrameCommands c{3.0, 5.0, true, false, false};
+  f.set_commands(c);
+  run(f, 0.2);
+  f.latch_fault(7);
+  const double at = f.state().displacement_mm;
+  run(f, 0.3);
+  CHECK(f.state().fault_code == 7);
+  CHECK((f.state().status_word & protocols::status::fault) != 0);
+  CHECK((f.state().status_word & (protocols::status::ready | protocols::status::enabled | protocols::status::limit_tripped)) == 0);
+  CHECK(f.state().displacement_mm == doctest::Approx(at).epsilon(1e-3));
+  f.latch_fault(9);  // the first fault stays the one reported
+  CHECK(f.state().fault_code == 7);
+  c.fault_reset = true;
+  f.set_commands(c);
+  CHECK(f.state().fault_code == kNoFault);
+  CHECK((f.state().status_word & protocols::status::ready) != 0);
+}
+
+TEST_CASE("load frame: a limit trip stays latched after a reset while the frame is still beyond the limit") {
+  LoadFrameParams p = quiet();
+  p.limit_mm = 2.0;
+  LoadFrameSim f(sma(), p);
+  LoadFrameCommands c{5.0, 50.0, true, false, false};
+  f.set_commands(c);
+  run(f, 1.0);
+  REQUIRE(f.state().fault_code == kDisplacementLimit);
+  REQUIRE(std::fabs(f.state().displacement_mm) > 2.0);
+  c.fault_reset = true;
+  f.set_commands(c);
+  run(f, 0.1);
+  CHECK(f.state().fault_code == kDisplacementLimit);
+  CHECK((f.state().status_word & protocols::status::limit_tripped) != 0);
+  CHECK(f.state().displacement_mm < 2.1);
+}
+
+TEST_CASE("load frame: the servo dead band leaves the frame short of the target, and not moving") {
+  LoadFrameParams p = quiet();
+  p.deadband_mm = 0.02;
+  LoadFrameSim f(sma(), p);
+  f.set_commands({4.0, 20.0, true, false, false});
+  run(f, 1.0);
+  CHECK(f.state().command_mm == doctest::Approx(4.0));
+  // It stops within one step's correction (18 % of the error at 1 ms, τ = 5 ms) of the band's edge.
+  CHECK(4.0 - f.state().displacement_mm < 0.02);
+  CHECK(4.0 - f.state().displacement_mm > 0.016);
+  CHECK((f.state().status_word & protocols::status::moving) == 0);
+  LoadFrameSim g(sma(), quiet());  // without a dead band it gets there
+  g.set_commands({4.0, 20.0, true, false, false});
+  run(g, 1.0);
+  CHECK(g.state().displacement_mm == doctest::Approx(4.0).epsilon(1e-4));
+}
+
+TEST_CASE("load frame: the mode interlock: enable is taken, but nothing moves outside the configured mode") {
+  LoadFrameParams p = quiet();
+  p.controller.mode_interlock = true;
+  p.controller.mode = 1;
+  LoadFrameSim f(sma(), p);
+  LoadFrameCommands c{2.0, 10.0, true, false, false};
+  f.set_commands(c);  // mode 0, as the register starts
+  run(f, 0.5);
+  CHECK(f.state().displacement_mm == 0.0);
+  CHECK((f.state().status_word & protocols::status::enabled) == 0);
+  CHECK((f.state().status_word & protocols::status::ready) != 0);  // the mode does not affect ready
+  c.mode = 1;
+  f.set_commands(c);
+  run(f, 0.5);
+  CHECK(f.state().displacement_mm > 1.9);
+  CHECK((f.state().status_word & protocols::status::enabled) != 0);
+}
+
+TEST_CASE("load frame: the host heartbeat watchdog latches fault 4 once the host stops") {
+  LoadFrameParams p = quiet();
+  p.controller.host_timeout_s = 0.1;
+  LoadFrameSim f(sma(), p);
+  LoadFrameCommands c{10.0, 2.0, true, false, false};
+  f.set_commands(c);
+  run(f, 0.5);  // never written: the watchdog is not armed
+  CHECK(f.state().fault_code == kNoFault);
+  for (std::uint32_t k = 1; k <= 20; ++k) {  // a host alive every 50 ms
+    c.host_heartbeat = k;
+    f.set_commands(c);
+    run(f, 0.05);
+  }
+  CHECK(f.state().fault_code == kNoFault);
+  const double at = f.state().displacement_mm;
+  run(f, 0.2);  // the host is gone
+  CHECK(f.state().fault_code == kHostHeartbeatLost);
+  CHECK((f.state().status_word & protocols::status::fault) != 0);
+  CHECK(f.state().displacement_mm < at + 0.25);  // stopped at about at + 0.1 s × 2 mm/s
+}
+
+TEST_CASE("the simulator's fault codes have their texts in the shipped maps") {
+  const auto frame = protocols::RegisterMap::from_json(protocols::kDefaultLoadFrameMap);
+  for (std::uint16_t code : {kDisplacementLimit, kForceLimit, kEstopPressed, kHostHeartbeatLost, kOperatorLatch}) {
+    CAPTURE(code);
+    CHECK_FALSE(frame.fault_text(code).empty());
+  }
+  CHECK(frame.fault_text(kHostHeartbeatLost) == "host heartbeat lost");
+  const auto shaker = protocols::RegisterMap::from_json(protocols::kDefaultShakerMap);
+  for (std::uint16_t code : {kEstopPressed, kHostHeartbeatLost, kOperatorLatch}) CHECK_FALSE(shaker.fault_text(code).empty());
 }
 
 TEST_CASE("specimen smoothing: corners rounded, lag bounded, nearly independent of the step size") {
@@ -110,4 +241,61 @@ TEST_CASE("shaker: rests at its preload, follows the base at low frequency, refu
   ShakerParams bad;
   bad.dt_s = 1e-2;
   CHECK_THROWS_WITH(ShakerSim(spring, bad), doctest::Contains("time step too large"));
+}
+
+TEST_CASE("shaker: an e-stop or a latched fault stops the drive at zero amplitude; enable is ignored until a reset and a new enable") {
+  const models::SimplifiedSmaModel spring(models::table1_parameters());
+  ShakerSim s(spring, ShakerParams{});
+  ShakerCommands c{5.0, 0.3, true};
+  s.set_commands(c);
+  s.step(0.3);
+  CHECK((s.state().status_word & protocols::status::enabled) != 0);
+  CHECK((s.state().status_word & protocols::status::moving) != 0);
+  s.press_estop();
+  s.set_drive(5.0, 0.3, true);  // enable again: ignored while latched
+  double base_max = 0;
+  for (int k = 0; k < 300; ++k) {
+    s.step(1e-3);
+    base_max = std::max(base_max, std::fabs(s.state().base_displacement_mm));
+  }
+  CHECK(base_max == 0.0);
+  CHECK(s.state().fault_code == kEstopPressed);
+  CHECK((s.state().status_word & (protocols::status::estop | protocols::status::fault)) == (protocols::status::estop | protocols::status::fault));
+  c.fault_reset = true;
+  s.set_commands(c);
+  CHECK(s.state().fault_code == kNoFault);
+  c.enable = false;
+  c.fault_reset = false;
+  s.set_commands(c);
+  c.enable = true;
+  s.set_commands(c);
+  for (int k = 0; k < 300; ++k) {
+    s.step(1e-3);
+    base_max = std::max(base_max, std::fabs(s.state().base_displacement_mm));
+  }
+  CHECK(base_max == doctest::Approx(0.3).epsilon(0.02));
+  s.latch_fault(5);
+  s.step(0.01);
+  CHECK(s.state().base_displacement_mm == 0.0);
+  CHECK(s.state().fault_code == kOperatorLatch);
+}
+
+TEST_CASE("load frame: the watchdog arms at the host's first heartbeat and times from then") {
+  LoadFrameParams p = quiet();
+  p.controller.host_timeout_s = 0.2;
+  p.controller.mode_interlock = true;
+  LoadFrameSim f(sma(), p);
+  LoadFrameCommands c{10.0, 2.0, false, false, false};
+  c.mode = 1;
+  f.set_commands(c);
+  run(f, 0.3);
+  c.enable = true;
+  f.set_commands(c);
+  run(f, 0.3);
+  c.host_heartbeat = 3;
+  f.set_commands(c);
+  run(f, 0.1);
+  CHECK(f.state().fault_code == kNoFault);
+  run(f, 0.15);
+  CHECK(f.state().fault_code == kHostHeartbeatLost);
 }

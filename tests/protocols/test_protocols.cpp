@@ -116,6 +116,55 @@ TEST_CASE("register maps: a bad map is rejected with the field named") {
          "signals.force_N.address");
 }
 
+TEST_CASE("register maps: the controller signals fault_reset and host_heartbeat, and fault_codes") {
+  const RegisterMap a = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  REQUIRE(a.find(Signal::fault_reset));
+  CHECK(a.find(Signal::fault_reset)->table == ModbusTable::coil);
+  CHECK(a.find(Signal::fault_reset)->address == 3);
+  REQUIRE(a.find(Signal::host_heartbeat));
+  CHECK(a.find(Signal::host_heartbeat)->address == 5);
+  CHECK(is_command(Signal::fault_reset));
+  CHECK(is_command(Signal::host_heartbeat));
+  CHECK_FALSE(is_command(Signal::displacement_mm));
+  CHECK_FALSE(is_required(Signal::fault_reset, RigKind::load_frame));
+  CHECK_FALSE(is_required(Signal::host_heartbeat, RigKind::shaker));
+  for (std::size_t k = 0; k < kSignalCount; ++k) CHECK(signal_from_name(signal_name(static_cast<Signal>(k))) == static_cast<Signal>(k));
+  CHECK(a.fault_text(1) == "displacement limit tripped");
+  CHECK(a.fault_text(4) == "host heartbeat lost");
+  CHECK(a.fault_text(7).empty());
+  CHECK(a.fault_text(0).empty());
+  const RegisterMap s = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json"));
+  CHECK(s.find(Signal::fault_reset)->address == 2);
+  CHECK(s.fault_text(3) == "e-stop pressed");
+  const RegisterMap b = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json"));
+  CHECK(b.find(Signal::fault_reset)->address == 19);
+  CHECK_FALSE(b.find(Signal::host_heartbeat));
+  CHECK(b.fault_text(1).empty());  // no fault_codes: no texts
+  // A map without the optional controller signals still loads.
+  auto j = nlohmann::json::parse(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  j["signals"].erase("fault_reset");
+  j["signals"].erase("host_heartbeat");
+  j.erase("fault_codes");
+  CHECK_FALSE(RegisterMap::from_json(j.dump()).find(Signal::fault_reset));
+}
+
+TEST_CASE("register maps: bad fault_codes, fault_reset or host_heartbeat are refused with the field named") {
+  refused_after([](auto& j) { j["fault_codes"] = nlohmann::json::array({"x"}); }, "fault_codes must be an object");
+  refused_after([](auto& j) { j["fault_codes"]["zero"] = "text"; }, "fault_codes.\"zero\": the code must be a decimal integer from 1 to 65535");
+  refused_after([](auto& j) { j["fault_codes"]["0"] = "text"; }, "fault_codes.\"0\": the code must be a decimal integer");
+  refused_after([](auto& j) { j["fault_codes"]["65536"] = "text"; }, "fault_codes.\"65536\": the code must be a decimal integer");
+  refused_after([](auto& j) { j["fault_codes"]["-3"] = "text"; }, "fault_codes.\"-3\": the code must be a decimal integer");
+  refused_after([](auto& j) { j["fault_codes"]["1.5"] = "text"; }, "fault_codes.\"1.5\": the code must be a decimal integer");
+  refused_after([](auto& j) { j["fault_codes"]["9"] = 9; }, "fault_codes.\"9\" must be a non-empty string");
+  refused_after([](auto& j) { j["fault_codes"]["9"] = ""; }, "fault_codes.\"9\" must be a non-empty string");
+  refused_after([](auto& j) { j["signals"]["fault_reset"] = {{"table", "holding_register"}, {"address", 9}}; },
+                "signals.fault_reset must be a coil");
+  refused_after([](auto& j) { j["signals"]["host_heartbeat"]["type"] = "float32"; },
+                "signals.host_heartbeat must be a holding_register of type uint16 or uint32");
+  refused_after([](auto& j) { j["signals"]["host_heartbeat"]["table"] = "input_register"; }, "signals.host_heartbeat is a command");
+  refused_after([](auto& j) { j["signals"]["fault_reset"]["address"] = 2; }, "signals.fault_reset overlaps signals.estop at coil 2");
+}
+
 TEST_CASE("sample windows: the shipped map's window, and records that encode and decode back") {
   const RegisterMap m = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
   REQUIRE(m.sample_window());

@@ -96,6 +96,12 @@ HttpApi::HttpApi(daemon::Daemon& d, const daemon::HttpConfig& cfg) : impl_(std::
   if (!s.set_mount_point("/vendor/uplot", vendor))
     spdlog::warn("http: the plotting library is not at '{}' (run 'npm ci' in web/): the page cannot plot", vendor);
   if (!s.set_mount_point("/", root)) spdlog::warn("http: no page at '{}': the API alone is served", root);
+  // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, and then a second daemon on the
+  // same port binds too and the kernel splits requests between them (an abort reached the wrong one).
+  s.set_socket_options([](httplib::socket_t sock) {
+    const int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   m.port = cfg.port == 0 ? s.bind_to_any_port(cfg.bind) : (s.bind_to_port(cfg.bind, cfg.port) ? cfg.port : -1);
   if (m.port <= 0) throw std::runtime_error("http: cannot listen on " + cfg.bind + ":" + std::to_string(cfg.port) + " (in use, or not an address here)");
   m.thread = std::thread([&s] { s.listen_after_bind(); });

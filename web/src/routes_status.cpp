@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/protocols/signals.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
@@ -15,7 +16,7 @@ static_assert(sizeof kErrorNames / sizeof kErrorNames[0] == drivers::kRigErrorCo
 
 std::map<std::string, std::int64_t> campaigns_by_state(db::Store& store) {
   std::map<std::string, std::int64_t> out;
-  for (const char* s : {"queued", "arming", "running", "paused", "completed", "aborted", "failed", "interrupted"}) out[s] = 0;
+  for (const char* s : {"queued", "held", "arming", "running", "paused", "completed", "aborted", "failed", "interrupted"}) out[s] = 0;
   db::Statement st(store.database(), "SELECT state, count(*) FROM campaigns GROUP BY state");
   while (st.step()) out[st.column_text(0)] = st.column_int(1);
   return out;
@@ -35,6 +36,24 @@ json rig_json(const daemon::Daemon& d, std::size_t k) {
   json j{{"id", info.id}, {"index", k}, {"name", info.name}, {"kind", info.kind}, {"description", info.description},
          {"simulated", info.simulated}, {"campaign", live.campaign.load()}, {"samples", live.samples.load()},
          {"missed_deadlines", live.missed_deadlines.load()}, {"late_wakeups", live.late_wakeups.load()}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
+  const daemon::RigSupervision sv = d.rig_supervision(k);
+  j["state"] = sv.state;
+  j["latched"] = sv.latched;
+  j["latch_reason"] = sv.latch_reason.empty() ? json(nullptr) : json(sv.latch_reason);
+  j["fault"] = sv.fault_code == 0 && sv.latched_fault_code == 0
+                   ? json(nullptr)
+                   : json{{"code", sv.fault_code ? sv.fault_code : sv.latched_fault_code}, {"text", sv.fault_text}};
+  const unsigned w = sv.status_word;
+  namespace stb = protocols::status;
+  j["status"] = {{"word", w}, {"ready", (w & stb::ready) != 0}, {"enabled", (w & stb::enabled) != 0}, {"holding", (w & stb::holding) != 0},
+                 {"estop", (w & stb::estop) != 0}, {"limit_tripped", (w & stb::limit_tripped) != 0}, {"fault", (w & stb::fault) != 0},
+                 {"moving", (w & stb::moving) != 0}, {"known", sv.have_sample}};
+  j["resetting"] = sv.resetting;
+  j["reset_refusal"] = sv.reset_refusal.empty() ? json(nullptr) : json(sv.reset_refusal);
+  j["link_losses"] = sv.link_losses;
+  j["transitions"] = sv.recent;
+  j["envelope"] = sv.envelope;
+  j["supervision"] = sv.supervision;
   const std::uint64_t h = live.ring.head();
   daemon::LiveSample s;
   if (h > 0 && live.ring.get(h - 1, s)) {
@@ -44,6 +63,13 @@ json rig_json(const daemon::Daemon& d, std::size_t k) {
     j["sample"] = {{"t", s.t}, {n[0], s.cmd}, {n[1], s.disp}, {n[2], s.force}, {"status", s.status}, {"run", s.run}};
   }
   return j;
+}
+
+// A rig by its id or its name.
+std::size_t rig_of(ApiContext& c, const std::string& key) {
+  for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
+    if (c.daemon.rig_info(k).name == key || std::to_string(c.daemon.rig_info(k).id) == key) return k;
+  throw ApiError(404, "not found", "no rig '" + key + "'");
 }
 
 // Label values escaped as the exposition format asks.
@@ -117,6 +143,21 @@ std::string metrics_text(ApiContext& c) {
   line("hystlab_http_requests_total", "", static_cast<double>(c.requests.load()));
   metric(o, "hystlab_campaigns", "gauge", "Campaigns by state.");
   for (const auto& [state, n] : campaigns_by_state(reader(c.db_path))) line("hystlab_campaigns", "state=\"" + state + "\"", static_cast<double>(n));
+  metric(o, "hystlab_rig_state", "gauge", "The rig supervisor's state (1 for the current one).");
+  for (std::size_t k = 0; k < d.rig_count(); ++k) {
+    const auto sv = d.rig_supervision(k);
+    for (const char* st : {"disconnected", "idle", "arming", "armed", "holding", "estopped", "faulted", "safing"})
+      line("hystlab_rig_state", "rig=\"" + label(d.rig_info(k).name) + "\",state=\"" + st + "\"", sv.state == st ? 1.0 : 0.0);
+  }
+  metric(o, "hystlab_rig_latched", "gauge", "1 while an e-stop or a fault is latched (nothing arms until a reset).");
+  for (std::size_t k = 0; k < d.rig_count(); ++k)
+    line("hystlab_rig_latched", "rig=\"" + label(d.rig_info(k).name) + "\"", d.rig_supervision(k).latched ? 1.0 : 0.0);
+  metric(o, "hystlab_rig_transitions_total", "counter", "Rig supervisor state transitions.");
+  for (std::size_t k = 0; k < d.rig_count(); ++k)
+    line("hystlab_rig_transitions_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_supervision(k).transitions));
+  metric(o, "hystlab_rig_link_losses_total", "counter", "Times the link to the rig was lost.");
+  for (std::size_t k = 0; k < d.rig_count(); ++k)
+    line("hystlab_rig_link_losses_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_supervision(k).link_losses));
   metric(o, "hystlab_uptime_seconds", "gauge", "Seconds since the daemon started.");
   line("hystlab_uptime_seconds", "", d.uptime_s());
   return o;
@@ -154,11 +195,15 @@ void add_status_routes(httplib::Server& s, ApiContext& c) {
     for (std::size_t k = 0; k < c.daemon.rig_count(); ++k) out.push_back(rig_json(c.daemon, k));
     send_json(res, out);
   }));
-  s.Get(R"(/api/rigs/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    const std::int64_t id = path_id(req);
-    for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
-      if (c.daemon.rig_info(k).id == id) return send_json(res, rig_json(c.daemon, k));
-    throw ApiError(404, "not found", "no rig " + std::to_string(id));
+  s.Get(R"(/api/rigs/([^/]+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    send_json(res, rig_json(c.daemon, rig_of(c, req.matches[1].str())));
+  }));
+  // The operator's e-stop and reset: straight to the rig's thread, whatever runs (or nothing).
+  s.Post(R"(/api/rigs/([^/]+)/(reset|estop))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    const std::size_t k = rig_of(c, req.matches[1].str());
+    const std::string verb = req.matches[2].str();
+    c.daemon.rig_command(k, verb == "reset" ? daemon::RigCommand::reset : daemon::RigCommand::estop);
+    send_json(res, json{{"rig", c.daemon.rig_info(k).name}, {"command", verb}, {"accepted", true}, {"state", c.daemon.rig_supervision(k).state}}, 202);
   }));
   s.Get("/metrics", guarded([&c](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics_text(c), "text/plain; version=0.0.4");

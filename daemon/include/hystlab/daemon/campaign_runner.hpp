@@ -1,58 +1,106 @@
 #pragma once
-// One campaign on one rig, on the acquisition thread: arm, drive the plan's input, sample at the
-// plan's rate on absolute deadlines, enforce the safety envelope and the watchdog, fit the
-// Preisach table online, and finish (or abort to the safe position) with every transition stored.
-// The disk is written only by the writer thread (samples through its ring, the rest as jobs).
+// One campaign on one rig, on the rig's acquisition thread: one loop for every campaign kind
+// (deadlines, controls, supervision, safety, watchdog, gap accounting, publishing to the writer
+// and the live ring), with the kinds (fot, waveform, sine) as strategies that produce setpoints
+// and consume samples. The loop never touches the database: samples go through the writer's
+// ring, everything else as writer jobs; the final fits run off this thread (RunnerContext::finish).
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "hystlab/daemon/clock.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/plan.hpp"
+#include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/drivers/rig.hpp"
 #include "hystlab/models/fot_node.hpp"
-#include <vector>
+#include "hystlab/models/online_table_builder.hpp"
 
 namespace hystlab::daemon {
 
 enum class Control { pause, resume, abort, estop };  // estop: the rig's e-stop, now; no motion
 
-struct RunnerContext {
-  RunnerContext(drivers::Rig& r, db::SampleWriter& w, db::Store& s) : rig(r), writer(w), store(s) {}
-  drivers::Rig& rig;
-  db::SampleWriter& writer;
-  db::Store& store;                                     // this thread's connection, used outside the loop
-  double time_scale = 1.0;                              // rig seconds per wall second (a time-scaled simulator)
-  std::function<std::optional<Control>()> next_control = [] { return std::nullopt; };
-  const std::atomic<bool>* stop = nullptr;              // the daemon is shutting down: hold, interrupted
-  double resume_preamble_after_s = 2.0;                 // rig seconds of pause after which memory is re-wiped
-  int watchdog_hold_periods = 20, watchdog_fail_periods = 500;
-  std::function<std::string()> now_iso;                 // wall-clock stamps for the records
-  std::function<void(const std::string&)> on_state;     // observers (logs, tests)
-  // Resuming an interrupted campaign: the nodes its earlier runs measured. Rows they complete
-  // are not driven again; the rest follow a wipe-out preamble to δmin.
+// What a campaign ends as: text only at the JSON/database edges.
+enum class CampaignEnd { none, completed, failed, aborted, interrupted };
+[[nodiscard]] const char* to_string(CampaignEnd e) noexcept;
+
+struct RunSeries {  // the measured loop, kept for the fits (about 16 bytes per sample)
+  std::vector<double> x, f;
+  void add(double xi, double fi) {
+    x.push_back(xi);
+    f.push_back(fi);
+  }
+};
+
+// A campaign as the daemon hands it to the rig's thread: the plan with the limits the rig's
+// envelope allows (the tighter of the plan's and the envelope's), and for a resumed campaign
+// what its earlier runs measured (their nodes, and their samples for the final fits).
+struct CampaignJob {
+  std::int64_t id = 0;
+  Plan plan;
   std::vector<models::FotNode> prior_nodes;
-  RigLive* live = nullptr;                        // when set, every sample and missed deadline is shown there
-  std::vector<float>* loop_periods_us = nullptr;  // when set, every tick's period is recorded (benchmarks)
+  RunSeries prior_series;
 };
 
 struct RunnerResult {
-  std::string state, reason;
+  CampaignEnd end = CampaignEnd::none;
+  std::string reason;
   std::int64_t run_id = 0;
   // missed_deadlines: samples not taken in time. Polling the latest value, that is a loop period
   // started a whole period late (a late wake-up); with block reads, a sample lost because the
   // controller's buffer overran before it was read. Late wake-ups are counted in both modes.
   std::uint64_t samples = 0, missed_deadlines = 0, late_wakeups = 0, dropped = 0;
+  std::uint64_t gaps = 0;          // holes in the run's time axis (each stored as an event)
+  double longest_gap_s = 0, gap_total_s = 0;
   std::size_t nodes = 0;
   std::optional<std::int64_t> table_id, lsq_table_id;
 };
 
-// Runs the campaign (already stored as 'queued') to its end state; never throws for rig errors.
-// fot and waveform plans drive a load frame; sine plans a shaker (run_sine_campaign).
-RunnerResult run_campaign(std::int64_t campaign_id, const Plan& plan, RunnerContext& ctx);
-RunnerResult run_sine_campaign(std::int64_t campaign_id, const Plan& plan, RunnerContext& ctx);
+// What finishing a run needs, handed off the acquisition thread.
+struct FinishJob {
+  std::int64_t campaign = 0;
+  Plan plan;
+  RunnerResult result;
+  std::shared_ptr<const models::OnlineTableBuilder> builder;  // every node of the campaign (fot)
+  RunSeries series;  // every sample of every run of the campaign (fot)
+};
+
+struct RunnerContext {
+  RunnerContext(drivers::Rig& r, Supervisor& s, db::SampleWriter& w, Clock& c) : rig(r), supervisor(s), writer(w), clock(c) {}
+  drivers::Rig& rig;
+  Supervisor& supervisor;
+  db::SampleWriter& writer;
+  Clock& clock;
+  double time_scale = 1.0;  // rig seconds per wall second (a time-scaled simulator)
+  std::function<std::optional<Control>()> next_control = [] { return std::nullopt; };
+  const std::atomic<bool>* stop = nullptr;  // the daemon is shutting down: hold, interrupted
+  double resume_preamble_after_s = 2.0;     // rig seconds of pause after which memory is re-wiped
+  int watchdog_hold_periods = 20, watchdog_fail_periods = 500;
+  double db_timeout_s = 10.0;               // for the writer to create the run before arming
+  std::function<std::string()> now_iso;     // wall-clock stamps for the records
+  std::function<void(const std::string&)> on_state;  // observers (logs, tests)
+  RigLive* live = nullptr;                        // when set, every sample and missed deadline is shown there
+  std::vector<float>* loop_periods_us = nullptr;  // when set, every tick's period is recorded (benchmarks)
+  // Finishing (fits, tables, the final state) off this thread; empty: done inline, then returns.
+  std::function<void(FinishJob)> finish;
+  // The steady-clock second at which the rig's time began (the supervisor's deadlines run on it
+  // across campaigns); NaN: the campaign's own start.
+  double epoch = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Runs the campaign (already stored as 'queued') to its end; never throws for rig errors. The
+// rig is left held and disabled (idle), latched, or held where it stopped, and says why.
+RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx);
+
+// The end of a run: the tables from every node and sample, their accuracy, and the run's and the
+// campaign's final state, in one writer transaction; skipped when the run already has its tables
+// (finishing is idempotent). Blocks until stored (for the finisher thread, or tests).
+RunnerResult finish_campaign(FinishJob job, db::SampleWriter& writer, const std::function<std::string()>& now_iso);
 
 }  // namespace hystlab::daemon

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/db/sample_writer.hpp"
@@ -42,6 +43,8 @@ struct RigEntry {
   double time_scale = 1.0;
   bool simulated = false;
   SimulatorOptions sim;
+  RigEnvelope envelope;             // "envelope": what the rig can do (plans are checked against it)
+  SupervisionSettings supervision;  // "supervision": dead band, lag, settle, mode, heartbeat, ...
 };
 
 // The HTTP/JSON API and the page (web/). Binding anywhere but loopback needs a token, which every
@@ -78,6 +81,23 @@ struct RigInfo {
   bool simulated = false;
 };
 
+// Operator commands for a rig itself, whatever campaign runs (or none).
+enum class RigCommand { reset, estop };
+
+// The rig's supervision as other threads see it (a copy, taken under a lock).
+struct RigSupervision {
+  std::string state = "disconnected";  // RigState, as text at this edge
+  bool latched = false, resetting = false, have_sample = false;
+  std::string latch_reason, reset_refusal;
+  std::uint16_t latched_fault_code = 0;  // the code that latched (0: an e-stop or none)
+  std::uint16_t status_word = 0, fault_code = 0;  // the last sample's
+  std::string fault_text;                          // the map's text for fault_code
+  double position_mm = 0, force_N = 0;
+  std::uint64_t link_losses = 0, transitions = 0;
+  std::vector<nlohmann::json> recent;  // the last transitions: at, t, from, to, reason
+  nlohmann::json envelope, supervision;
+};
+
 // The daemon's owners: one acquisition thread per rig, the db writer thread, and the main loop
 // (run) that carries out commands and keeps the snapshots. Other threads (HTTP) read the
 // snapshots and live feeds, and send commands through a queue; they never touch a rig.
@@ -96,14 +116,20 @@ class Daemon {
   [[nodiscard]] const RigInfo& rig_info(std::size_t k) const;
   [[nodiscard]] const RigLive& rig_live(std::size_t k) const;
   [[nodiscard]] drivers::IoHealthSnapshot rig_health(std::size_t k) const;
+  [[nodiscard]] RigSupervision rig_supervision(std::size_t k) const;
+  // The rig by name (empty: the only rig); throws std::invalid_argument naming it.
+  [[nodiscard]] std::size_t rig_index(const std::string& name) const;
   [[nodiscard]] db::WriterStats writer_stats() const;
   [[nodiscard]] double uptime_s() const noexcept;
 
   // Queues a campaign on a rig (empty name: the only rig). Throws std::invalid_argument naming
   // what is wrong (the plan's field, an unknown rig, a plan the rig cannot run).
   std::int64_t submit(const std::string& rig_name, const nlohmann::json& plan);
-  // pause, resume, abort, estop: carried out by the main loop, as the CLI's commands are.
+  // pause, resume, abort, estop. A running campaign's goes straight to its rig's thread (never
+  // through the database, which may be busy); a queued or held one's through the main loop.
   void command(std::int64_t campaign_id, const std::string& verb);
+  // reset or estop a rig: straight to its thread, from any state.
+  void rig_command(std::size_t rig, RigCommand c);
 
  private:
   struct Impl;

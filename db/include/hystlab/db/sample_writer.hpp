@@ -7,6 +7,10 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <future>
+#include <memory>
+#include <optional>
+#include <chrono>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -50,6 +54,28 @@ class SampleWriter {
   // Other writes (events, FOT nodes, evaluations) run on the writer thread after the samples
   // queued before them, so the caller never waits on the disk. Brief lock, no I/O.
   void post(std::function<void(Store&)> job);
+  // Runs f on the writer thread and waits at most timeout_s for its result: nothing when it did
+  // not come in time or threw (a busy or failing database). For the few answers the acquisition
+  // thread needs before it arms a rig (a new run's id); never inside the loop.
+  template <class R>
+  std::optional<R> call(std::function<R(Store&)> f, double timeout_s) {
+    auto p = std::make_shared<std::promise<R>>();
+    auto fut = p->get_future();
+    post([p, f = std::move(f)](Store& s) {
+      try {
+        p->set_value(f(s));
+      } catch (...) {
+        p->set_exception(std::current_exception());
+      }
+    });
+    cv_.notify_all();
+    if (fut.wait_for(std::chrono::duration<double>(timeout_s)) != std::future_status::ready) return std::nullopt;
+    try {
+      return fut.get();
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+  }
   // Blocks until every row pushed (and job posted) before the call is done (not for the acquisition thread).
   void flush();
   [[nodiscard]] WriterStats stats() const;

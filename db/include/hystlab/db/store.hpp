@@ -59,8 +59,33 @@ class Store {
   std::int64_t add_table(std::optional<std::int64_t> campaign_id, std::optional<std::int64_t> run_id,
                          const std::string& method, int n, double lo, double hi, const std::string& now,
                          const std::string& accuracy_json, const std::string& document_json);
-  // At start-up: every campaign left arming, running or paused by a crash becomes interrupted.
+  // At start-up: every campaign left arming, running or paused by a crash becomes interrupted,
+  // except one whose tables were stored (finishing was done): that one is completed.
   int mark_interrupted(const std::string& now);
+  // At start-up: campaigns left queued wait for an operator ('held'); nothing moves by itself.
+  int hold_queued(const std::string& now);
+  struct TableRecord {
+    std::string method;
+    int n = 0;
+    double lo = 0, hi = 0;
+    std::string accuracy_json, document_json;
+  };
+  // Ends a run and its campaign in one transaction: the tables, the run's state, the campaign's
+  // state with its transition event. When the campaign already has tables (finishing again after
+  // a crash), none are added. Returns the new tables' ids.
+  std::vector<std::int64_t> finish_run(std::int64_t campaign_id, std::int64_t run_id, const std::vector<TableRecord>& tables,
+                                       const std::string& state, const std::string& reason, const std::string& now);
+  [[nodiscard]] std::int64_t table_count(std::int64_t campaign_id);
+  [[nodiscard]] std::vector<std::int64_t> runs_of_campaign(std::int64_t campaign_id);
+  // Operator commands for a rig (reset, estop), written by the CLI, taken by the daemon.
+  std::int64_t add_rig_command(const std::string& rig_name, const std::string& command, const std::string& now);
+  struct RigCommand {
+    std::int64_t id;
+    std::string rig, command;
+  };
+  [[nodiscard]] std::vector<RigCommand> take_rig_commands(const std::string& now);
+  [[nodiscard]] std::vector<std::string> rig_names();
+  void add_io_stats(std::int64_t rig_id, const std::string& stats_json, const std::string& now);
 
   // Operator commands (pause, resume, abort) queued for the daemon.
   std::int64_t add_command(std::int64_t campaign_id, const std::string& command, const std::string& now);
@@ -88,6 +113,7 @@ class Store {
   [[nodiscard]] std::string integrity_check();
 
  private:
+  void transition_in(std::int64_t campaign_id, const std::string& to, const std::string& reason, const std::string& now);
   Database db_;
   Statement insert_sample_, upsert_block_;
 };

@@ -27,6 +27,9 @@ class CanRig final : public Rig {
   std::error_code command(double setpoint_mm, double ramp_rate_mm_s) noexcept override;
   std::error_code hold(bool on) noexcept override;
   std::error_code estop(bool on) noexcept override;
+  // The command frame carries the mode (0..3) and a fault reset flag (protocols/CAN.md).
+  std::error_code set_mode(std::uint16_t mode) noexcept override;
+  std::error_code reset_faults() noexcept override;
   std::error_code read_sample(double now_s, RigSample& out) noexcept override;
   std::error_code command_shaker(double frequency_hz, double amplitude_mm, bool enable) noexcept override;
   std::error_code read_shaker(double now_s, ShakerSample& out) noexcept override;

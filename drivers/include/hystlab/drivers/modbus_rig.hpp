@@ -44,6 +44,10 @@ class ModbusRig final : public Rig {
   std::error_code command(double setpoint_mm, double ramp_rate_mm_s) noexcept override;
   std::error_code hold(bool on) noexcept override;
   std::error_code estop(bool on) noexcept override;
+  std::error_code set_mode(std::uint16_t mode) noexcept override;
+  std::error_code reset_faults() noexcept override;
+  std::error_code write_host_heartbeat(std::uint32_t value) noexcept override;
+  [[nodiscard]] std::string fault_text(std::uint16_t code) const override { return cfg_.map.fault_text(code); }
   std::error_code read_sample(double now_s, RigSample& out) noexcept override;
   std::error_code read_samples(double now_s, std::vector<RigSample>& out) noexcept override;
   [[nodiscard]] bool block_reads() const noexcept override { return cfg_.block_reads; }

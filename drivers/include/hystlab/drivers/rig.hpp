@@ -49,6 +49,18 @@ class Rig {
     return ec;
   }
   [[nodiscard]] virtual bool block_reads() const noexcept { return false; }
+  // What a real controller needs beyond motion. Each answers RigError::unsupported when the rig
+  // (its map) has no such signal; the supervisor then skips that step and says so.
+  // The operating mode (the map's `mode`): a controller moves only in the mode it was set to.
+  virtual std::error_code set_mode(std::uint16_t) noexcept { return RigError::unsupported; }
+  // The operator's reset: releases the e-stop signal and pulses the map's `fault_reset` (1, then
+  // 0), so the controller clears its latched faults. Default: release the e-stop only.
+  virtual std::error_code reset_faults() noexcept { return estop(false); }
+  // The host's heartbeat (the map's `host_heartbeat`), which a controller can watch to stop on
+  // its own when the host is gone.
+  virtual std::error_code write_host_heartbeat(std::uint32_t) noexcept { return RigError::unsupported; }
+  // The text of a controller fault code (the map's `fault_codes`); empty when unknown.
+  [[nodiscard]] virtual std::string fault_text(std::uint16_t) const { return {}; }
   virtual std::error_code command_shaker(double, double, bool) noexcept { return RigError::unsupported; }
   virtual std::error_code read_shaker(double, ShakerSample&) noexcept { return RigError::unsupported; }
   [[nodiscard]] virtual IoHealthSnapshot health() const noexcept = 0;

@@ -19,6 +19,7 @@ struct Command {  // hystlab -> rig
   double setpoint_mm = 0, ramp_rate_mm_s = 0;
   bool enable = false, hold = false, estop = false;
   std::uint8_t mode = 0;
+  bool fault_reset = false;  // flag bit 3: a rising edge clears the rig's latched faults
 };
 struct StatusA {  // rig -> hystlab, cyclic
   double displacement_mm = 0, force_N = 0;

@@ -2,6 +2,7 @@
 // A Modbus register map as data: which table, address, type, word order and scaling carry each
 // signal. Real controllers differ, so the map is a JSON file (docs: protocols/MODBUS.md).
 #include <array>
+#include <map>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -71,6 +72,9 @@ class RegisterMap {
   // Blocks covering the measurements (reads) of this map.
   [[nodiscard]] const std::vector<ReadBlock>& measurement_blocks() const noexcept { return blocks_; }
   [[nodiscard]] const std::optional<SampleWindow>& sample_window() const noexcept { return window_; }
+  // The controller's text for a fault code (the map's optional `fault_codes`); empty if unknown.
+  [[nodiscard]] std::string fault_text(std::uint16_t code) const;
+  [[nodiscard]] const std::map<std::uint16_t, std::string>& fault_codes() const noexcept { return fault_codes_; }
 
  private:
   static RegisterMap parse_map(std::string_view text);
@@ -81,6 +85,7 @@ class RegisterMap {
   std::array<int, kSignalCount> index_{};
   std::vector<ReadBlock> blocks_;
   std::optional<SampleWindow> window_;
+  std::map<std::uint16_t, std::string> fault_codes_;
 };
 
 // Engineering value -> register words (1 or 2) or a bit (0/1 in words[0]).

@@ -18,6 +18,8 @@ enum class Signal : std::size_t {
   drive_frequency_hz,
   drive_amplitude_mm,
   shaker_enable,
+  fault_reset,     // a rising edge clears the controller's latched faults (optional)
+  host_heartbeat,  // a counter the host keeps changing; a controller may stop when it stalls (optional)
   // measurements (read by hystlab)
   displacement_mm,
   force_N,

@@ -1,0 +1,397 @@
+// The one acquisition loop: arming handshake, absolute deadlines, controls, supervision of every
+// status bit, the safety envelope, the watchdog, gap accounting, the safe ramp, and hand-off of
+// the finished run. Campaign kinds are strategies (ramp_strategy.cpp, sine_strategy.cpp).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "acquisition_loop.hpp"
+
+namespace hystlab::daemon {
+using nlohmann::json;
+
+const char* to_string(CampaignEnd e) noexcept {
+  switch (e) {
+    case CampaignEnd::completed: return "completed";
+    case CampaignEnd::failed: return "failed";
+    case CampaignEnd::aborted: return "aborted";
+    case CampaignEnd::interrupted: return "interrupted";
+    case CampaignEnd::none: break;
+  }
+  return "running";
+}
+
+Loop::Loop(const CampaignJob& j, RunnerContext& c)
+    : job(j), plan(j.plan), ctx(c), shaker(j.plan.kind == "sine"), safety(j.plan.limits),
+      watchdog(c.watchdog_hold_periods, c.watchdog_fail_periods) {}
+
+void Loop::state(const std::string& to, const std::string& reason) {
+  const std::string now = ctx.now_iso();
+  const auto id = job.id;
+  ctx.writer.post([id, to, reason, now](db::Store& s) { s.transition(id, to, reason, now); });
+  if (ctx.on_state) ctx.on_state(to);
+}
+
+void Loop::event(const std::string& kind, const json& detail) {
+  const std::string now = ctx.now_iso(), text = detail.dump();
+  const auto id = job.id;
+  ctx.writer.post([id, kind, text, now](db::Store& s) { s.add_event(id, kind, text, now); });
+}
+
+void Loop::publish(double t, double a, double b, double c, std::uint16_t status) {
+  ctx.writer.try_push({result.run_id, next_seq++, t, a, b, c, status});
+  ++result.samples;
+  if (ctx.live) {
+    ctx.live->ring.push({ctx.clock.now(), t, a, b, c, result.run_id, status});
+    ctx.live->samples.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+// A hole in the time axis (a lost link, a frozen sensor, a stall, a reconnect): counted always,
+// stored as an event when longer than 20 ms, summed up when the campaign ends.
+void Loop::check_gap(double t) {
+  const double dt = t - last_t;
+  last_t = t;
+  if (!(dt > 3 * spacing && dt > 0.005)) return;
+  const double hole = dt - spacing;
+  ++result.gaps;
+  result.gap_total_s += hole;
+  result.longest_gap_s = std::max(result.longest_gap_s, hole);
+  if (hole > 0.02) event("gap", {{"from_s", t - dt}, {"to_s", t}, {"length_ms", hole * 1e3}});
+}
+
+void Loop::begin_safing(double t, CampaignEnd e, const std::string& reason, double x) {
+  end(e, reason);
+  if (safing) return;
+  if (shaker) {  // a shaker's safe state is no drive
+    ctx.supervisor.hold(t, reason);
+    return;
+  }
+  safing = true;
+  safe_started = t;
+  const Limits& l = plan.limits;
+  const SupervisionSettings& s = ctx.supervisor.settings();
+  safe_deadline = t + std::fabs(x - l.safe_position_mm) / l.safe_rate_mm_s + s.lag_s + s.settle_s;
+  ctx.supervisor.begin_safing(t, reason + ": to the safe position");
+  if (auto ec = ctx.rig.command(l.safe_position_mm, l.safe_rate_mm_s)) {
+    ctx.supervisor.hold(t, "the safe ramp was refused: held");
+    result.reason += "; the safe ramp was refused (" + ec.message() + "): held where it stopped";
+    safing = false;
+  }
+}
+
+namespace {
+StatusView view_of(const drivers::RigSample& s) { return {s.status_word, s.fault_code, s.displacement_mm}; }
+StatusView view_of(const drivers::ShakerSample& s) { return {s.status_word, s.fault_code, 0.0}; }
+
+// The arming handshake, sampled at the plan's period; false (result set) when it fails.
+bool arm(Loop& L) {
+  RunnerContext& c = L.ctx;
+  const double period = 1.0 / L.plan.sample_rate_hz;
+  double next = c.clock.now();
+  const double give_up = L.rig_time() + 2.0 + c.supervisor.settings().arm_timeout_s;
+  bool begun = false;
+  (void)c.rig.connect(L.rig_time());
+  for (;;) {
+    next += period;
+    c.clock.sleep_until(next);
+    const double t = L.rig_time();
+    if (c.stop && c.stop->load()) return L.end(CampaignEnd::interrupted, "the daemon is stopping"), c.supervisor.disarm(t, "stopping"), false;
+    if (const auto ctl = c.next_control(); ctl && (*ctl == Control::abort || *ctl == Control::estop)) {
+      if (*ctl == Control::estop) c.supervisor.estop(t, "e-stop by the operator");
+      else c.supervisor.disarm(t, "aborted while arming");
+      return L.end(CampaignEnd::aborted, *ctl == Control::estop ? "e-stop by the operator" : "aborted by the operator while arming"), false;
+    }
+    StatusView v;
+    std::error_code ec;
+    if (L.shaker) {
+      drivers::ShakerSample s;
+      ec = c.rig.read_shaker(t, s);
+      v = view_of(s);
+    } else {
+      drivers::RigSample s;
+      ec = c.rig.read_sample(t, s);
+      v = view_of(s);
+    }
+    if (ec == drivers::RigError::unsupported)
+      return L.end(CampaignEnd::failed, std::string("a ") + L.plan.kind + " campaign needs a " + (L.shaker ? "shaker" : "load frame") +
+                                            "; this rig is not one"),
+             false;
+    if (ec) {
+      c.supervisor.on_link_error(t, ec);
+      if (t > give_up) return L.end(CampaignEnd::failed, "cannot arm: the rig does not answer (" + ec.message() + ")"), false;
+      continue;
+    }
+    (void)c.supervisor.on_status(t, v);
+    if (!begun) {
+      if (c.supervisor.state() == RigState::disconnected) continue;  // re-asserting first
+      if (auto why = c.supervisor.begin_arming(t)) return L.end(CampaignEnd::failed, "cannot arm: " + *why), false;
+      begun = true;
+    }
+    std::string why;
+    const auto r = c.supervisor.arming_step(t, v, why);
+    if (r == Supervisor::Arming::armed) return true;
+    if (r == Supervisor::Arming::failed) return L.end(CampaignEnd::failed, "cannot arm: " + why), false;
+  }
+}
+
+// Pause, resume, abort, e-stop; false when the campaign ends at once (e-stop).
+bool handle_control(Loop& L, Strategy& strategy, double t, double x) {
+  const auto c = L.ctx.next_control();
+  if (!c) return true;
+  Supervisor& sup = L.ctx.supervisor;
+  if (*c == Control::estop) {
+    sup.estop(t, "e-stop by the operator");
+    L.end(CampaignEnd::aborted, "e-stop by the operator");
+    return false;
+  }
+  if (*c == Control::abort) {
+    L.paused = false;
+    L.begin_safing(t, CampaignEnd::aborted, "aborted by the operator", x);
+    return !L.shaker;
+  }
+  if (L.safing) return true;  // pause and resume mean nothing on the way to the safe position
+  if (*c == Control::pause && !L.paused) {
+    sup.hold(t, "paused by the operator");
+    strategy.on_pause(L, t);
+    L.paused = true;
+    L.pause_started = t;
+    L.state("paused", "operator");
+  } else if (*c == Control::resume && L.paused) {
+    sup.release(t, "resumed by the operator");
+    if (sup.state() != RigState::armed) return true;  // still held (the link): resumed when it answers
+    L.paused = false;
+    strategy.on_resume(L, t, false);
+  }
+  return true;
+}
+
+// The safe ramp's end: arrived within the in-position tolerance, or held where it stopped.
+bool safing_step(Loop& L, double t, double x) {
+  const Limits& l = L.plan.limits;
+  const double tol = L.ctx.supervisor.settings().in_position_mm;
+  if (std::fabs(x - l.safe_position_mm) <= tol) {
+    L.event("safe", {{"position_mm", x}, {"target_mm", l.safe_position_mm}, {"seconds", t - L.safe_started}});
+    return false;
+  }
+  if (t > L.safe_deadline) {
+    L.ctx.supervisor.hold(t, "the safe position was not reached: held");
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "; the safe position %.3f mm was not reached in %.1f s: held at %.3f mm", l.safe_position_mm,
+                  t - L.safe_started, x);
+    L.result.reason += buf;
+    return false;
+  }
+  return true;
+}
+
+// One fresh load-frame sample; false when the campaign ends.
+bool frame_sample(Loop& L, Strategy& strategy, const drivers::RigSample& s) {
+  L.check_gap(s.time_s);
+  L.publish(s.time_s, s.command_mm, s.displacement_mm, s.force_N, s.status_word);
+  if (auto why = L.ctx.supervisor.on_status(s.time_s, view_of(s))) {
+    L.end(CampaignEnd::failed, *why + (L.safing ? " (on the way to the safe position)" : ""));
+    L.safing = false;
+    return false;
+  }
+  if (L.safing) return safing_step(L, s.time_s, s.displacement_mm);
+  if (auto trip = L.safety.check(s.displacement_mm, s.force_N, s.time_s, std::max(s.time_s, L.answered_at))) {
+    L.begin_safing(s.time_s, CampaignEnd::aborted, "safety trip: " + *trip, s.displacement_mm);
+    return L.safing;
+  }
+  if (L.paused || L.link_held) return true;
+  return strategy.on_frame(L, s);
+}
+
+bool shaker_sample(Loop& L, Strategy& strategy, const drivers::ShakerSample& s) {
+  L.check_gap(s.time_s);
+  L.publish(s.time_s, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, s.status_word);
+  if (auto why = L.ctx.supervisor.on_status(s.time_s, view_of(s))) return L.end(CampaignEnd::failed, *why), false;
+  if (std::fabs(s.mass_displacement_mm) > L.plan.limits.displacement_max_mm) {
+    L.begin_safing(s.time_s, CampaignEnd::aborted, "safety trip: mass displacement beyond the limits", 0.0);
+    return false;
+  }
+  if (L.paused || L.link_held) return true;
+  return strategy.on_shaker(L, s);
+}
+
+// A read that brought nothing fresh: the watchdog decides between waiting, holding and failing.
+bool on_missed(Loop& L, double t, std::error_code ec) {
+  const auto v = L.watchdog.missed();
+  if (v == Watchdog::Verdict::hold && !L.link_held) {
+    L.link_held = true;
+    L.ctx.supervisor.on_link_error(t, ec);
+    L.ctx.supervisor.hold(t, "no fresh sample: held");
+  }
+  if (v != Watchdog::Verdict::fail) return true;
+  L.ctx.supervisor.hold(t, "watchdog: held");
+  L.end(CampaignEnd::failed, "watchdog: no fresh sample for " + std::to_string(L.watchdog.missed_periods()) + " periods (" + ec.message() +
+                                 "); the rig is held, and held again the moment it answers");
+  L.safing = false;
+  return false;
+}
+
+void count_tick(Loop& L, double now, double next, double period, bool blocks) {
+  if (now - next <= period) return;
+  ++L.result.late_wakeups;
+  if (L.ctx.live) L.ctx.live->late_wakeups.fetch_add(1, std::memory_order_relaxed);
+  if (blocks) return;  // block reads lose nothing to a late wake-up
+  ++L.result.missed_deadlines;
+  if (L.ctx.live) L.ctx.live->missed_deadlines.fetch_add(1, std::memory_order_relaxed);
+}
+
+struct Reader {  // the rig's samples, fresh ones only, at the plan's rate on the controller's clock
+  std::vector<drivers::RigSample> block;
+  std::uint32_t last_counter = 0;
+  bool have_counter = false;
+  double last_kept = -1e300;
+  Reader() { block.reserve(4096); }  // the rig fills it without allocating
+  bool fresh(std::uint32_t counter) {
+    if (have_counter && counter == last_counter) return false;
+    have_counter = true;
+    last_counter = counter;
+    return true;
+  }
+};
+
+// One tick's reading and processing; false when the campaign ends.
+bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double period) {
+  RunnerContext& c = L.ctx;
+  bool fresh = false;
+  if (L.shaker) {
+    drivers::ShakerSample s;
+    if (auto ec = c.rig.read_shaker(t, s)) return on_missed(L, t, ec);
+    if (rd.fresh(s.sample_counter)) {
+      fresh = true;
+      s.time_s = t;
+      if (L.link_held) L.link_held = false, strategy.on_resume(L, t, true);
+      if (!shaker_sample(L, strategy, s)) return false;
+    }
+  } else {
+    if (auto ec = c.rig.read_samples(t, rd.block)) return on_missed(L, t, ec);
+    if (!blocks) L.answered_at = L.rig_time();  // a polled sample is stamped when asked
+    for (const drivers::RigSample& s : rd.block) {
+      if (!rd.fresh(s.sample_counter)) continue;
+      fresh = true;
+      if (blocks && s.time_s - rd.last_kept < period * c.time_scale * (1 - 1e-6)) continue;  // a faster controller
+      rd.last_kept = s.time_s;
+      if (L.link_held && !L.paused && !L.safing) {  // the link is back and the hold re-asserted: go on
+        (void)c.supervisor.on_status(s.time_s, view_of(s));
+        c.supervisor.release(s.time_s, "link back: the segment is taken again");
+        if (c.supervisor.state() == RigState::armed) L.link_held = false, strategy.on_resume(L, s.time_s, true);
+      } else if (L.link_held) {
+        L.link_held = false;
+      }
+      if (!frame_sample(L, strategy, s)) return false;
+    }
+  }
+  if (!fresh) return on_missed(L, t, drivers::RigError::stale_data);
+  L.watchdog.fresh();
+  if (strategy.done() && !L.safing) {
+    L.end(CampaignEnd::completed, "");
+    return false;
+  }
+  return true;
+}
+
+void run_ticks(Loop& L, Strategy& strategy) {
+  RunnerContext& c = L.ctx;
+  const double period = 1.0 / L.plan.sample_rate_hz;
+  const bool blocks = !L.shaker && c.rig.block_reads();
+  const std::uint64_t lost_before = c.rig.health().lost_samples;
+  L.spacing = period * c.time_scale;
+  Reader rd;
+  double next = c.clock.now(), prev_tick = 0;
+  for (;;) {
+    next += period;
+    c.clock.sleep_until(next);
+    const double now = c.clock.now();
+    count_tick(L, now, next, period, blocks);
+    if (c.loop_periods_us && prev_tick > 0) c.loop_periods_us->push_back(static_cast<float>((now - prev_tick) * 1e6));
+    prev_tick = now;
+    const double t = (now - L.wall0) * c.time_scale;
+    c.supervisor.heartbeat(t);
+    if (c.stop && c.stop->load()) {
+      L.end(CampaignEnd::interrupted, "the daemon is stopping");
+      break;
+    }
+    const double x = rd.block.empty() ? 0.0 : rd.block.back().displacement_mm;
+    if (!handle_control(L, strategy, t, x)) break;
+    const bool going = tick(L, strategy, rd, t, blocks, period);
+    if (blocks) {
+      const std::uint64_t lost = c.rig.health().lost_samples - lost_before;
+      if (c.live && lost > L.result.missed_deadlines) c.live->missed_deadlines.fetch_add(lost - L.result.missed_deadlines);
+      L.result.missed_deadlines = lost;
+    }
+    if (!going) break;
+  }
+}
+
+// The rig after the run: held and disabled (idle) unless latched; a lost link re-asserts it later.
+void leave_rig(Loop& L) {
+  const double t = L.rig_time();
+  Supervisor& sup = L.ctx.supervisor;
+  if (sup.latched()) return;
+  if (L.shaker) (void)L.ctx.rig.command_shaker(0.0, 0.0, false);
+  sup.disarm(t, std::string("campaign ") + to_string(L.result.end) + (L.result.reason.empty() ? "" : ": " + L.result.reason));
+}
+
+void hand_off(Loop& L, Strategy& strategy) {
+  FinishJob fj;
+  fj.campaign = L.job.id;
+  fj.plan = L.plan;
+  fj.result = L.result;
+  strategy.fill_finish(L, fj);
+  if (L.result.gaps > 0)
+    L.event("gaps", {{"count", L.result.gaps}, {"total_ms", L.result.gap_total_s * 1e3}, {"longest_ms", L.result.longest_gap_s * 1e3}});
+  if (L.ctx.finish) {
+    L.ctx.finish(std::move(fj));
+    return;
+  }
+  L.result = finish_campaign(std::move(fj), L.ctx.writer, L.ctx.now_iso);
+  if (L.ctx.on_state) L.ctx.on_state(to_string(L.result.end));
+}
+
+bool create_run(Loop& L) {
+  const auto id = L.job.id;
+  const std::string now = L.ctx.now_iso();
+  const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(), mono = L.wall0;
+  const auto run = L.ctx.writer.call<std::int64_t>([id, now, wall, mono](db::Store& s) { return s.add_run(id, now, wall, mono); },
+                                                   L.ctx.db_timeout_s);
+  if (!run) return L.end(CampaignEnd::failed, "the database did not take the new run in time: the rig was not armed"), false;
+  L.result.run_id = *run;
+  return true;
+}
+}  // namespace
+
+RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
+  Loop L(job, ctx);
+  std::unique_ptr<Strategy> strategy = L.shaker ? make_sine_strategy(L) : make_ramp_strategy(L);
+  L.wall0 = ctx.clock.now();
+  ctx.supervisor.set_time_offset(std::isnan(ctx.epoch) ? 0.0 : (L.wall0 - ctx.epoch) * ctx.time_scale);
+  const Limits& l = job.plan.limits;
+  L.event("limits", {{"displacement_mm", {l.displacement_min_mm, l.displacement_max_mm}}, {"force_N", l.force_max_N},
+                     {"rate_mm_s", l.rate_max_mm_s}, {"safe_position_mm", l.safe_position_mm}, {"safe_rate_mm_s", l.safe_rate_mm_s},
+                     {"in_position_mm", ctx.supervisor.settings().in_position_mm}});
+  if (!strategy->has_work()) {  // a resume with every node measured: finish without moving
+    L.end(CampaignEnd::completed, "every node was measured by earlier runs: finished without driving the rig");
+    hand_off(L, *strategy);
+    return L.result;
+  }
+  L.state("arming", "started by the daemon");
+  const std::uint64_t dropped_before = ctx.writer.stats().dropped_full;
+  if (create_run(L) && arm(L)) {
+    L.state("running", "armed");
+    run_ticks(L, *strategy);
+  }
+  leave_rig(L);
+  L.result.dropped = ctx.writer.stats().dropped_full - dropped_before;
+  if (L.result.gaps > 0 && L.result.end == CampaignEnd::completed)
+    L.result.reason = std::to_string(L.result.gaps) + " gap(s) in the data, the longest " + std::to_string(static_cast<int>(L.result.longest_gap_s * 1e3)) + " ms";
+  hand_off(L, *strategy);
+  ctx.supervisor.set_time_offset(0.0);
+  return L.result;
+}
+
+}  // namespace hystlab::daemon

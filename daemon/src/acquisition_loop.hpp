@@ -1,0 +1,68 @@
+#pragma once
+// The acquisition loop's state and the strategy interface (internal to the daemon library).
+#include <cmath>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "hystlab/daemon/campaign_runner.hpp"
+#include "hystlab/daemon/safety.hpp"
+
+namespace hystlab::daemon {
+
+struct Loop;
+
+// A campaign kind: it produces setpoints and consumes samples. The loop does everything else.
+class Strategy {
+ public:
+  virtual ~Strategy() = default;
+  // False for a resumed campaign with nothing left to drive (its tables are made from what its
+  // earlier runs measured, without arming the rig).
+  [[nodiscard]] virtual bool has_work() const { return true; }
+  // A fresh sample, stored and checked; returns false to end the campaign (result set, or done).
+  virtual bool on_frame(Loop&, const drivers::RigSample&) { return true; }
+  virtual bool on_shaker(Loop&, const drivers::ShakerSample&) { return true; }
+  virtual void on_pause(Loop&, double /*t*/) {}
+  // After a pause (long: memory-aware) or a held link: re-issue the command in progress.
+  virtual void on_resume(Loop&, double t, bool after_link_loss) = 0;
+  [[nodiscard]] virtual bool done() const = 0;
+  virtual void fill_finish(Loop&, FinishJob&) {}
+};
+
+std::unique_ptr<Strategy> make_ramp_strategy(Loop& L);  // fot, waveform (load frame)
+std::unique_ptr<Strategy> make_sine_strategy(Loop& L);  // sine (shaker)
+
+struct Loop {
+  Loop(const CampaignJob& j, RunnerContext& c);
+  const CampaignJob& job;
+  const Plan& plan;
+  RunnerContext& ctx;
+  const bool shaker;
+  RunnerResult result;
+  SafetyEnvelope safety;
+  Watchdog watchdog;
+  double wall0 = 0;
+  std::int64_t next_seq = 0;
+  bool paused = false, link_held = false, safing = false;
+  double pause_started = 0, answered_at = -1e300;
+  double safe_deadline = 0, safe_started = 0;
+  CampaignEnd safing_end = CampaignEnd::aborted;
+  double last_t = NAN, spacing = 0;  // the time axis: the last sample's time and the expected spacing
+
+  [[nodiscard]] double rig_time() { return (ctx.clock.now() - wall0) * ctx.time_scale; }
+  // The first end wins: a trip during an abort stays an abort with both reasons said.
+  void end(CampaignEnd e, const std::string& reason) {
+    if (result.end != CampaignEnd::none) return;
+    result.end = e;
+    result.reason = reason;
+  }
+  void state(const std::string& to, const std::string& reason);
+  void event(const std::string& kind, const nlohmann::json& detail);
+  // The safe ramp (abort or trip): the loop keeps sampling, storing and publishing until the
+  // rig is within the in-position tolerance of the safe position, or holds where it stopped.
+  void begin_safing(double t, CampaignEnd e, const std::string& reason, double position_mm);
+  void publish(double t, double a, double b, double c, std::uint16_t status);
+  void check_gap(double t);
+};
+
+}  // namespace hystlab::daemon

@@ -1,0 +1,50 @@
+#include "finisher.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "rig_worker.hpp"
+
+namespace hystlab::daemon {
+
+Finisher::Finisher(db::SampleWriter& writer) : writer_(writer), thread_([this] { run(); }) {}
+
+Finisher::~Finisher() {
+  {
+    std::lock_guard lk(mu_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
+}
+
+void Finisher::submit(FinishJob job) {
+  {
+    std::lock_guard lk(mu_);
+    jobs_.push_back(std::move(job));
+  }
+  cv_.notify_all();
+}
+
+void Finisher::run() {
+  for (;;) {
+    FinishJob job;
+    {
+      std::unique_lock lk(mu_);
+      cv_.wait(lk, [this] { return stop_ || !jobs_.empty(); });
+      if (jobs_.empty()) return;
+      job = std::move(jobs_.front());
+      jobs_.pop_front();
+    }
+    const auto id = job.campaign;
+    try {
+      const RunnerResult r = finish_campaign(std::move(job), writer_, now_iso);
+      spdlog::info("campaign {} finished: {}{}{}", id, to_string(r.end), r.reason.empty() ? "" : ": ", r.reason);
+    } catch (const std::exception& e) {  // a fit that throws fails the campaign; the thread goes on
+      spdlog::error("campaign {}: finishing failed: {}", id, e.what());
+      const std::string now = now_iso(), reason = std::string("finishing failed: ") + e.what();
+      writer_.post([id, reason, now](db::Store& s) { s.transition(id, "failed", reason, now); });
+    }
+  }
+}
+
+}  // namespace hystlab::daemon

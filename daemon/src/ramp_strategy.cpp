@@ -1,0 +1,133 @@
+// fot and waveform campaigns on a load frame: a list of ramps (the sequencer), each supervised
+// for its arrival, and for fot the online table fitted as each descent passes the grid.
+#include <cmath>
+#include <cstdio>
+
+#include "acquisition_loop.hpp"
+#include "hystlab/daemon/online_fot.hpp"
+#include "hystlab/daemon/sequencer.hpp"
+#include "hystlab/models/online_table_builder.hpp"
+#include "run_finish.hpp"
+
+namespace hystlab::daemon {
+namespace {
+
+class RampStrategy final : public Strategy {
+ public:
+  explicit RampStrategy(Loop& L)
+      : plan_(L.plan), seq_(schedule(L.plan), L.ctx.supervisor.settings().in_position_mm), settings_(L.ctx.supervisor.settings()) {
+    series_ = L.job.prior_series;
+    if (plan_.kind != "fot") return;
+    const models::Grid g = models::Grid::make(plan_.lo_mm, plan_.hi_mm, plan_.subdivisions);
+    builder_ = std::make_shared<models::OnlineTableBuilder>(g);
+    for (const models::FotNode& n : L.job.prior_nodes) (void)builder_->add(n);
+    if (!L.job.prior_nodes.empty()) resume_rows_only(L);
+    const double band = std::min(0.05 * g.step(), 0.02);
+    fot_ = std::make_unique<OnlineFot>(g, band, [this, &L](const models::FotNode& n, double t) {
+      if (builder_->add(n)) return;
+      ++L.result.nodes;
+      const auto run = L.result.run_id;
+      L.ctx.writer.post([run, n, t](db::Store& s) { s.add_fot_node(run, n.alpha, n.beta, n.force_alpha, n.force_alpha_beta, t); });
+    });
+  }
+
+  [[nodiscard]] bool has_work() const override { return !(builder_ && builder_->complete()); }
+
+  bool on_frame(Loop& L, const drivers::RigSample& s) override {
+    series_.add(s.displacement_mm, s.force_N);
+    const std::size_t before = seq_.index();
+    if (const auto cmd = seq_.step(s.time_s, s.displacement_mm)) {
+      if (auto ec = L.ctx.rig.command(cmd->target_mm, cmd->rate_mm_s)) {
+        L.ctx.supervisor.hold(s.time_s, "command refused: held");
+        L.end(CampaignEnd::failed, "command refused: " + ec.message());
+        return false;
+      }
+      arm_deadline(s.time_s, s.displacement_mm, *cmd);
+    } else if (seq_.index() == before && !seq_.done() && s.time_s > deadline_) {
+      return target_missed(L, s);
+    }
+    if (fot_) {
+      fot_->feed(s.time_s, s.displacement_mm, s.force_N, collecting());
+      if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
+    }
+    return true;
+  }
+
+  void on_resume(Loop& L, double t, bool after_link_loss) override {
+    const Segment* cur = seq_.current();
+    if (!after_link_loss && plan_.kind == "fot" && cur && t - L.pause_started > L.ctx.resume_preamble_after_s) {
+      // Memory-aware resume: the specimen drifted while held; wipe its memory at δmin and
+      // re-take the row that was in progress.
+      const std::size_t k = cur->kind == SegmentKind::descent ? seq_.index() - 1 : seq_.index();
+      seq_.restart_at(k);
+      seq_.insert_before_current({{plan_.lo_mm, plan_.ramp_rate_mm_s, plan_.dwell_s, SegmentKind::preamble, 0}});
+      L.state("running", "resumed after a long pause: wipe-out preamble to δmin, row re-taken");
+    } else {
+      seq_.restart_at(seq_.index());  // re-issue the current segment's command
+      L.state("running", after_link_loss ? "link back: segment taken again" : "resumed");
+    }
+    deadline_ = 1e300;
+  }
+
+  [[nodiscard]] bool done() const override { return seq_.done(); }
+
+  void fill_finish(Loop& L, FinishJob& fj) override {
+    if (fot_) {
+      fot_->finish();  // the last descent ends here: evaluate it like the others
+      if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
+    }
+    if (!builder_) return;
+    fj.builder = std::move(builder_);
+    fj.series = std::move(series_);
+  }
+
+ private:
+  static std::vector<Segment> schedule(const Plan& p) { return p.kind == "fot" ? fot_schedule(p) : waveform_schedule(p); }
+
+  void resume_rows_only(Loop& L) {  // a resumed campaign drives only the rows not yet complete
+    const std::vector<Segment> all = schedule(L.plan);
+    std::vector<Segment> rest{all.front()};
+    for (const Segment& seg : all) {
+      if (seg.kind != SegmentKind::rise && seg.kind != SegmentKind::descent) continue;
+      bool row_done = true;
+      for (int j = 0; j < seg.row; ++j) row_done = row_done && builder_->identified(seg.row, j);
+      if (!row_done) rest.push_back(seg);
+    }
+    seq_ = Sequencer(rest, settings_.in_position_mm);
+  }
+
+  // Motion is supervised: distance / rate, plus the rig's lag, a settle time and the dwell.
+  void arm_deadline(double t, double x, const SetpointCommand& cmd) {
+    const Segment* seg = seq_.current();
+    target_ = cmd.target_mm;
+    started_ = t;
+    deadline_ = t + std::fabs(cmd.target_mm - x) / cmd.rate_mm_s + settings_.lag_s + settings_.settle_s + (seg ? seg->dwell_s : 0.0);
+  }
+
+  bool target_missed(Loop& L, const drivers::RigSample& s) {
+    L.ctx.supervisor.hold(s.time_s, "target not reached: held");
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "target %.3f mm not reached in %.1f s: stopped at %.3f mm (in-position tolerance %.3g mm)", target_,
+                  s.time_s - started_, s.displacement_mm, settings_.in_position_mm);
+    L.end(CampaignEnd::failed, buf);
+    return false;
+  }
+
+  bool collecting() const {
+    const Segment* s = seq_.current();
+    return s && (s->kind == SegmentKind::rise || s->kind == SegmentKind::descent);
+  }
+
+  const Plan& plan_;
+  Sequencer seq_;
+  SupervisionSettings settings_;
+  std::shared_ptr<models::OnlineTableBuilder> builder_;
+  std::unique_ptr<OnlineFot> fot_;
+  RunSeries series_;
+  double target_ = 0, started_ = 0, deadline_ = 1e300;
+};
+}  // namespace
+
+std::unique_ptr<Strategy> make_ramp_strategy(Loop& L) { return std::make_unique<RampStrategy>(L); }
+
+}  // namespace hystlab::daemon

@@ -1,0 +1,81 @@
+// sine campaigns on a shaker: each frequency is driven for settle_cycles, then measured for
+// measured_cycles; amplitude and phase of base and mass motion come from a least-squares sine
+// fit, and the transmissibility point is stored as it comes.
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "acquisition_loop.hpp"
+#include "hystlab/models/sine_fit.hpp"
+
+namespace hystlab::daemon {
+namespace {
+
+class SineStrategy final : public Strategy {
+ public:
+  explicit SineStrategy(const Plan& p) : plan_(p) {}
+
+  bool on_shaker(Loop& L, const drivers::ShakerSample& s) override {
+    if (!started_) return start_step(L, s.time_s);
+    if (s.time_s >= t_measure_) {
+      t_.push_back(s.time_s);
+      base_.push_back(s.base_displacement_mm);
+      mass_.push_back(s.mass_displacement_mm);
+    }
+    if (s.time_s < t_end_) return true;
+    if (!store_point(L)) return false;
+    ++k_;
+    started_ = false;
+    return true;
+  }
+
+  void on_resume(Loop& L, double t, bool) override {  // the step is taken again from its start
+    if (k_ < plan_.frequencies_hz.size()) (void)start_step(L, t);
+  }
+
+  [[nodiscard]] bool done() const override { return k_ >= plan_.frequencies_hz.size(); }
+
+ private:
+  bool start_step(Loop& L, double t) {
+    const double f = plan_.frequencies_hz[k_];
+    if (auto ec = L.ctx.rig.command_shaker(f, plan_.amplitude_mm, true)) {
+      L.ctx.supervisor.hold(t, "shaker command refused: no drive");
+      L.end(CampaignEnd::failed, "shaker command refused: " + ec.message());
+      return false;
+    }
+    started_ = true;
+    t_measure_ = t + plan_.settle_cycles / f;
+    t_end_ = t_measure_ + plan_.measured_cycles / f;
+    t_.clear(), base_.clear(), mass_.clear();
+    return true;
+  }
+
+  bool store_point(Loop& L) {
+    const double f = plan_.frequencies_hz[k_];
+    const models::SineFit b = models::fit_sine(t_, base_, f), m = models::fit_sine(t_, mass_, f);
+    if (!b.ok || !m.ok || b.amplitude <= 0) {
+      L.ctx.supervisor.hold(t_end_, "no fit: no drive");
+      L.end(CampaignEnd::failed, "too few samples to fit the sine at " + std::to_string(f) + " Hz");
+      return false;
+    }
+    const double ratio = m.amplitude / b.amplitude, phase = std::remainder(m.phase_rad - b.phase_rad, 2 * std::numbers::pi);
+    const auto run = L.result.run_id, id = L.job.id;
+    const std::string now = L.ctx.now_iso();
+    L.ctx.writer.post([run, f, b, m, ratio, phase, id, now](db::Store& st) {
+      st.add_transmissibility(run, f, b.amplitude, m.amplitude, ratio, phase);
+      st.add_event(id, "transmissibility", nlohmann::json{{"frequency_hz", f}, {"ratio", ratio}, {"phase_rad", phase}}.dump(), now);
+    });
+    return true;
+  }
+
+  const Plan& plan_;
+  std::size_t k_ = 0;
+  bool started_ = false;
+  double t_measure_ = 0, t_end_ = 0;
+  std::vector<double> t_, base_, mass_;
+};
+}  // namespace
+
+std::unique_ptr<Strategy> make_sine_strategy(Loop& L) { return std::make_unique<SineStrategy>(L.plan); }
+
+}  // namespace hystlab::daemon

@@ -1,0 +1,156 @@
+#pragma once
+// An in-process load frame for the unit tests of the loop and the supervisor: a controller with
+// the contract of a real one (ready/enabled handshake, a mode interlock, latched e-stop and
+// faults cleared only by a reset, a servo dead band, hold), driven by the time passed in, with a
+// fault plan (latch fault k at t, e-stop at t, drop or exceptions or a frozen counter over a
+// window, a late answer). It records what the host wrote, so invariants can be checked.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "hystlab/drivers/rig.hpp"
+#include "hystlab/protocols/signals.hpp"
+
+namespace hystlab::test {
+namespace st = protocols::status;
+using drivers::RigError;
+
+struct FaultEvent {
+  enum Kind { latch_fault, estop, drop, exceptions, freeze, drop_enable } kind;
+  double at_s = 0, until_s = 0;  // windows: [at, until)
+  std::uint16_t code = 0;
+  bool applied = false;  // one-shot events (latch_fault, estop, drop_enable) happen once
+};
+
+class FakeRig final : public drivers::Rig {
+ public:
+  // What the host did, for the invariants.
+  struct Log {
+    int setpoints_while_latched = 0, enables_while_latched = 0, resets = 0, hold_writes = 0, estop_writes = 0;
+    int mode_writes = 0, heartbeats = 0;
+    std::vector<double> setpoints;
+  } log;
+  double deadband_mm = 0, rate_cap_mm_s = 500, dt = 0.001;
+  std::uint16_t required_mode = 1;
+  std::vector<FaultEvent> plan;
+
+  std::error_code connect(double) noexcept override { return {}; }
+  void disconnect() noexcept override {}
+  std::error_code arm(bool on) noexcept override {
+    if (auto ec = link()) return ec;
+    if (on && (estop_ || fault_)) ++log.enables_while_latched;
+    enable_ = on;
+    return {};
+  }
+  std::error_code command(double sp, double rate) noexcept override {
+    if (auto ec = link()) return ec;
+    if (estop_ || fault_) ++log.setpoints_while_latched;
+    setpoint_ = sp, rate_ = rate;
+    log.setpoints.push_back(sp);
+    return {};
+  }
+  std::error_code hold(bool on) noexcept override {
+    if (auto ec = link()) return ec;
+    ++log.hold_writes;
+    hold_ = on;
+    return {};
+  }
+  std::error_code estop(bool on) noexcept override {
+    if (auto ec = link()) return ec;
+    ++log.estop_writes;
+    estop_cmd_ = on;
+    if (on) latch_estop();
+    return {};
+  }
+  std::error_code set_mode(std::uint16_t m) noexcept override {
+    if (auto ec = link()) return ec;
+    ++log.mode_writes;
+    mode_ = m;
+    return {};
+  }
+  std::error_code reset_faults() noexcept override {
+    if (auto ec = link()) return ec;
+    ++log.resets;
+    estop_cmd_ = false;
+    if (!cause_) fault_ = 0, estop_ = false, enable_ = false;
+    return {};
+  }
+  std::error_code write_host_heartbeat(std::uint32_t) noexcept override {
+    if (auto ec = link()) return ec;
+    ++log.heartbeats;
+    return {};
+  }
+  std::string fault_text(std::uint16_t code) const override { return code == 7 ? "hydraulic pressure low" : ""; }
+  std::error_code read_sample(double now, drivers::RigSample& out) noexcept override {
+    advance(now);
+    if (auto ec = link()) return ec;
+    out.time_s = now;
+    out.displacement_mm = x_;
+    out.command_mm = cmd_;
+    out.force_N = 20 * x_;
+    out.status_word = status();
+    out.fault_code = fault_;
+    if (!frozen()) ++counter_;
+    out.sample_counter = counter_;
+    return {};
+  }
+  [[nodiscard]] drivers::IoHealthSnapshot health() const noexcept override { return {}; }
+  [[nodiscard]] std::string describe() const override { return "fake rig"; }
+
+  // The controller's state, for assertions.
+  [[nodiscard]] bool enabled() const { return enable_ && mode_ == required_mode && !estop_ && !fault_; }
+  [[nodiscard]] bool held() const { return hold_; }
+  [[nodiscard]] bool latched() const { return estop_ || fault_ != 0; }
+  [[nodiscard]] double position() const { return x_; }
+  [[nodiscard]] bool moving() const { return moving_; }
+  void clear_cause() { cause_ = false; }
+  void set_cause() { cause_ = true; }
+
+ private:
+  bool in(FaultEvent::Kind k) const {
+    for (const auto& e : plan)
+      if (e.kind == k && now_ >= e.at_s && now_ < e.until_s) return true;
+    return false;
+  }
+  std::error_code link() const {
+    if (in(FaultEvent::drop)) return RigError::connection_lost;
+    if (in(FaultEvent::exceptions)) return RigError::exception_response;
+    return {};
+  }
+  bool frozen() const { return in(FaultEvent::freeze); }
+  void latch_estop() {
+    estop_ = true;
+    if (!fault_) fault_ = 3;
+  }
+  void advance(double now) {
+    while (now_ + dt <= now) {
+      now_ += dt;
+      for (auto& e : plan)
+        if (now_ >= e.at_s && !e.applied) {
+          e.applied = true;
+          if (e.kind == FaultEvent::latch_fault) fault_ = e.code;
+          if (e.kind == FaultEvent::estop) latch_estop();
+          if (e.kind == FaultEvent::drop_enable) enable_ = false;
+        }
+      const bool driving = enabled() && !hold_;
+      const double before = x_;
+      if (driving) cmd_ += std::clamp(setpoint_ - cmd_, -std::min(rate_, rate_cap_mm_s) * dt, std::min(rate_, rate_cap_mm_s) * dt);
+      else cmd_ = x_;
+      if (std::fabs(cmd_ - x_) > deadband_mm) x_ += (cmd_ - x_) * 0.2;
+      moving_ = std::fabs(x_ - before) > 1e-9;
+    }
+  }
+  std::uint16_t status() const {
+    const bool ready = !estop_ && !fault_;
+    return static_cast<std::uint16_t>((ready ? st::ready : 0U) | (enabled() ? st::enabled : 0U) | (hold_ ? st::holding : 0U) |
+                                      (estop_ ? st::estop : 0U) | (fault_ && !estop_ ? st::fault : 0U) | (moving_ ? st::moving : 0U));
+  }
+
+  double now_ = 0, x_ = 0, cmd_ = 0, setpoint_ = 0, rate_ = 1;
+  bool enable_ = false, hold_ = false, estop_ = false, estop_cmd_ = false, cause_ = false, moving_ = false;
+  std::uint16_t mode_ = 0, fault_ = 0;
+  std::uint32_t counter_ = 0;
+};
+
+}  // namespace hystlab::test
