@@ -15,6 +15,8 @@
 
 #include "../drivers/sim_process.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
+#include "hystlab/daemon/envelope.hpp"
+#include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/db/sqlite.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
@@ -64,10 +66,16 @@ daemon::RunnerResult acquire(bool blocks, int port, double seconds, db::Store& s
   const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), "waveform", plan.source.dump(), "t");
   std::vector<float> periods;
   periods.reserve(static_cast<std::size_t>(seconds * 1100));
-  daemon::RunnerContext ctx(*rig, writer, store);
+  daemon::SteadyClock clock;
+  daemon::Supervisor supervisor(*rig, daemon::SupervisionSettings{}, false);
+  daemon::RunnerContext ctx(*rig, supervisor, writer, clock);
   ctx.now_iso = [] { return std::string("t"); };
   ctx.loop_periods_us = &periods;
-  const auto r = daemon::run_campaign(id, plan, ctx);
+  daemon::CampaignJob job;
+  job.id = id;
+  job.plan = plan;
+  job.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, false);
+  const auto r = daemon::run_campaign(job, ctx);
   writer.flush();
   const db::WriterStats w = writer.stats();
   const std::string what = blocks ? "block reads" : "polling";
@@ -81,7 +89,7 @@ daemon::RunnerResult acquire(bool blocks, int port, double seconds, db::Store& s
               static_cast<long long>(q.column_double(0)), q.column_double(1) * 1e3, static_cast<long long>(q.column_double(2)),
               static_cast<long long>(q.column_double(3)));
   std::printf("%s: campaign %s%s%s; %llu samples, %llu written in all, %llu dropped (ring full), %llu commits, max commit %.1f ms; "
-              "rig: %llu samples lost\n", what.c_str(), r.state.c_str(), r.reason.empty() ? "" : ": ", r.reason.c_str(),
+              "rig: %llu samples lost\n", what.c_str(), daemon::to_string(r.end), r.reason.empty() ? "" : ": ", r.reason.c_str(),
               static_cast<unsigned long long>(r.samples), static_cast<unsigned long long>(w.written), static_cast<unsigned long long>(w.dropped_full),
               static_cast<unsigned long long>(w.commits), w.max_commit_ms, static_cast<unsigned long long>(rig->health().lost_samples));
   return r;
@@ -120,5 +128,5 @@ int main(int argc, char** argv) {
               "late wake-ups %ld (target: p99.9 within 1 ms, no missed deadlines)\n",
               static_cast<long>(blocks.missed_deadlines), static_cast<long>(blocks.late_wakeups));
   std::filesystem::remove_all(dir);
-  return polled.state == "completed" && blocks.state == "completed" ? 0 : 1;
+  return polled.end == daemon::CampaignEnd::completed && blocks.end == daemon::CampaignEnd::completed ? 0 : 1;
 }

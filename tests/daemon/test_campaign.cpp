@@ -109,7 +109,7 @@ daemon::RunnerResult run(std::int64_t id, const daemon::Plan& plan, daemon::Runn
   j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, plan.kind == "sine");
   return daemon::run_campaign(j, ctx);
 }
-std::string st(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }
+std::string end_of(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }
 
 // Runs a campaign while another thread sends the simulator faults: (wait in ms, command) in turn.
 daemon::RunnerResult run_with_faults(std::int64_t id, const daemon::Plan& plan, daemon::RunnerContext& ctx, SimProcess& sim,
@@ -136,7 +136,7 @@ TEST_CASE("fot campaign n = 12: the online table equals the offline one and the 
   const daemon::RunnerResult r = run(id, plan, ctx);
   b.writer->flush();
   CAPTURE(r.reason);
-  REQUIRE(st(r) == "completed");
+  REQUIRE(end_of(r) == "completed");
   CHECK(r.nodes == 78);
   REQUIRE(r.table_id);
   CHECK(r.lsq_table_id);
@@ -183,7 +183,7 @@ TEST_CASE("safety: a force-limit trip aborts to the safe position, with the reas
   auto ctx = context(*rig, b, nullptr, 200);
   const auto r = run(id, plan, ctx);
   b.writer->flush();
-  CHECK(st(r) == "aborted");
+  CHECK(end_of(r) == "aborted");
   CHECK(r.reason.find("force") != std::string::npos);
   drivers::RigSample s;
   REQUIRE_FALSE(rig->read_sample(0, s));
@@ -216,7 +216,7 @@ TEST_CASE("operator: pause, a long pause's memory-aware resume, then abort") {
   const auto r = run(id, plan, ctx);
   operator_thread.join();
   b.writer->flush();
-  CHECK(st(r) == "aborted");
+  CHECK(end_of(r) == "aborted");
   CHECK(seen == std::vector<std::string>{"arming", "running", "paused", "running", "aborted"});
   bool preamble = false;
   for (const auto& e : b.store->events(id)) preamble |= e.detail.find("wipe-out preamble") != std::string::npos;
@@ -237,7 +237,7 @@ TEST_CASE("operator e-stop: passed to the rig at once, the campaign aborted") {
   });
   const auto r = run(id, plan, ctx);
   op.join();
-  CHECK(st(r) == "aborted");
+  CHECK(end_of(r) == "aborted");
   CHECK(r.reason == "e-stop by the operator");
   drivers::RigSample s;
   REQUIRE_FALSE(rig->read_sample(0, s));
@@ -254,7 +254,7 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
     auto ctx = context(*rig, b, nullptr, 200);
     ctx.watchdog_fail_periods = 200;
     const auto r = run_with_faults(id, plan, ctx, sim, {{300, "fault drop"}});
-    CHECK(st(r) == "failed");
+    CHECK(end_of(r) == "failed");
     CHECK(r.reason.find("watchdog") != std::string::npos);
     sim.control("clear");
   }
@@ -264,7 +264,7 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
     ctx.watchdog_fail_periods = 2000;
     const auto r = run_with_faults(id, plan, ctx, sim, {{300, "fault drop"}, {100, "clear"}});
     CAPTURE(r.reason);
-    CHECK(st(r) == "completed");
+    CHECK(end_of(r) == "completed");
     CHECK(rig->health().errors_of(drivers::RigError::connection_lost) >= 1);
   }
 }
@@ -284,7 +284,7 @@ TEST_CASE("a stalled controller answers late: the campaign goes on, no false rat
   for (int k = 0; k < 8; ++k) stalls.insert(stalls.end(), {{250, "fault stall 35"}, {5, "clear"}});
   const auto r = run_with_faults(id, plan, ctx, sim, stalls);
   CAPTURE(r.reason);
-  CHECK(st(r) == "completed");
+  CHECK(end_of(r) == "completed");
   CHECK(rig->health().max_transaction_us > 30'000);  // the stalls did happen
 }
 
@@ -297,7 +297,7 @@ TEST_CASE("a full writer queue is counted and never blocks acquisition") {
   auto ctx = context(*rig, b, nullptr, 200);
   const auto r = run(id, plan, ctx);
   b.writer->flush();
-  CHECK(st(r) == "completed");
+  CHECK(end_of(r) == "completed");
   CHECK(r.dropped > 0);
   CHECK(b.writer->stats().dropped_full == r.dropped);
 }
@@ -314,7 +314,7 @@ TEST_CASE("fot campaign over CAN (socketpair)") {
   auto ctx = context(rig, b, nullptr, 100);
   const auto r = run(id, plan, ctx);
   CAPTURE(r.reason);
-  CHECK(st(r) == "completed");
+  CHECK(end_of(r) == "completed");
   CHECK(r.nodes == 10);
 }
 
@@ -397,7 +397,7 @@ TEST_CASE("sine campaign on the simulated shaker: transmissibility per frequency
   auto ctx = context(*rig, b, nullptr, 1.0, true);
   const auto r = run(id, plan, ctx);
   CAPTURE(r.reason);
-  REQUIRE(st(r) == "completed");
+  REQUIRE(end_of(r) == "completed");
   db::Statement st(b.store->database(), "SELECT frequency_hz, ratio FROM transmissibility WHERE run_id = ? ORDER BY frequency_hz");
   st.bind(1, r.run_id);
   std::vector<double> ratio;
@@ -413,7 +413,7 @@ TEST_CASE("sine campaign on the simulated shaker: transmissibility per frequency
   const auto id2 = b.submit(plan.source);
   auto ctx2 = context(*frame_rig, b, nullptr, 1.0, true);
   const auto r2 = run(id2, plan, ctx2);
-  CHECK(st(r2) == "failed");
+  CHECK(end_of(r2) == "failed");
   CHECK(r2.reason.find("not one") != std::string::npos);
 }
 

@@ -98,7 +98,7 @@ HttpApi::HttpApi(daemon::Daemon& d, const daemon::HttpConfig& cfg) : impl_(std::
   if (!s.set_mount_point("/", root)) spdlog::warn("http: no page at '{}': the API alone is served", root);
   // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, and then a second daemon on the
   // same port binds too and the kernel splits requests between them (an abort reached the wrong one).
-  s.set_socket_options([](httplib::socket_t sock) {
+  s.set_socket_options([](socket_t sock) {
     const int yes = 1;
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   });
