@@ -72,7 +72,7 @@ void Loop::begin_safing(double t, CampaignEnd e, const std::string& reason, doub
   safe_started = t;
   const Limits& l = plan.limits;
   const SupervisionSettings& s = ctx.supervisor.settings();
-  safe_deadline = t + std::fabs(x - l.safe_position_mm) / l.safe_rate_mm_s + s.lag_s + s.settle_s;
+  safe_deadline = t + std::fabs(x - l.safe_position_mm) / l.safe_rate_mm_s + s.lag_s + s.settle_s + 0.5 * ctx.time_scale;
   ctx.supervisor.begin_safing(t, reason + ": to the safe position");
   if (auto ec = ctx.rig.command(l.safe_position_mm, l.safe_rate_mm_s)) {
     ctx.supervisor.hold(t, "the safe ramp was refused: held");

@@ -15,7 +15,8 @@ namespace {
 class RampStrategy final : public Strategy {
  public:
   explicit RampStrategy(Loop& L)
-      : plan_(L.plan), seq_(schedule(L.plan), L.ctx.supervisor.settings().in_position_mm), settings_(L.ctx.supervisor.settings()) {
+      : plan_(L.plan), seq_(schedule(L.plan), L.ctx.supervisor.settings().in_position_mm), settings_(L.ctx.supervisor.settings()),
+        time_scale_(L.ctx.time_scale) {
     series_ = L.job.prior_series;
     if (plan_.kind != "fot") return;
     const models::Grid g = models::Grid::make(plan_.lo_mm, plan_.hi_mm, plan_.subdivisions);
@@ -101,7 +102,10 @@ class RampStrategy final : public Strategy {
     const Segment* seg = seq_.current();
     target_ = cmd.target_mm;
     started_ = t;
-    deadline_ = t + std::fabs(cmd.target_mm - x) / cmd.rate_mm_s + settings_.lag_s + settings_.settle_s + (seg ? seg->dwell_s : 0.0);
+    // Plus half a second of wall time: a host (or a time-scaled simulator) starved for that long
+    // is no servo failure; at time scale 200 it is 100 s of rig time.
+    deadline_ = t + std::fabs(cmd.target_mm - x) / cmd.rate_mm_s + settings_.lag_s + settings_.settle_s + (seg ? seg->dwell_s : 0.0) +
+                0.5 * time_scale_;
   }
 
   bool target_missed(Loop& L, const drivers::RigSample& s) {
@@ -124,6 +128,7 @@ class RampStrategy final : public Strategy {
   std::shared_ptr<models::OnlineTableBuilder> builder_;
   std::unique_ptr<OnlineFot> fot_;
   RunSeries series_;
+  double time_scale_ = 1.0;
   double target_ = 0, started_ = 0, deadline_ = 1e300;
 };
 }  // namespace
