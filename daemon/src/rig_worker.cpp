@@ -48,27 +48,28 @@ void RigWorker::build_rig(const std::string& base) {
   snap_.supervision = supervision_json(entry.supervision);
 }
 
-void RigWorker::push_job(CampaignJob job) {
+namespace {
+template <class T>
+void push_locked(std::mutex& mu, std::condition_variable& cv, std::deque<T>& q, T item) {
   {
-    std::lock_guard lk(mu_);
-    jobs_.push_back(std::move(job));
+    std::lock_guard lk(mu);
+    q.push_back(std::move(item));
   }
-  cv_.notify_all();
+  cv.notify_all();
 }
-void RigWorker::push_control(Control c) {
-  {
-    std::lock_guard lk(mu_);
-    controls_.push_back(c);
-  }
-  cv_.notify_all();
+template <class T>
+std::optional<T> pop_locked(std::mutex& mu, std::deque<T>& q) {
+  std::lock_guard lk(mu);
+  if (q.empty()) return std::nullopt;
+  T item = std::move(q.front());
+  q.pop_front();
+  return item;
 }
-void RigWorker::push_rig_command(RigCommand c) {
-  {
-    std::lock_guard lk(mu_);
-    rig_commands_.push_back(c);
-  }
-  cv_.notify_all();
-}
+}  // namespace
+
+void RigWorker::push_job(CampaignJob job) { push_locked(mu_, cv_, jobs_, std::move(job)); }
+void RigWorker::push_control(Control c) { push_locked(mu_, cv_, controls_, c); }
+void RigWorker::push_rig_command(RigCommand c) { push_locked(mu_, cv_, rig_commands_, c); }
 bool RigWorker::cancel_queued(std::int64_t id) {
   std::lock_guard lk(mu_);
   for (auto it = jobs_.begin(); it != jobs_.end(); ++it)
@@ -93,20 +94,8 @@ std::optional<CampaignJob> RigWorker::pop_job() {
   controls_.clear();        // commands meant for an earlier campaign
   return j;
 }
-std::optional<Control> RigWorker::pop_control() {
-  std::lock_guard lk(mu_);
-  if (controls_.empty()) return std::nullopt;
-  const Control c = controls_.front();
-  controls_.pop_front();
-  return c;
-}
-std::optional<RigCommand> RigWorker::pop_rig_command() {
-  std::lock_guard lk(mu_);
-  if (rig_commands_.empty()) return std::nullopt;
-  const RigCommand c = rig_commands_.front();
-  rig_commands_.pop_front();
-  return c;
-}
+std::optional<Control> RigWorker::pop_control() { return pop_locked(mu_, controls_); }
+std::optional<RigCommand> RigWorker::pop_rig_command() { return pop_locked(mu_, rig_commands_); }
 void RigWorker::wait(double seconds) {
   std::unique_lock lk(mu_);
   cv_.wait_for(lk, std::chrono::duration<double>(seconds), [this] { return !jobs_.empty() || !rig_commands_.empty(); });

@@ -283,10 +283,9 @@ TEST_CASE("randomized fault schedules: never moving while latched, never armed w
     CHECK_FALSE(moved_while_latched);
     CHECK(h.rig.log.setpoints_while_latched == 0);
     CHECK(h.rig.log.enables_while_latched == 0);
-    bool armed_seen = false, enabled_before = true;
+    bool armed_seen = false;
     for (const auto& t : h.transitions)
       if (t.to == RigState::armed) armed_seen = true;
-    (void)enabled_before;
     if (armed_seen) CHECK(h.rig.log.mode_writes >= 1);
     CHECK((h.sup->state() == RigState::idle || h.sup->latched() || h.sup->state() == RigState::disconnected ||
            h.sup->state() == RigState::holding));
