@@ -8,7 +8,7 @@
 
 namespace hystlab::cli {
 namespace {
-const char* kHelp = R"(usage: hystlab export (--table T.json | --params P.json) --format json|csv|m|h [--name NAME] [-o OUT]
+const char* kExportHelp = R"(usage: hystlab export (--table T.json | --params P.json) --format json|csv|m|h [--name NAME] [-o OUT]
 
 Writes a table or simplified-model parameters for other tools (docs/FORMATS.md):
   json  the canonical, versioned document (re-written, validated)
@@ -19,7 +19,7 @@ Writes a table or simplified-model parameters for other tools (docs/FORMATS.md):
 }  // namespace
 
 int run_export(const Args& args) {
-  if (print_help_if_asked(args, kHelp)) return 0;
+  if (print_help_if_asked(args, kExportHelp)) return 0;
   const Options opt(args, {"table", "params", "format", "name", "output"}, {});
   if (opt.has("table") == opt.has("params")) throw CliError("give one of --table T.json or --params P.json");
   const std::string format = opt.require("format");

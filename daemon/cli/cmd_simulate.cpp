@@ -17,7 +17,7 @@
 
 namespace hystlab::cli {
 namespace {
-const char* kHelp = R"(usage: hystlab simulate sdof --mass KG --amplitude-mm Y SPRING [options] (--frequency-hz F --duration-s T | --sweep RANGE)
+const char* kSimulateHelp = R"(usage: hystlab simulate sdof --mass KG --amplitude-mm Y SPRING [options] (--frequency-hz F --duration-s T | --sweep RANGE)
 
 A mass on N springs over a base moving as y = Y sin(2πft) (mm, N, kg, s). The springs carry the
 weight at the preload; their compression is preload + y − x and they only push.
@@ -151,9 +151,9 @@ int run_sweep(const Options& opt, const Springs& protos, const models::SdofOptio
 }  // namespace
 
 int run_simulate(const Args& args) {
-  if (print_help_if_asked(args, kHelp) || args.empty() || args[0] != "sdof") {
+  if (print_help_if_asked(args, kSimulateHelp) || args.empty() || args[0] != "sdof") {
     if (!args.empty() && args[0] != "sdof" && args[0] != "--help" && args[0] != "-h") throw CliError("unknown simulation '" + args[0] + "' (known: sdof)");
-    if (args.empty()) std::cout << kHelp;
+    if (args.empty()) std::cout << kSimulateHelp;
     return args.empty() ? 2 : 0;
   }
   const Options opt(Args(args.begin() + 1, args.end()),

@@ -72,7 +72,7 @@ void Loop::begin_safing(double t, CampaignEnd e, const std::string& reason, doub
   safe_started = t;
   const Limits& l = plan.limits;
   const SupervisionSettings& s = ctx.supervisor.settings();
-  safe_deadline = t + std::fabs(x - l.safe_position_mm) / l.safe_rate_mm_s + s.lag_s + s.settle_s + 0.5 * ctx.time_scale;
+  safe_deadline = t + std::fabs(x - l.safe_position_mm) / l.safe_rate_mm_s + s.lag_s + s.settle_s + kHostStallAllowance_s * ctx.time_scale;
   ctx.supervisor.begin_safing(t, reason + ": to the safe position");
   if (auto ec = ctx.rig.command(l.safe_position_mm, l.safe_rate_mm_s)) {
     ctx.supervisor.hold(t, "the safe ramp was refused: held");
@@ -90,7 +90,10 @@ bool arm(Loop& L) {
   RunnerContext& c = L.ctx;
   const double period = 1.0 / L.plan.sample_rate_hz;
   double next = c.clock.now();
-  const double give_up = L.rig_time() + 2.0 + c.supervisor.settings().arm_timeout_s;
+  // A rig that does not answer for 2 s plus the arming timeout is not armed (on a time-scaled rig
+  // at least the host-stall allowance of wall time: 3 s of rig time is 15 ms at scale 200).
+  const double give_up = L.rig_time() + std::max(2.0 + c.supervisor.settings().arm_timeout_s,
+                                                 c.time_scale > 1 ? kHostStallAllowance_s * c.time_scale : 0.0);
   bool begun = false;
   (void)c.rig.connect(L.rig_time());
   for (;;) {
@@ -308,10 +311,13 @@ void run_ticks(Loop& L, Strategy& strategy) {
     c.clock.sleep_until(next);
     const double now = c.clock.now();
     count_tick(L, now, next, period, blocks);
+    // Woken far behind (a starved host): the ticks missed are gone, not to be run back to back;
+    // a burst would read nothing fresh and count as a silent rig for the watchdog.
+    if (now - next > 5 * period) next = now;
     if (c.loop_periods_us && prev_tick > 0) c.loop_periods_us->push_back(static_cast<float>((now - prev_tick) * 1e6));
     prev_tick = now;
     const double t = (now - L.wall0) * c.time_scale;
-    c.supervisor.heartbeat(t);
+    c.supervisor.heartbeat(now);
     if (c.stop && c.stop->load()) {
       L.end(CampaignEnd::interrupted, "the daemon is stopping");
       break;
@@ -369,6 +375,7 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
   Loop L(job, ctx);
   std::unique_ptr<Strategy> strategy = L.shaker ? make_sine_strategy(L) : make_ramp_strategy(L);
   L.wall0 = ctx.clock.now();
+  ctx.supervisor.set_time_scale(ctx.time_scale);
   ctx.supervisor.set_time_offset(std::isnan(ctx.epoch) ? 0.0 : (L.wall0 - ctx.epoch) * ctx.time_scale);
   const Limits& l = job.plan.limits;
   L.event("limits", {{"displacement_mm", {l.displacement_min_mm, l.displacement_max_mm}}, {"force_N", l.force_max_N},

@@ -102,10 +102,10 @@ class RampStrategy final : public Strategy {
     const Segment* seg = seq_.current();
     target_ = cmd.target_mm;
     started_ = t;
-    // Plus half a second of wall time: a host (or a time-scaled simulator) starved for that long
-    // is no servo failure; at time scale 200 it is 100 s of rig time.
+    // Plus kHostStallAllowance_s of wall time: a host (or a time-scaled simulator) starved for that
+    // long is no servo failure; at time scale 200 it is 300 s of rig time.
     deadline_ = t + std::fabs(cmd.target_mm - x) / cmd.rate_mm_s + settings_.lag_s + settings_.settle_s + (seg ? seg->dwell_s : 0.0) +
-                0.5 * time_scale_;
+                kHostStallAllowance_s * time_scale_;
   }
 
   bool target_missed(Loop& L, const drivers::RigSample& s) {

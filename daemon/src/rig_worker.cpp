@@ -43,6 +43,7 @@ void RigWorker::build_rig(const std::string& base) {
   const bool shaker = info.kind == "shaker";
   if (supervisor) supervisor->rebind(*rig);
   else supervisor = std::make_unique<Supervisor>(*rig, entry.supervision, shaker, [this](const RigTransition& t) { record(t); });
+  supervisor->set_time_scale(entry.time_scale);
   std::lock_guard lk(mu_);
   snap_.envelope = envelope_json(entry.envelope, shaker);
   snap_.supervision = supervision_json(entry.supervision);
@@ -190,7 +191,7 @@ void idle_tick(RigWorker& w, double t, const std::string& base) {
   }
   if (ec) w.supervisor->on_link_error(t, ec);
   else (void)w.supervisor->on_status(t, v);
-  w.supervisor->heartbeat(t);
+  w.supervisor->heartbeat(mono_now());
   w.update_snapshot(v, x, f, !ec);
 }
 

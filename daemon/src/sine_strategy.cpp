@@ -1,7 +1,9 @@
 // sine campaigns on a shaker: each frequency is driven for settle_cycles, then measured for
 // measured_cycles; amplitude and phase of base and mass motion come from a least-squares sine
 // fit, and the transmissibility point is stored as it comes.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <vector>
 
@@ -23,8 +25,10 @@ class SineStrategy final : public Strategy {
       mass_.push_back(s.mass_displacement_mm);
     }
     if (s.time_s < t_end_) return true;
+    if (const std::string hole = window_hole(L); !hole.empty()) return retake(L, s.time_s, hole);
     if (!store_point(L)) return false;
     ++k_;
+    retakes_ = 0;
     started_ = false;
     return true;
   }
@@ -50,6 +54,35 @@ class SineStrategy final : public Strategy {
     return true;
   }
 
+  // A measurement window with a hole in it (a stalled host, a lost link) fits a sine to a part
+  // of it: the step is taken again, up to kMaxRetakes times, and the campaign fails only then.
+  std::string window_hole(const Loop& L) const {
+    const double expected = (t_end_ - t_measure_) / L.spacing;
+    double longest = 0;
+    for (std::size_t i = 1; i < t_.size(); ++i) longest = std::max(longest, t_[i] - t_[i - 1]);
+    char buf[160];
+    if (static_cast<double>(t_.size()) < 0.8 * expected)
+      std::snprintf(buf, sizeof buf, "%zu of %.0f samples", t_.size(), expected);
+    else if (longest > 5 * L.spacing)
+      std::snprintf(buf, sizeof buf, "a gap of %.0f ms", longest * 1e3);
+    else
+      return {};
+    return buf;
+  }
+
+  bool retake(Loop& L, double t, const std::string& hole) {
+    const double f = plan_.frequencies_hz[k_];
+    if (++retakes_ > kMaxRetakes) {
+      L.ctx.supervisor.hold(t, "no complete measurement: no drive");
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "the measurement window at %g Hz was incomplete %d times (last: %s)", f, kMaxRetakes + 1, hole.c_str());
+      L.end(CampaignEnd::failed, buf);
+      return false;
+    }
+    L.event("retake", {{"frequency_hz", f}, {"why", hole}, {"attempt", retakes_ + 1}});
+    return start_step(L, t);
+  }
+
   bool store_point(Loop& L) {
     const double f = plan_.frequencies_hz[k_];
     const models::SineFit b = models::fit_sine(t_, base_, f), m = models::fit_sine(t_, mass_, f);
@@ -69,7 +102,9 @@ class SineStrategy final : public Strategy {
   }
 
   const Plan& plan_;
+  static constexpr int kMaxRetakes = 3;
   std::size_t k_ = 0;
+  int retakes_ = 0;
   bool started_ = false;
   double t_measure_ = 0, t_end_ = 0;
   std::vector<double> t_, base_, mass_;

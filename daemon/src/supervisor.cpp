@@ -1,5 +1,6 @@
 #include "hystlab/daemon/supervisor.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "hystlab/protocols/signals.hpp"
@@ -35,6 +36,14 @@ std::string describe_status(std::uint16_t status, std::uint16_t code, const std:
 
 Supervisor::Supervisor(drivers::Rig& rig, SupervisionSettings settings, bool shaker, Observer observer)
     : rig_(&rig), s_(settings), shaker_(shaker), observer_(std::move(observer)) {}
+
+// A controller's handshake time is its own, but the answer reaches us only at our next poll: at
+// time scale 200 the 1 s arming timeout is 5 ms of wall time, less than one 100 Hz poll, and a
+// starved host wakes late. On a time-scaled rig kHandshakeFloor_s of wall time is the least any
+// handshake gets; a real rig (time scale 1) keeps its configured timeouts exactly.
+double Supervisor::deadline(double now, double timeout_s) const noexcept {
+  return now + (time_scale_ > 1 ? std::max(timeout_s, kHandshakeFloor_s * time_scale_) : timeout_s);
+}
 
 void Supervisor::go(double now, RigState to, const std::string& reason) {
   if (to == state_) return;
@@ -85,7 +94,7 @@ void Supervisor::reassert(double now) {
   } else {
     go(now, RigState::idle, "link back: rig held and disabled before anything else");
     verify_disabled_ = true;
-    verify_deadline_ = now + s_.arm_timeout_s;
+    verify_deadline_ = deadline(now, s_.arm_timeout_s);
   }
 }
 
@@ -131,7 +140,7 @@ std::optional<std::string> Supervisor::on_status(double now, const StatusView& v
     if (!(v.status & st::enabled)) verify_disabled_ = false;
     else if (now > verify_deadline_) {  // the disable did not take: write it again, and again
       (void)write_disable();
-      verify_deadline_ = now + s_.arm_timeout_s;
+      verify_deadline_ = deadline(now, s_.arm_timeout_s);
     }
   }
   return std::nullopt;
@@ -144,7 +153,7 @@ std::optional<std::string> Supervisor::begin_arming(double now) {
   if (state_ == RigState::disconnected) return "the rig is not connected";
   if (state_ != RigState::idle) return "the rig is busy (" + std::string(to_string(state_)) + ")";
   arming_written_ = false;
-  arming_deadline_ = now + s_.arm_timeout_s;
+  arming_deadline_ = deadline(now, s_.arm_timeout_s);
   go(now, RigState::arming, "arming: checking ready");
   return std::nullopt;
 }
@@ -220,7 +229,7 @@ void Supervisor::disarm(double now, const std::string& reason) { disarm_at(now +
 void Supervisor::disarm_at(double now, const std::string& reason) {
   if (!write_disable()) reassert_pending_ = true;
   verify_disabled_ = true;
-  verify_deadline_ = now + s_.arm_timeout_s;
+  verify_deadline_ = deadline(now, s_.arm_timeout_s);
   if (latched()) return;
   intended_ = RigState::idle;
   if (state_ != RigState::disconnected) go(now, RigState::idle, reason);
@@ -243,7 +252,7 @@ void Supervisor::begin_reset(double now) {
     return;
   }
   resetting_ = true;
-  reset_deadline_ = now + s_.reset_timeout_s;
+  reset_deadline_ = deadline(now, s_.reset_timeout_s);
   if (intended_ == RigState::estopped) intended_ = RigState::faulted;  // never re-send the e-stop the reset released
 }
 
@@ -256,7 +265,7 @@ void Supervisor::reset_step(double now, const StatusView& v) {
     intended_ = RigState::idle;
     (void)write_disable();
     verify_disabled_ = true;
-    verify_deadline_ = now + s_.arm_timeout_s;
+    verify_deadline_ = deadline(now, s_.arm_timeout_s);
     go(now, RigState::idle, "reset by the operator: the rig reports ready");
     return;
   }
@@ -267,8 +276,8 @@ void Supervisor::reset_step(double now, const StatusView& v) {
   }
 }
 
-void Supervisor::heartbeat(double now) {
-  now += offset_;
+void Supervisor::heartbeat(double wall_s) {
+  const double now = wall_s;
   if (!heartbeat_supported_ || now < next_heartbeat_) return;
   next_heartbeat_ = now + s_.heartbeat_period_s;
   if (rig_->write_host_heartbeat(++heartbeat_count_) == drivers::RigError::unsupported) heartbeat_supported_ = false;

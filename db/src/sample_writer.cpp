@@ -81,7 +81,8 @@ void SampleWriter::run() {
     std::uint64_t flush_ticket = 0;
     {
       std::unique_lock lk(mu_);
-      cv_.wait_for(lk, window, [&] { return stop_ || flush_requested_ > flush_done_; });
+      cv_.wait_for(lk, window, [&] { return stop_ || urgent_ || flush_requested_ > flush_done_; });
+      urgent_ = false;
       stopping = stop_;
       flush_ticket = flush_requested_;
     }

@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -47,7 +48,7 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --deadband-mm D                load frame servo dead band: no correction while |command - displacement| < D (default 0)
   --mode N                       the controller moves only while the map's mode register (CAN: the command's mode)
                                  holds N (default 1; a map without mode has no interlock). It starts at 0
-  --host-timeout-ms T            stop with fault 4 when the host's host_heartbeat has not changed for T simulated ms
+  --host-timeout-ms T            stop with fault 4 when the host's host_heartbeat has not changed for T wall-clock ms
                                  while the drive is on (default 0: off; a real controller would have it on)
   --control-port P               text control channel on 127.0.0.1 (default 0: any free port)
   --duration S                   stop after S wall-clock seconds (default: run until SIGTERM or 'quit')
@@ -158,7 +159,9 @@ sim::ControllerParams controller_params(const Args& a, const std::optional<proto
   sim::ControllerParams c;
   c.mode = static_cast<std::uint16_t>(a.mode);
   c.mode_interlock = map ? map->find(protocols::Signal::mode) != nullptr : a.rig == "load_frame";
-  c.host_timeout_s = map && map->find(protocols::Signal::host_heartbeat) ? a.host_timeout_ms * 1e-3 : 0.0;
+  // The host's link runs on wall-clock time whatever the time scale: the controller counts it in
+  // its own (simulated) seconds, so the wall-clock timeout is scaled into them.
+  c.host_timeout_s = map && map->find(protocols::Signal::host_heartbeat) ? a.host_timeout_ms * 1e-3 * a.time_scale : 0.0;
   return c;
 }
 
@@ -213,8 +216,18 @@ int run(const Args& a) {
   std::vector<pollfd> pfds;
   // Brings the physics up to now and publishes it: before every wait, and again right before
   // answering, so an answer never carries values older than the request.
+  // A starved simulator pauses its world instead of jumping it forward: the rig it stands in
+  // for has a CPU of its own and never misses a cycle, so a host-side freeze (on CI VMs, 1 ms
+  // sleeps were seen to wake 0.5-0.7 s late with the machine idle) must not become a 100 s jump
+  // of rig time at time scale 200. At most 20 ms of wall time is caught up (the longest wait of
+  // a simulator that is not starved); the rest is lost and counted ("lost=" on the control
+  // channel's status).
+  constexpr double kMaxCatchUp_s = 0.02;
+  double lost_wall_s = 0;
   auto advance = [&](double now) {
-    sim_due += (now - last) * a.time_scale;
+    const double wall_dt = now - last;
+    if (wall_dt > kMaxCatchUp_s) lost_wall_s += wall_dt - kMaxCatchUp_s;
+    sim_due += std::min(wall_dt, kMaxCatchUp_s) * a.time_scale;
     last = now;
     for (int guard = 0; sim_due >= sample_dt && guard < 100000; ++guard) {
       rig.step(sample_dt);
@@ -226,8 +239,8 @@ int run(const Args& a) {
     return m;
   };
   // CAN sends cyclic frames, so it wakes every millisecond; Modbus only answers, so it sleeps
-  // until a request comes (or 50 ms pass, to keep the physics' catch-up short).
-  const int wait_ms = can ? 1 : 50;
+  // until a request comes (or 15 ms pass: within the catch-up limit above).
+  const int wait_ms = can ? 1 : 15;
   const pid_t parent = getppid();
   while (!g_stop && (a.duration <= 0 || wall() < a.duration)) {
     if (a.exit_with_parent && getppid() != parent) break;  // the supervisor died (even by kill -9)
@@ -249,7 +262,7 @@ int run(const Args& a) {
       if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;
       if (control.owns(p.fd)) {
         std::ostringstream status;
-        status << "t=" << rig.time_s();
+        status << "t=" << rig.time_s() << " lost=" << lost_wall_s;
         if (control.handle(p.fd, faults, rig, status.str())) g_stop = 1;
       } else if (can && p.fd == can->fd()) {
         can->receive(rig);

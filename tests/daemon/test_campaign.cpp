@@ -5,6 +5,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <deque>
 #include <filesystem>
@@ -84,7 +85,10 @@ std::unique_ptr<drivers::Rig> tcp_rig(int port) {
 }
 
 daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale, bool shaker = false) {
-  b.sup = std::make_unique<daemon::Supervisor>(rig, daemon::SupervisionSettings{}, shaker);
+  b.sup = std::make_unique<daemon::Supervisor>(rig, daemon::SupervisionSettings{}, shaker, [](const daemon::RigTransition& t) {
+    if (std::getenv("HYSTLAB_TRACE"))
+      std::fprintf(stderr, "%.3f %s -> %s: %s\n", t.t, std::string(daemon::to_string(t.from)).c_str(), std::string(daemon::to_string(t.to)).c_str(), t.reason.c_str());
+  });
   daemon::RunnerContext ctx{rig, *b.sup, *b.writer, b.clock};
   ctx.time_scale = scale;
   ctx.now_iso = [] { return std::string("2026-11-23T00:00:00Z"); };
@@ -111,17 +115,28 @@ daemon::RunnerResult run(std::int64_t id, const daemon::Plan& plan, daemon::Runn
 }
 std::string end_of(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }
 
-// Runs a campaign while another thread sends the simulator faults: (wait in ms, command) in turn.
+// Runs a campaign while another thread sends the simulator faults: (wait in ms, command) in turn,
+// counted from the campaign's "running" (arming takes a database round trip first, and a starved
+// machine may take longer than a fixed wait).
 daemon::RunnerResult run_with_faults(std::int64_t id, const daemon::Plan& plan, daemon::RunnerContext& ctx, SimProcess& sim,
                                      const std::vector<std::pair<int, std::string>>& schedule) {
+  std::atomic<bool> running{false}, over{false};
+  auto before = ctx.on_state;
+  ctx.on_state = [&](const std::string& s) {
+    if (s == "running") running = true;
+    if (before) before(s);
+  };
   std::thread fault([&] {
+    while (!running && !over) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     for (const auto& [wait_ms, command] : schedule) {
       std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms));
       sim.control(command);
     }
   });
   const daemon::RunnerResult r = run(id, plan, ctx);
+  over = true;
   fault.join();
+  ctx.on_state = before;
   return r;
 }
 }  // namespace
@@ -254,6 +269,7 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
     auto ctx = context(*rig, b, nullptr, 200);
     ctx.watchdog_fail_periods = 200;
     const auto r = run_with_faults(id, plan, ctx, sim, {{300, "fault drop"}});
+    CAPTURE(r.reason);
     CHECK(end_of(r) == "failed");
     CHECK(r.reason.find("watchdog") != std::string::npos);
     sim.control("clear");
@@ -290,7 +306,7 @@ TEST_CASE("a stalled controller answers late: the campaign goes on, no false rat
 
 TEST_CASE("a full writer queue is counted and never blocks acquisition") {
   SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
-  Bench b(64);  // far smaller than 100 ms of samples
+  Bench b(8);  // far smaller than the 100 samples of one 100 ms batch window
   auto rig = tcp_rig(sim.modbus_port);
   const auto plan = daemon::parse_plan(fot_plan(3, 0.4));
   const auto id = b.submit(plan.source);
@@ -314,6 +330,9 @@ TEST_CASE("fot campaign over CAN (socketpair)") {
   auto ctx = context(rig, b, nullptr, 100);
   const auto r = run(id, plan, ctx);
   CAPTURE(r.reason);
+  CAPTURE(r.late_wakeups);
+  CAPTURE(r.missed_deadlines);
+  CAPTURE(rig.health().lost_samples);
   CHECK(end_of(r) == "completed");
   CHECK(r.nodes == 10);
 }

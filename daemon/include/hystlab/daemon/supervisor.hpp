@@ -49,6 +49,9 @@ class Supervisor {
   // A campaign counts its time from its own start; the supervisor's deadlines (heartbeat, verify,
   // reset) run on the rig's time across campaigns: offset = the campaign's start in rig time.
   void set_time_offset(double offset_s) noexcept { offset_ = offset_s; }
+  // Rig seconds per wall-clock second (a time-scaled simulator): handshake deadlines get at least
+  // kHandshakeFloor_s of wall time.
+  void set_time_scale(double scale) noexcept { time_scale_ = scale > 0 ? scale : 1.0; }
   // The simulator was restarted: a new driver; the link is new, the latch stays.
   void rebind(drivers::Rig& rig) noexcept {
     rig_ = &rig;
@@ -80,14 +83,17 @@ class Supervisor {
   void begin_reset(double now);
   [[nodiscard]] bool resetting() const noexcept { return resetting_; }
   [[nodiscard]] const std::string& reset_refusal() const noexcept { return reset_refusal_; }
-  // The host heartbeat, at its period (skipped for good when the rig has none).
-  void heartbeat(double now);
+  // The host heartbeat, at its period (skipped for good when the rig has none), on the host's
+  // monotonic clock in seconds, not the rig's: at time scale 200 a rig-time period of 100 ms came
+  // every tick, doubled the Modbus traffic and gave write timeouts (stop 16's campaign tests).
+  void heartbeat(double wall_s);
   // A campaign that is not moving the rig: idle states accept new work.
   [[nodiscard]] bool moving_state() const noexcept {
     return state_ == RigState::arming || state_ == RigState::armed || state_ == RigState::holding || state_ == RigState::safing;
   }
 
  private:
+  [[nodiscard]] double deadline(double now, double timeout_s) const noexcept;
   void go(double now, RigState to, const std::string& reason);
   void latch(double now, RigState to, const std::string& reason, std::uint16_t code);
   bool write_hold() noexcept;     // the rig's hold (a shaker: zero drive)
@@ -99,6 +105,7 @@ class Supervisor {
 
   drivers::Rig* rig_;
   double offset_ = 0;
+  double time_scale_ = 1.0;
   SupervisionSettings s_;
   bool shaker_;
   Observer observer_;

@@ -68,6 +68,10 @@ class SampleWriter {
         p->set_exception(std::current_exception());
       }
     });
+    {
+      std::lock_guard lk(mu_);
+      urgent_ = true;  // the writer wakes now, not at the end of its batch window
+    }
     cv_.notify_all();
     if (fut.wait_for(std::chrono::duration<double>(timeout_s)) != std::future_status::ready) return std::nullopt;
     try {
@@ -94,6 +98,7 @@ class SampleWriter {
   std::condition_variable cv_;
   bool stop_ = false;
   std::uint64_t flush_requested_ = 0, flush_done_ = 0;
+  bool urgent_ = false;
   std::string last_error_;
   std::deque<std::function<void(Store&)>> jobs_;
   std::thread thread_;
