@@ -277,9 +277,8 @@ void Supervisor::reset_step(double now, const StatusView& v) {
 }
 
 void Supervisor::heartbeat(double wall_s) {
-  const double now = wall_s;
-  if (!heartbeat_supported_ || now < next_heartbeat_) return;
-  next_heartbeat_ = now + s_.heartbeat_period_s;
+  if (!heartbeat_supported_ || wall_s < next_heartbeat_) return;
+  next_heartbeat_ = wall_s + s_.heartbeat_period_s;
   if (rig_->write_host_heartbeat(++heartbeat_count_) == drivers::RigError::unsupported) heartbeat_supported_ = false;
 }
 
