@@ -81,6 +81,21 @@ void Loop::begin_safing(double t, CampaignEnd e, const std::string& reason, doub
   }
 }
 
+bool Loop::command_failed(double t, std::error_code ec, const char* what) {
+  using drivers::RigError;
+  const bool lost = ec == RigError::timeout || ec == RigError::connection_lost || ec == RigError::not_connected || ec == RigError::crc_error;
+  if (lost && ++lost_commands < kMaxLostCommands) {
+    link_held = true;
+    ctx.supervisor.on_link_error(t, ec);
+    ctx.supervisor.hold(t, std::string(what) + " lost: held until the rig answers");
+    return true;
+  }
+  ctx.supervisor.hold(t, std::string(what) + " refused: held");
+  end(CampaignEnd::failed, std::string(what) + " refused: " + ec.message() +
+                               (lost ? " (" + std::to_string(lost_commands) + " times in a row)" : std::string()));
+  return false;
+}
+
 namespace {
 StatusView view_of(const drivers::RigSample& s) { return {s.status_word, s.fault_code, s.displacement_mm}; }
 StatusView view_of(const drivers::ShakerSample& s) { return {s.status_word, s.fault_code, 0.0}; }

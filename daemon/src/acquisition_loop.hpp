@@ -63,6 +63,13 @@ struct Loop {
   void begin_safing(double t, CampaignEnd e, const std::string& reason, double position_mm);
   void publish(double t, double a, double b, double c, std::uint16_t status);
   void check_gap(double t);
+  // A command the rig did not take. A lost answer (timeout, dropped link) holds the rig like a
+  // lost read, and the segment is commanded again when the rig answers; true while the campaign
+  // goes on. Any other refusal, or kMaxLostCommands in a row, holds and fails it.
+  bool command_failed(double t, std::error_code ec, const char* what);
+  void command_taken() noexcept { lost_commands = 0; }
+  static constexpr int kMaxLostCommands = 3;
+  int lost_commands = 0;
 };
 
 }  // namespace hystlab::daemon

@@ -124,7 +124,10 @@ Plan parse_plan(const json& j) {
   } else {
     fail("kind", "must be \"fot\", \"waveform\" or \"sine\" (got \"" + p.kind + "\")");
   }
-  if (p.ramp_rate_mm_s > p.limits.rate_max_mm_s) fail("ramp_rate_mm_s", "is above limits.rate_mm_s");
+  // Only against a rate the plan wrote: without one, the rig's envelope decides at submission and
+  // names its own maximum (check_plan_against), not a default the user never saw.
+  const bool own_rate = j.contains("limits") && j["limits"].is_object() && j["limits"].contains("rate_mm_s");
+  if (own_rate && p.ramp_rate_mm_s > p.limits.rate_max_mm_s) fail("ramp_rate_mm_s", "is above limits.rate_mm_s");
   return p;
 }
 

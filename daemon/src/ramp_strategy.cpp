@@ -38,11 +38,8 @@ class RampStrategy final : public Strategy {
     series_.add(s.displacement_mm, s.force_N);
     const std::size_t before = seq_.index();
     if (const auto cmd = seq_.step(s.time_s, s.displacement_mm)) {
-      if (auto ec = L.ctx.rig.command(cmd->target_mm, cmd->rate_mm_s)) {
-        L.ctx.supervisor.hold(s.time_s, "command refused: held");
-        L.end(CampaignEnd::failed, "command refused: " + ec.message());
-        return false;
-      }
+      if (auto ec = L.ctx.rig.command(cmd->target_mm, cmd->rate_mm_s)) return L.command_failed(s.time_s, ec, "command");
+      L.command_taken();
       arm_deadline(s.time_s, s.displacement_mm, *cmd);
     } else if (seq_.index() == before && !seq_.done() && s.time_s > deadline_) {
       return target_missed(L, s);

@@ -25,7 +25,7 @@ class SineStrategy final : public Strategy {
       mass_.push_back(s.mass_displacement_mm);
     }
     if (s.time_s < t_end_) return true;
-    if (const std::string hole = window_hole(L); !hole.empty()) return retake(L, s.time_s, hole);
+    if (const std::string hole = window_hole(plan_.frequencies_hz[k_]); !hole.empty()) return retake(L, s.time_s, hole);
     if (!store_point(L)) return false;
     ++k_;
     retakes_ = 0;
@@ -56,14 +56,16 @@ class SineStrategy final : public Strategy {
 
   // A measurement window with a hole in it (a stalled host, a lost link) fits a sine to a part
   // of it: the step is taken again, up to kMaxRetakes times, and the campaign fails only then.
-  std::string window_hole(const Loop& L) const {
-    const double expected = (t_end_ - t_measure_) / L.spacing;
+  // What a fit needs is the signal's, not the loop's rate: 8 samples a cycle, no hole longer
+  // than a quarter cycle (a starved 2-core VM polled the shaker at 170 Hz, still a good fit).
+  std::string window_hole(double f) const {
     double longest = 0;
     for (std::size_t i = 1; i < t_.size(); ++i) longest = std::max(longest, t_[i] - t_[i - 1]);
+    const double needed = 8.0 * plan_.measured_cycles;
     char buf[160];
-    if (static_cast<double>(t_.size()) < 0.8 * expected)
-      std::snprintf(buf, sizeof buf, "%zu of %.0f samples", t_.size(), expected);
-    else if (longest > 5 * L.spacing)
+    if (static_cast<double>(t_.size()) < needed)
+      std::snprintf(buf, sizeof buf, "%zu samples, %.0f needed", t_.size(), needed);
+    else if (longest > 0.25 / f)
       std::snprintf(buf, sizeof buf, "a gap of %.0f ms", longest * 1e3);
     else
       return {};

@@ -313,6 +313,7 @@ TEST_CASE("a full writer queue is counted and never blocks acquisition") {
   auto ctx = context(*rig, b, nullptr, 200);
   const auto r = run(id, plan, ctx);
   b.writer->flush();
+  CAPTURE(r.reason);
   CHECK(end_of(r) == "completed");
   CHECK(r.dropped > 0);
   CHECK(b.writer->stats().dropped_full == r.dropped);
@@ -403,7 +404,16 @@ TEST_CASE("plans: an error names the field and the reason") {
   bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"speed", 3}}, "speed is not a field");
   bad({{"kind", "sweep"}}, "kind must be");
   bad({{"kind", "waveform"}, {"points_mm", {0, "x"}}}, "points_mm[1] must be a number");
-  bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"ramp_rate_mm_s", 30}}, "ramp_rate_mm_s is above limits.rate_mm_s");
+  bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"ramp_rate_mm_s", 30}, {"limits", {{"rate_mm_s", 10}}}},
+      "ramp_rate_mm_s is above limits.rate_mm_s");
+  // Without a rate of its own the plan parses; the rig's envelope refuses it, naming its maximum.
+  const auto fast = daemon::parse_plan({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"ramp_rate_mm_s", 30}});
+  try {
+    (void)daemon::check_plan_against(fast, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, false);
+    FAIL("a ramp of 30 mm/s passed an envelope of 20 mm/s");
+  } catch (const daemon::PlanError& e) {
+    CHECK(std::string(e.what()).find("ramp_rate_mm_s 30 exceeds the rig's maximum speed 20 mm/s") != std::string::npos);
+  }
 }
 
 TEST_CASE("sine campaign on the simulated shaker: transmissibility per frequency, stored as it comes") {

@@ -74,6 +74,9 @@ int cli(const std::string& args) {
 }
 
 std::string state_of(const std::string& db, std::int64_t id) { return db::Store(db).campaign(id)->state; }
+// The daemon is up once its rig is registered: after it held what was queued before it started
+// (a campaign submitted when only the file exists may be held as left over from a restart).
+bool daemon_ready(const std::string& db) { return fs::exists(db) && db::Store(db).rig_names().size() == 1; }
 // Whether any event of campaign id has text in its detail.
 bool has_event(const std::string& db, std::int64_t id, const std::string& text) {
   for (const auto& e : db::Store(db).events(id))
@@ -113,7 +116,7 @@ TEST_CASE("hystlabd: SIGTERM holds, marks the campaign interrupted, exits 0") {
   d.write("plan.json", kPlan);
   const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
-  REQUIRE(eventually([&] { return fs::exists(d.db()); }));
+  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
   REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "running"; }));
   kill(pid, SIGTERM);
@@ -127,7 +130,7 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
   d.write("plan.json", kPlan);
   pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
-  REQUIRE(eventually([&] { return fs::exists(d.db()); }));
+  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
   REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
   std::int64_t committed = -1;
   REQUIRE(eventually([&] {  // well into the campaign: some rows of the table measured
@@ -212,7 +215,7 @@ TEST_CASE("hystlabd: e-stop latches the rig until a reset; then a campaign compl
   d.write("fast.json", R"({"kind": "waveform", "points_mm": [0, 1.0], "ramp_rate_mm_s": 500})");
   const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
-  REQUIRE(eventually([&] { return fs::exists(d.db()) && db::Store(d.db()).rig_names().size() == 1; }));
+  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
   REQUIRE(cli("rig estop 'sim frame' --db " + d.db()) == 0);
   CHECK(cli("rig reset 'no such rig' --db " + d.db()) == 2);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -236,7 +239,7 @@ TEST_CASE("hystlabd: the supervised simulator killed; the next campaign runs on 
   d.write("plan.json", kShortPlan);
   const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
-  REQUIRE(eventually([&] { return fs::exists(d.db()) && db::Store(d.db()).rig_names().size() == 1; }));
+  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   REQUIRE(std::system(("pkill -KILL -P " + std::to_string(pid) + " hystlab-sim").c_str()) == 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
