@@ -72,8 +72,12 @@ void migrate(Database& db) {
     throw DbError("database '" + db.path() + "' has schema version " + std::to_string(v) + ", newer than this hystlab (" +
                       std::to_string(kSchemaVersion) + "): refusing to touch it",
                   0);
+  // Each step under the write lock, the version read again inside it: two processes opening a
+  // new file at once (the daemon starting, a reader polling for it) both saw version 0, and the
+  // second failed with "table commands already exists".
   for (int k = v; k < kSchemaVersion; ++k) {
-    Transaction tx(db);
+    Transaction tx(db, true);
+    if (schema_version(db) > k) continue;  // the other process did this step
     db.exec(kMigrations[k]);
     db.exec("PRAGMA user_version=" + std::to_string(k + 1));
     tx.commit();
