@@ -70,6 +70,7 @@ void Loop::begin_safing(double t, CampaignEnd e, const std::string& reason, doub
   }
   safing = true;
   safe_started = t;
+  safe_stalled = stalled;
   const Limits& l = plan.limits;
   const SupervisionSettings& s = ctx.supervisor.settings();
   safe_deadline = t + std::fabs(x - l.safe_position_mm) / l.safe_rate_mm_s + s.lag_s + s.settle_s + kHostStallAllowance_s * ctx.time_scale;
@@ -193,7 +194,7 @@ bool safing_step(Loop& L, double t, double x) {
     L.event("safe", {{"position_mm", x}, {"target_mm", l.safe_position_mm}, {"seconds", t - L.safe_started}});
     return false;
   }
-  if (t > L.safe_deadline) {
+  if (t > L.safe_deadline + (L.stalled - L.safe_stalled)) {
     L.ctx.supervisor.hold(t, "the safe position was not reached: held");
     char buf[160];
     std::snprintf(buf, sizeof buf, "; the safe position %.3f mm was not reached in %.1f s: held at %.3f mm", l.safe_position_mm,
@@ -280,9 +281,8 @@ bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double
   if (L.shaker) {
     drivers::ShakerSample s;
     if (auto ec = c.rig.read_shaker(t, s)) return on_missed(L, t, ec);
-    if (rd.fresh(s.sample_counter)) {
+    if (rd.fresh(s.sample_counter)) {  // time_s is the rig's: on the controller's clock when its map gives one
       fresh = true;
-      s.time_s = t;
       if (L.link_held) L.link_held = false, strategy.on_resume(L, t, true);
       if (!shaker_sample(L, strategy, s)) return false;
     }
@@ -315,7 +315,10 @@ bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double
 
 void run_ticks(Loop& L, Strategy& strategy) {
   RunnerContext& c = L.ctx;
-  const double period = 1.0 / L.plan.sample_rate_hz;
+  // The plan's rate is in rig time: a rig slowed down (time scale under 1, a simulator in slow
+  // motion) is polled as much slower, or 3 of 4 reads would find nothing new at time scale 0.25
+  // and the watchdog would take that for a silent rig. A faster rig is polled at the plan's rate.
+  const double period = 1.0 / (L.plan.sample_rate_hz * std::min(1.0, c.time_scale));
   const bool blocks = !L.shaker && c.rig.block_reads();
   const std::uint64_t lost_before = c.rig.health().lost_samples;
   L.spacing = period * c.time_scale;
@@ -328,7 +331,7 @@ void run_ticks(Loop& L, Strategy& strategy) {
     count_tick(L, now, next, period, blocks);
     // Woken far behind (a starved host): the ticks missed are gone, not to be run back to back;
     // a burst would read nothing fresh and count as a silent rig for the watchdog.
-    if (now - next > 5 * period) next = now;
+    if (now - next > 5 * period) L.stalled += (now - next) * c.time_scale, next = now;
     if (c.loop_periods_us && prev_tick > 0) c.loop_periods_us->push_back(static_cast<float>((now - prev_tick) * 1e6));
     prev_tick = now;
     const double t = (now - L.wall0) * c.time_scale;
@@ -362,8 +365,8 @@ void hand_off(Loop& L, Strategy& strategy) {
   FinishJob fj;
   fj.campaign = L.job.id;
   fj.plan = L.plan;
+  strategy.fill_finish(L, fj);  // first: the last descent's bottom node is counted there
   fj.result = L.result;
-  strategy.fill_finish(L, fj);
   if (L.result.gaps > 0)
     L.event("gaps", {{"count", L.result.gaps}, {"total_ms", L.result.gap_total_s * 1e3}, {"longest_ms", L.result.longest_gap_s * 1e3}});
   if (L.ctx.finish) {

@@ -45,7 +45,11 @@ struct Loop {
   std::int64_t next_seq = 0;
   bool paused = false, link_held = false, safing = false;
   double pause_started = 0, answered_at = -1e300;
-  double safe_deadline = 0, safe_started = 0;
+  double safe_deadline = 0, safe_started = 0, safe_stalled = 0;
+  // Rig seconds the loop itself was not running (woken more than 5 periods late): deadlines are
+  // extended by it, since a paced simulator waits for its host and a starved host is no servo
+  // failure (a CAN campaign "missed" δmin by 0.04 mm after 630 late wake-ups).
+  double stalled = 0;
   CampaignEnd safing_end = CampaignEnd::aborted;
   double last_t = NAN, spacing = 0;  // the time axis: the last sample's time and the expected spacing
 

@@ -36,10 +36,14 @@ void OnlineFot::bottom_reached(double t, double f) {
 void OnlineFot::feed(double t, double x, double f, bool collect) {
   // Nodes inside an open descent: each δ_j (j >= 1) passed on the way down.
   if (row_ >= 1 && dir_ < 0 && have_prev_) {
+    // Two samples further apart than half a cell are a hole (a lost link, a stalled host), not
+    // a measurement: a node inside it is not guessed by interpolation; it stays missing, and the
+    // row is taken again.
+    const bool hole = prev_x_ - x > 0.5 * grid_.step();
     while (next_j_ >= 1 && x <= grid_.node(next_j_) && prev_x_ > grid_.node(next_j_)) {
       const double level = grid_.node(next_j_);
       const double s = (prev_x_ - level) / (prev_x_ - x);
-      sink_(models::FotNode{grid_.node(row_), level, f_alpha_, prev_f_ + s * (f - prev_f_)}, t);
+      if (!hole) sink_(models::FotNode{grid_.node(row_), level, f_alpha_, prev_f_ + s * (f - prev_f_)}, t);
       --next_j_;
     }
   }

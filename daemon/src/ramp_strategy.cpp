@@ -1,7 +1,10 @@
 // fot and waveform campaigns on a load frame: a list of ramps (the sequencer), each supervised
 // for its arrival, and for fot the online table fitted as each descent passes the grid.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+
+#include <nlohmann/json.hpp>
 
 #include "acquisition_loop.hpp"
 #include "hystlab/daemon/online_fot.hpp"
@@ -41,12 +44,16 @@ class RampStrategy final : public Strategy {
       if (auto ec = L.ctx.rig.command(cmd->target_mm, cmd->rate_mm_s)) return L.command_failed(s.time_s, ec, "command");
       L.command_taken();
       arm_deadline(s.time_s, s.displacement_mm, *cmd);
-    } else if (seq_.index() == before && !seq_.done() && s.time_s > deadline_) {
+      stalled_at_arm_ = L.stalled;
+    } else if (seq_.index() == before && !seq_.done() && !seq_.in_position() && s.time_s > deadline_ + (L.stalled - stalled_at_arm_)) {
+      // Arrival is what the deadline supervises: once in position, the dwell runs its course
+      // (a browser-test campaign reached 0.000 mm late after a host stall, then "missed" it while dwelling).
       return target_missed(L, s);
     }
     if (fot_) {
       fot_->feed(s.time_s, s.displacement_mm, s.force_N, collecting());
       if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
+      if (seq_.done()) retake_rows(L);
     }
     return true;
   }
@@ -114,6 +121,31 @@ class RampStrategy final : public Strategy {
     return false;
   }
 
+  // At the end of the schedule, each fot row with a node missing (a hole in its descent) is
+  // taken again, from δmin (which wipes the memory as at any row's start), for up to
+  // kMaxRowRetakeRounds rounds; the table is completed with what was measured by then.
+  void retake_rows(Loop& L) {
+    if (builder_->complete() || rounds_ >= kMaxRowRetakeRounds) return;
+    std::vector<Segment> again;
+    nlohmann::json rows = nlohmann::json::array();
+    for (const Segment& seg : schedule(plan_)) {
+      if (seg.kind != SegmentKind::rise || row_complete(seg.row) || std::find(rows.begin(), rows.end(), seg.row) != rows.end()) continue;
+      rows.push_back(seg.row);
+      again.push_back(seg);
+      again.push_back({plan_.lo_mm, plan_.ramp_rate_mm_s, plan_.dwell_s, SegmentKind::descent, seg.row});
+    }
+    if (again.empty()) return;
+    ++rounds_;
+    seq_.insert_before_current(again);
+    L.event("retake", {{"rows", rows}, {"round", rounds_}, {"why", "a node of each was missing (a hole in the data)"}});
+  }
+
+  [[nodiscard]] bool row_complete(int row) const {
+    for (int j = 0; j < row; ++j)  // the last descent's bottom comes when the next rise (or the end) turns it
+      if (!builder_->identified(row, j) && !(j == 0 && fot_->bottom_pending(row))) return false;
+    return true;
+  }
+
   bool collecting() const {
     const Segment* s = seq_.current();
     return s && (s->kind == SegmentKind::rise || s->kind == SegmentKind::descent);
@@ -127,6 +159,9 @@ class RampStrategy final : public Strategy {
   RunSeries series_;
   double time_scale_ = 1.0;
   double target_ = 0, started_ = 0, deadline_ = 1e300;
+  double stalled_at_arm_ = 0;
+  int rounds_ = 0;
+  static constexpr int kMaxRowRetakeRounds = 3;
 };
 }  // namespace
 

@@ -35,6 +35,7 @@ struct RigWorker {
   RigLive live;
   std::thread thread;
   std::atomic<std::int64_t> running_campaign{0};
+  int idle_misses = 0;  // failed idle reads in a row (the acquisition thread's)
 
   void build_rig(const std::string& base);  // throws drivers::RigConfigError
   // From other threads: a campaign, a campaign control, a rig command. Never blocks on I/O.

@@ -1,5 +1,8 @@
 #include "can_endpoint.hpp"
 
+#include <linux/sockios.h>
+#include <sys/ioctl.h>
+
 #include <sys/socket.h>
 
 #include <cerrno>
@@ -40,6 +43,11 @@ void CanEndpoint::receive(SimRig& rig) {
     }
     rig.apply(v);
   }
+}
+
+bool CanEndpoint::host_caught_up() const noexcept {
+  int queued = 0;
+  return ioctl(fd_, SIOCOUTQ, &queued) != 0 || queued == 0;
 }
 
 void CanEndpoint::maybe_send(double now_s, const SignalValues& m, protocols::RigKind kind, const Faults& faults) {

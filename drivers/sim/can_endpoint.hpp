@@ -13,6 +13,9 @@ class CanEndpoint {
   // Sends a status cycle when its period (wall time) has passed.
   void maybe_send(double now_s, const SignalValues& m, protocols::RigKind kind, const Faults& faults);
   [[nodiscard]] bool peer_gone() const noexcept { return gone_; }
+  // The host has read every frame sent so far (its only sign of life on a bus it just listens
+  // to; what paces a time-scaled world over CAN). True where the socket cannot tell (SIOCOUTQ).
+  [[nodiscard]] bool host_caught_up() const noexcept;
 
  private:
   int fd_, node_;

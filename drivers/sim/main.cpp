@@ -26,6 +26,7 @@
 #include "hystlab/models/simplified_sma.hpp"
 #include "hystlab/protocols/default_maps.hpp"
 #include "modbus_endpoint.hpp"
+#include "pacer.hpp"
 
 namespace {
 using namespace hystlab;
@@ -39,6 +40,9 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --map M.json                   register map (default: the shipped map for the rig)
   --can-fd N  --can-node N  --can-rate HZ   CAN: inherited fd carrying struct can_frame, node id, status rate
   --time-scale S                 simulated seconds per wall-clock second (default 1)
+  --pace auto|on|off             the world runs at most a few request intervals past the host's last request
+                                 (CAN: the last time it had read every frame), then waits for the next
+                                 (auto: on when --time-scale > 1; see SIM.md)
   --sample-rate HZ               simulated samples per simulated second (default 1000)
   --seed N  --noise N  --drift N_PER_S      load cell noise (1 sigma, N) and drift
   --params P.json | --table T.json          the specimen (default: Table 1, corners smoothed)
@@ -62,7 +66,7 @@ volatile sig_atomic_t g_stop = 0;
 void on_signal(int) { g_stop = 1; }
 
 struct Args {
-  std::string rig = "load_frame", transport = "tcp", address = "127.0.0.1", map, params, table;
+  std::string rig = "load_frame", transport = "tcp", address = "127.0.0.1", map, params, table, pace = "auto";
   int port = 1502, can_fd = -1, can_node = 1, control_port = 0, realtime = 0;
   double time_scale = 1, sample_rate = 1000, can_rate = 1000, noise = 0.05, drift = 0, corner = 0.05, duration = 0;
   double deadband_mm = 0, host_timeout_ms = 0, mode = 1;
@@ -108,6 +112,7 @@ Args parse(int argc, char** argv) {
     else if (o == "--can-node") a.can_node = static_cast<int>(num());
     else if (o == "--can-rate") a.can_rate = num();
     else if (o == "--time-scale") a.time_scale = num();
+    else if (o == "--pace") a.pace = v;
     else if (o == "--sample-rate") a.sample_rate = num();
     else if (o == "--seed") a.seed = static_cast<std::uint64_t>(num());
     else if (o == "--noise") a.noise = num();
@@ -127,6 +132,7 @@ Args parse(int argc, char** argv) {
   }
   if (a.rig != "load_frame" && a.rig != "shaker") throw std::runtime_error("--rig must be load_frame or shaker");
   if (a.transport != "tcp" && a.transport != "rtu" && a.transport != "can") throw std::runtime_error("--transport must be tcp, rtu or can");
+  if (a.pace != "auto" && a.pace != "on" && a.pace != "off") throw std::runtime_error("--pace must be auto, on or off");
   if (a.transport == "can" && a.can_fd < 0) throw std::runtime_error("--transport can needs --can-fd");
   if (!(a.time_scale > 0) || !(a.sample_rate > 0) || !(a.can_rate > 0)) throw std::runtime_error("rates and time scale must be > 0");
   if (!(a.deadband_mm >= 0) || !std::isfinite(a.deadband_mm)) throw std::runtime_error("--deadband-mm must be a number >= 0");
@@ -147,9 +153,9 @@ std::optional<protocols::RegisterMap> load_map(const Args& a) {
   const std::string text = a.map.empty() ? (a.rig == "shaker" ? protocols::kDefaultShakerMap : protocols::kDefaultLoadFrameMap) : read_file(a.map);
   protocols::RegisterMap map = protocols::RegisterMap::from_json(text);
   if ((map.kind() == protocols::RigKind::shaker) != (a.rig == "shaker")) throw std::runtime_error("the map is for another kind of rig than --rig " + a.rig);
-  if (const auto& w = map.sample_window(); w && std::fabs(w->period_s * a.sample_rate - 1.0) > 1e-9)
-    throw std::runtime_error("the map's sample_window.period_s (" + std::to_string(w->period_s) + " s) is not the period of --sample-rate " +
-                             std::to_string(a.sample_rate) + " Hz");
+  if (const double p = map.sample_period_s(); p > 0 && std::fabs(p * a.sample_rate - 1.0) > 1e-9)
+    throw std::runtime_error(std::string(map.sample_window() ? "the map's sample_window.period_s (" : "the map's sample_period_s (") +
+                             std::to_string(p) + " s) is not the period of --sample-rate " + std::to_string(a.sample_rate) + " Hz");
   return map;
 }
 
@@ -216,20 +222,24 @@ int run(const Args& a) {
   std::vector<pollfd> pfds;
   // Brings the physics up to now and publishes it: before every wait, and again right before
   // answering, so an answer never carries values older than the request.
-  // A starved simulator pauses its world instead of jumping it forward: the rig it stands in
-  // for has a CPU of its own and never misses a cycle, so a host-side freeze (on CI VMs, 1 ms
-  // sleeps were seen to wake 0.5-0.7 s late with the machine idle) must not become a 100 s jump
-  // of rig time at time scale 200. At most 20 ms of wall time is caught up (the longest wait of
-  // a simulator that is not starved); the rest is lost and counted ("lost=" on the control
-  // channel's status).
+  // The controller it stands in for has a CPU of its own and never misses a cycle. A moment the
+  // simulator is not scheduled is, on the VMs this runs on in CI, a moment the whole machine was
+  // not: two processes spinning on the two vCPUs lost 6.6 s of 8 s, in the same 0.05-0.6 s
+  // chunks. Its host froze with it; a world that jumped ahead meanwhile would be a rig the host
+  // could not have watched (100 s of rig at time scale 200). So at most 20 ms of wall time (the
+  // longest wait of a simulator that is scheduled) is caught up; the rest is lost, and counted
+  // ("lost=" on the control channel's status). Time-scaled, it is also paced by its host
+  // (pacer.hpp): a host starved on its own finds the rig where it left it.
   constexpr double kMaxCatchUp_s = 0.02;
-  double lost_wall_s = 0;
+  sim::Pacer pacer(a.pace == "on" || (a.pace == "auto" && a.time_scale > 1));
+  double frozen_s = 0;
   auto advance = [&](double now) {
-    const double wall_dt = now - last;
-    if (wall_dt > kMaxCatchUp_s) lost_wall_s += wall_dt - kMaxCatchUp_s;
-    sim_due += std::min(wall_dt, kMaxCatchUp_s) * a.time_scale;
-    last = now;
-    for (int guard = 0; sim_due >= sample_dt && guard < 100000; ++guard) {
+    const double until = pacer.horizon(now);
+    double wall_dt = std::max(0.0, until - last);
+    if (wall_dt > kMaxCatchUp_s) frozen_s += wall_dt - kMaxCatchUp_s, wall_dt = kMaxCatchUp_s;
+    sim_due += wall_dt * a.time_scale;
+    last = std::max(last, until);
+    for (int guard = 0; sim_due >= sample_dt && guard < 10000000; ++guard) {
       rig.step(sample_dt);
       sim_due -= sample_dt;
       if (modbus && !faults.freeze) modbus->record(rig.measurements(faults));  // the controller's own clock
@@ -245,6 +255,7 @@ int run(const Args& a) {
   while (!g_stop && (a.duration <= 0 || wall() < a.duration)) {
     if (a.exit_with_parent && getppid() != parent) break;  // the supervisor died (even by kill -9)
     const double now = wall();
+    if (can && can->host_caught_up()) last = pacer.on_request(now, last);  // it read all we sent: a sign of life
     const sim::SignalValues m = advance(now);
     if (faults.drop && !was_dropping && modbus) modbus->drop_clients();
     was_dropping = faults.drop;
@@ -257,12 +268,16 @@ int run(const Args& a) {
     for (int fd : fds) pfds.push_back(pollfd{fd, POLLIN, 0});
     if (poll(pfds.data(), pfds.size(), wait_ms) <= 0) continue;
     if (modbus && faults.stall_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(faults.stall_ms));
-    if (modbus) advance(wall());
+    if (modbus) {
+      const double arrived = wall();
+      last = pacer.on_request(arrived, last);
+      advance(arrived);
+    }
     for (const pollfd& p : pfds) {
       if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;
       if (control.owns(p.fd)) {
         std::ostringstream status;
-        status << "t=" << rig.time_s() << " lost=" << lost_wall_s;
+        status << "t=" << rig.time_s() << " lost=" << frozen_s + pacer.lost_s();
         if (control.handle(p.fd, faults, rig, status.str())) g_stop = 1;
       } else if (can && p.fd == can->fd()) {
         can->receive(rig);

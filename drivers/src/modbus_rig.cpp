@@ -74,6 +74,7 @@ std::error_code ModbusRig::connect(double now_s) noexcept {
   disconnect();
   last_now_ = now_s;
   have_window_counter_ = false;  // block reads start afresh: what came before is not "lost"
+  have_poll_anchor_ = false;
   ctx_ = cfg_.transport == ModbusRigConfig::Transport::tcp
              ? modbus_new_tcp(cfg_.host.c_str(), cfg_.port)
              : modbus_new_rtu(cfg_.device.c_str(), cfg_.baud, cfg_.parity, cfg_.data_bits, cfg_.stop_bits);
@@ -340,9 +341,27 @@ std::error_code ModbusRig::read_shaker(double now_s, ShakerSample& out) noexcept
                           Signal::sample_counter};
   for (int k = 0; k < 8; ++k)
     if (auto ec = value_of(sigs[k], v[k])) return ec;
-  out = ShakerSample{now_s, v[0], v[1], v[2], v[3], static_cast<std::uint16_t>(v[4]), static_cast<std::uint16_t>(v[5]),
-                     static_cast<std::uint32_t>(v[6]), static_cast<std::uint32_t>(v[7])};
-  return check_stale(now_s, out.sample_counter);
+  const auto counter = static_cast<std::uint32_t>(v[7]);
+  out = ShakerSample{clock_time(now_s, counter), v[0], v[1], v[2], v[3], static_cast<std::uint16_t>(v[4]), static_cast<std::uint16_t>(v[5]),
+                     static_cast<std::uint32_t>(v[6]), counter};
+  return check_stale(now_s, counter);
+}
+
+// A sine fit needs the signal's own time axis: asked when the host happened to run, a shaker
+// on a VM frozen for 0.4 s at a time (both vCPUs at once, twice a second) looked 0.4 s older
+// than it was. Anchored at the first read (and again if the counter goes back).
+double ModbusRig::clock_time(double now_s, std::uint32_t counter) noexcept {
+  const double period = cfg_.map.sample_period_s();
+  if (period <= 0) return now_s;
+  if (!have_poll_anchor_ || static_cast<std::int32_t>(counter - poll_counter_) < 0) {
+    have_poll_anchor_ = true;
+    poll_anchor_s_ = now_s;
+    poll_anchor64_ = poll_counter64_ = counter;
+  } else {
+    poll_counter64_ += static_cast<std::int32_t>(counter - poll_counter_);
+  }
+  poll_counter_ = counter;
+  return poll_anchor_s_ + static_cast<double>(poll_counter64_ - poll_anchor64_) * period;
 }
 
 std::error_code ModbusRig::write_signals(std::initializer_list<Write> writes) noexcept {

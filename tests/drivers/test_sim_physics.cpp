@@ -1,6 +1,7 @@
 // The simulated rigs' physics, stepped directly (time is passed in, so this runs in no time).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "hystlab/models/simplified_sma.hpp"
@@ -8,6 +9,7 @@
 #include "hystlab/protocols/register_map.hpp"
 #include "hystlab/protocols/signals.hpp"
 #include "load_frame_sim.hpp"
+#include "pacer.hpp"
 #include "shaker_sim.hpp"
 
 using namespace hystlab;
@@ -298,4 +300,34 @@ TEST_CASE("load frame: the watchdog arms at the host's first heartbeat and times
   CHECK(f.state().fault_code == kNoFault);
   run(f, 0.15);
   CHECK(f.state().fault_code == kHostHeartbeatLost);
+}
+
+TEST_CASE("pacer: a time-scaled world waits for its host, and one late request does not widen its lead") {
+  sim::Pacer off(false);
+  CHECK(off.horizon(5.0) == 5.0);
+  CHECK(off.on_request(5.0, 1.0) == 1.0);
+
+  sim::Pacer p(true);
+  CHECK(p.horizon(0.5) == 0.5);  // no host yet: the world runs freely
+  double world = 0;
+  for (int k = 0; k <= 10; ++k) {  // a host asking every millisecond
+    const double now = 0.001 * k;
+    world = p.on_request(now, world);
+    world = std::max(world, p.horizon(now));
+  }
+  CHECK(world == doctest::Approx(0.010));
+  CHECK(p.window_s() == doctest::Approx(0.003));
+  CHECK(p.lost_s() == 0);
+  // The host stalls for 0.6 s: the world stops 3 ms past its last request, and goes on from 3 ms
+  // before the next one; the rest is counted as lost.
+  CHECK(p.horizon(0.3) == doctest::Approx(0.013));
+  world = p.on_request(0.61, 0.013);
+  CHECK(world == doctest::Approx(0.607));
+  CHECK(p.lost_s() == doctest::Approx(0.594));
+  CHECK(p.window_s() == doctest::Approx(0.003));  // the median of 8: one late request is not the rhythm
+  // A slower host (idle polling every 50 ms) gets a wider lead, up to 200 ms.
+  for (int k = 1; k <= 8; ++k) world = std::max(p.on_request(0.61 + 0.05 * k, world), p.horizon(0.61 + 0.05 * k));
+  CHECK(p.window_s() == doctest::Approx(0.15));
+  for (int k = 1; k <= 8; ++k) (void)p.on_request(1.01 + 0.1 * k, 2.0);
+  CHECK(p.window_s() == doctest::Approx(sim::Pacer::kMaxWindow_s));
 }

@@ -21,6 +21,9 @@ class OnlineFot {
   // Ends a descent still open at the end of the input (its bottom gives the δmin node).
   void finish();
   [[nodiscard]] int descents_completed() const noexcept { return descents_; }
+  // A descent of row i passed its last δ_j and waits for its bottom (the next reversal, or
+  // finish()) to give node (i, 0).
+  [[nodiscard]] bool bottom_pending(int i) const noexcept { return row_ == i && next_j_ == 0; }
   // True once after each completed descent (then cleared): the moment to re-evaluate the table.
   bool take_descent_completed() noexcept;
 

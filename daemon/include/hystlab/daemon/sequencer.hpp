@@ -33,6 +33,8 @@ class Sequencer {
   // segment starts.
   std::optional<SetpointCommand> step(double now_s, double displacement_mm);
   [[nodiscard]] bool done() const noexcept { return index_ >= segments_.size(); }
+  // The current segment's target was reached: it is dwelling there (its arrival is no longer due).
+  [[nodiscard]] bool in_position() const noexcept { return dwelling_; }
   [[nodiscard]] std::size_t index() const noexcept { return index_; }
   [[nodiscard]] std::size_t size() const noexcept { return segments_.size(); }
   [[nodiscard]] const Segment* current() const noexcept { return done() ? nullptr : &segments_[index_]; }

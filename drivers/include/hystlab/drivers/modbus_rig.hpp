@@ -93,6 +93,13 @@ class ModbusRig final : public Rig {
   std::uint32_t window_counter_ = 0;
   std::int64_t window_counter64_ = 0, anchor_counter64_ = 0;
   double anchor_time_s_ = 0;
+  // Polled shaker samples on the controller's clock (the map's sample_period_s): the counter at
+  // the anchor, extended to 64 bits, and the host time then.
+  double clock_time(double now_s, std::uint32_t counter) noexcept;
+  bool have_poll_anchor_ = false;
+  std::uint32_t poll_counter_ = 0;
+  std::int64_t poll_counter64_ = 0, poll_anchor64_ = 0;
+  double poll_anchor_s_ = 0;
 };
 
 }  // namespace hystlab::drivers

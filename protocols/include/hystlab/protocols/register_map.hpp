@@ -72,6 +72,9 @@ class RegisterMap {
   // Blocks covering the measurements (reads) of this map.
   [[nodiscard]] const std::vector<ReadBlock>& measurement_blocks() const noexcept { return blocks_; }
   [[nodiscard]] const std::optional<SampleWindow>& sample_window() const noexcept { return window_; }
+  // The controller's sample clock: its sample_counter advances once per period (the map's
+  // optional `sample_period_s`, else its window's period); 0 when the map does not say.
+  [[nodiscard]] double sample_period_s() const noexcept { return period_s_ > 0 ? period_s_ : window_ ? window_->period_s : 0.0; }
   // The controller's text for a fault code (the map's optional `fault_codes`); empty if unknown.
   [[nodiscard]] std::string fault_text(std::uint16_t code) const;
   [[nodiscard]] const std::map<std::uint16_t, std::string>& fault_codes() const noexcept { return fault_codes_; }
@@ -85,6 +88,7 @@ class RegisterMap {
   std::array<int, kSignalCount> index_{};
   std::vector<ReadBlock> blocks_;
   std::optional<SampleWindow> window_;
+  double period_s_ = 0;
   std::map<std::uint16_t, std::string> fault_codes_;
 };
 
