@@ -331,7 +331,10 @@ void run_ticks(Loop& L, Strategy& strategy) {
     count_tick(L, now, next, period, blocks);
     // Woken far behind (a starved host): the ticks missed are gone, not to be run back to back;
     // a burst would read nothing fresh and count as a silent rig for the watchdog.
-    if (now - next > 5 * period) L.stalled += (now - next) * c.time_scale, next = now;
+    if (now - next > 5 * period) {
+      if (now - next > Loop::kLoopStall_s) L.stalled += (now - next) * c.time_scale;
+      next = now;
+    }
     if (c.loop_periods_us && prev_tick > 0) c.loop_periods_us->push_back(static_cast<float>((now - prev_tick) * 1e6));
     prev_tick = now;
     const double t = (now - L.wall0) * c.time_scale;

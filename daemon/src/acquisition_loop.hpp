@@ -46,10 +46,11 @@ struct Loop {
   bool paused = false, link_held = false, safing = false;
   double pause_started = 0, answered_at = -1e300;
   double safe_deadline = 0, safe_started = 0, safe_stalled = 0;
-  // Rig seconds the loop itself was not running (woken more than 5 periods late): deadlines are
+  // Rig seconds the loop itself was not running (woken kLoopStall_s late or more): deadlines are
   // extended by it, since a paced simulator waits for its host and a starved host is no servo
   // failure (a CAN campaign "missed" δmin by 0.04 mm after 630 late wake-ups).
   double stalled = 0;
+  static constexpr double kLoopStall_s = 0.02;  // of wall time: beyond any scheduling delay of a host that runs
   CampaignEnd safing_end = CampaignEnd::aborted;
   double last_t = NAN, spacing = 0;  // the time axis: the last sample's time and the expected spacing
 

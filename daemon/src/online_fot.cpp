@@ -36,10 +36,11 @@ void OnlineFot::bottom_reached(double t, double f) {
 void OnlineFot::feed(double t, double x, double f, bool collect) {
   // Nodes inside an open descent: each δ_j (j >= 1) passed on the way down.
   if (row_ >= 1 && dir_ < 0 && have_prev_) {
-    // Two samples further apart than half a cell are a hole (a lost link, a stalled host), not
-    // a measurement: a node inside it is not guessed by interpolation; it stays missing, and the
-    // row is taken again.
-    const bool hole = prev_x_ - x > 0.5 * grid_.step();
+    // Two samples further apart than half a cell, and late (over 3 expected spacings), are a
+    // hole (a lost link, a stalled host), not a measurement: a node inside it is not guessed by
+    // interpolation; it stays missing, and the row is taken again. Coarse but regular sampling
+    // is no hole.
+    const bool hole = spacing_s_ > 0 && prev_x_ - x > 0.5 * grid_.step() && t - prev_t_ > 3 * spacing_s_;
     while (next_j_ >= 1 && x <= grid_.node(next_j_) && prev_x_ > grid_.node(next_j_)) {
       const double level = grid_.node(next_j_);
       const double s = (prev_x_ - level) / (prev_x_ - x);
@@ -58,7 +59,7 @@ void OnlineFot::feed(double t, double x, double f, bool collect) {
     dir_ = -dir_;
     ext_x_ = x, ext_f_ = f, ext_t_ = t;  // (the dead band is far smaller than a cell: no δ_j was passed yet)
   }
-  prev_x_ = x, prev_f_ = f;
+  prev_x_ = x, prev_f_ = f, prev_t_ = t;
   have_prev_ = true;
 }
 

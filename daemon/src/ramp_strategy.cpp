@@ -51,6 +51,7 @@ class RampStrategy final : public Strategy {
       return target_missed(L, s);
     }
     if (fot_) {
+      fot_->set_spacing(L.spacing);
       fot_->feed(s.time_s, s.displacement_mm, s.force_N, collecting());
       if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
       if (seq_.done()) retake_rows(L);
@@ -123,7 +124,7 @@ class RampStrategy final : public Strategy {
 
   // At the end of the schedule, each fot row with a node missing (a hole in its descent) is
   // taken again, from δmin (which wipes the memory as at any row's start), for up to
-  // kMaxRowRetakeRounds rounds; the table is completed with what was measured by then.
+  // kMaxRowRetakeRounds rounds; a table still incomplete then fails the campaign (run_finish.cpp).
   void retake_rows(Loop& L) {
     if (builder_->complete() || rounds_ >= kMaxRowRetakeRounds) return;
     std::vector<Segment> again;

@@ -228,6 +228,7 @@ void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void
       while (auto c = w.pop_rig_command()) rig_command(w, *c, rig_time());
       if (auto job = w.pop_job()) {
         run_job(w, std::move(*job), writer, finish, stop, t0);
+        w.idle_misses = 0;
         w.running_campaign = 0;
         continue;
       }

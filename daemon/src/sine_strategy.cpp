@@ -33,9 +33,9 @@ class SineStrategy final : public Strategy {
     return true;
   }
 
-  void on_resume(Loop& L, double t, bool) override {  // the step is taken again from its start
-    if (k_ < plan_.frequencies_hz.size()) (void)start_step(L, t);
-  }
+  // The step is taken again from its start, at the next sample: on the rig's clock, as every
+  // window is (a shaker's samples may be on the controller's clock, behind the loop's).
+  void on_resume(Loop&, double, bool) override { started_ = false; }
 
   [[nodiscard]] bool done() const override { return k_ >= plan_.frequencies_hz.size(); }
 
@@ -61,12 +61,13 @@ class SineStrategy final : public Strategy {
   // sampled (a gap over a quarter cycle counts as unsampled). A starved 2-core VM polled the
   // shaker at 170 Hz with 0.6 s stalls; judging by the longest gap, 10 Hz never passed there.
   std::string window_hole(double f) const {
-    const double window = plan_.measured_cycles / f, needed = 8.0 * plan_.measured_cycles;
-    double holes = 0, longest = 0;
-    for (std::size_t i = 1; i < t_.size(); ++i) {
-      const double gap = t_[i] - t_[i - 1];
+    const double window = t_end_ - t_measure_, needed = 8.0 * plan_.measured_cycles;
+    double holes = 0, longest = 0, prev = t_measure_;
+    for (const double t : t_) {  // the window's stretches between samples, its edges included
+      const double gap = std::min(t, t_end_) - std::max(prev, t_measure_);
       longest = std::max(longest, gap);
       if (gap > 0.25 / f) holes += gap;
+      prev = t;
     }
     char buf[160];
     if (static_cast<double>(t_.size()) < needed)

@@ -26,7 +26,7 @@
 #include "hystlab/models/simplified_sma.hpp"
 #include "hystlab/protocols/default_maps.hpp"
 #include "modbus_endpoint.hpp"
-#include "pacer.hpp"
+#include "world_clock.hpp"
 
 namespace {
 using namespace hystlab;
@@ -53,6 +53,7 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --mode N                       the controller moves only while the map's mode register (CAN: the command's mode)
                                  holds N (default 1; a map without mode has no interlock). It starts at 0
   --host-timeout-ms T            stop with fault 4 when the host's host_heartbeat has not changed for T wall-clock ms
+                                 of the world's time (a paced world waiting for its host does not count)
                                  while the drive is on (default 0: off; a real controller would have it on)
   --control-port P               text control channel on 127.0.0.1 (default 0: any free port)
   --duration S                   stop after S wall-clock seconds (default: run until SIGTERM or 'quit')
@@ -215,33 +216,15 @@ int run(const Args& a) {
   const auto t0 = clock::now();
   auto wall = [&] { return std::chrono::duration<double>(clock::now() - t0).count(); };
   const double sample_dt = 1.0 / a.sample_rate;
-  double sim_due = 0;  // simulated time owed to the physics
-  double last = 0;
+  sim::WorldClock world(a.time_scale, sample_dt, a.pace == "on" || (a.pace == "auto" && a.time_scale > 1));
   bool was_dropping = false;
   std::vector<int> fds;
   std::vector<pollfd> pfds;
-  // Brings the physics up to now and publishes it: before every wait, and again right before
-  // answering, so an answer never carries values older than the request.
-  // The controller it stands in for has a CPU of its own and never misses a cycle. A moment the
-  // simulator is not scheduled is, on the VMs this runs on in CI, a moment the whole machine was
-  // not: two processes spinning on the two vCPUs lost 6.6 s of 8 s, in the same 0.05-0.6 s
-  // chunks. Its host froze with it; a world that jumped ahead meanwhile would be a rig the host
-  // could not have watched (100 s of rig at time scale 200). So at most 20 ms of wall time (the
-  // longest wait of a simulator that is scheduled) is caught up; the rest is lost, and counted
-  // ("lost=" on the control channel's status). Time-scaled, it is also paced by its host
-  // (pacer.hpp): a host starved on its own finds the rig where it left it.
-  constexpr double kMaxCatchUp_s = 0.02;
-  sim::Pacer pacer(a.pace == "on" || (a.pace == "auto" && a.time_scale > 1));
-  double frozen_s = 0;
+  // Brings the physics up to now (world_clock.hpp) and publishes it: before every wait, and
+  // again right before answering, so an answer never carries values older than the request.
   auto advance = [&](double now) {
-    const double until = pacer.horizon(now);
-    double wall_dt = std::max(0.0, until - last);
-    if (wall_dt > kMaxCatchUp_s) frozen_s += wall_dt - kMaxCatchUp_s, wall_dt = kMaxCatchUp_s;
-    sim_due += wall_dt * a.time_scale;
-    last = std::max(last, until);
-    for (int guard = 0; sim_due >= sample_dt && guard < 10000000; ++guard) {
+    for (long n = world.steps_due(now); n > 0; --n) {
       rig.step(sample_dt);
-      sim_due -= sample_dt;
       if (modbus && !faults.freeze) modbus->record(rig.measurements(faults));  // the controller's own clock
     }
     const sim::SignalValues m = rig.measurements(faults);
@@ -255,7 +238,7 @@ int run(const Args& a) {
   while (!g_stop && (a.duration <= 0 || wall() < a.duration)) {
     if (a.exit_with_parent && getppid() != parent) break;  // the supervisor died (even by kill -9)
     const double now = wall();
-    if (can && can->host_caught_up()) last = pacer.on_request(now, last);  // it read all we sent: a sign of life
+    if (can && can->host_caught_up()) world.host_request(now);  // it read all we sent: a sign of life
     const sim::SignalValues m = advance(now);
     if (faults.drop && !was_dropping && modbus) modbus->drop_clients();
     was_dropping = faults.drop;
@@ -270,14 +253,15 @@ int run(const Args& a) {
     if (modbus && faults.stall_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(faults.stall_ms));
     if (modbus) {
       const double arrived = wall();
-      last = pacer.on_request(arrived, last);
+      const bool asked = std::any_of(pfds.begin(), pfds.end(), [&](const pollfd& p) { return (p.revents & POLLIN) && !control.owns(p.fd); });
+      if (asked) world.host_request(arrived);  // a host's request (a test's status query is none)
       advance(arrived);
     }
     for (const pollfd& p : pfds) {
       if (!(p.revents & (POLLIN | POLLHUP | POLLERR))) continue;
       if (control.owns(p.fd)) {
         std::ostringstream status;
-        status << "t=" << rig.time_s() << " lost=" << frozen_s + pacer.lost_s();
+        status << "t=" << rig.time_s() << " lost=" << world.lost_s();
         if (control.handle(p.fd, faults, rig, status.str())) g_stop = 1;
       } else if (can && p.fd == can->fd()) {
         can->receive(rig);

@@ -353,12 +353,16 @@ std::error_code ModbusRig::read_shaker(double now_s, ShakerSample& out) noexcept
 double ModbusRig::clock_time(double now_s, std::uint32_t counter) noexcept {
   const double period = cfg_.map.sample_period_s();
   if (period <= 0) return now_s;
-  if (!have_poll_anchor_ || static_cast<std::int32_t>(counter - poll_counter_) < 0) {
+  // A 16-bit counter (one register) wraps every 65,536 samples: steps are taken at its width.
+  const protocols::MapEntry* e = cfg_.map.find(Signal::sample_counter);
+  const std::int64_t step = e && e->width() == 1 ? static_cast<std::int16_t>(static_cast<std::uint16_t>(counter - poll_counter_))
+                                                 : static_cast<std::int64_t>(static_cast<std::int32_t>(counter - poll_counter_));
+  if (!have_poll_anchor_ || step < 0) {
     have_poll_anchor_ = true;
     poll_anchor_s_ = now_s;
     poll_anchor64_ = poll_counter64_ = counter;
   } else {
-    poll_counter64_ += static_cast<std::int32_t>(counter - poll_counter_);
+    poll_counter64_ += step;
   }
   poll_counter_ = counter;
   return poll_anchor_s_ + static_cast<double>(poll_counter64_ - poll_anchor64_) * period;

@@ -157,6 +157,17 @@ RegisterMap RegisterMap::from_json(std::string_view text) {
   }
 }
 
+namespace {
+// The optional "sample_period_s": the controller's sample clock (one with the window's, if any).
+double parse_sample_period(const json& p, const std::optional<SampleWindow>& window) {
+  if (!p.is_number() || !(p.get<double>() > 0) || p.get<double>() > 1) fail("sample_period_s must be a number of seconds > 0 and <= 1");
+  const double s = p.get<double>();
+  if (window && std::fabs(window->period_s - s) > 1e-12 * s)
+    fail("sample_period_s differs from sample_window.period_s: the controller has one sample clock");
+  return s;
+}
+}  // namespace
+
 RegisterMap RegisterMap::parse_map(std::string_view text) {
   json j;
   try {
@@ -210,13 +221,7 @@ RegisterMap RegisterMap::parse_map(std::string_view text) {
   }
   if (j.contains("sample_window")) m.window_ = parse_window(j["sample_window"], m);
   if (j.contains("fault_codes")) m.fault_codes_ = parse_fault_codes(j["fault_codes"]);
-  if (j.contains("sample_period_s")) {
-    const json& p = j["sample_period_s"];
-    if (!p.is_number() || !(p.get<double>() > 0) || p.get<double>() > 1) fail("sample_period_s must be a number of seconds > 0 and <= 1");
-    m.period_s_ = p.get<double>();
-    if (m.window_ && std::fabs(m.window_->period_s - m.period_s_) > 1e-12 * m.period_s_)
-      fail("sample_period_s differs from sample_window.period_s: the controller has one sample clock");
-  }
+  if (j.contains("sample_period_s")) m.period_s_ = parse_sample_period(j["sample_period_s"], m.window_);
   return m;
 }
 

@@ -160,6 +160,7 @@ TEST_CASE("fot campaign n = 12: the online table equals the offline one and the 
   const models::Grid g = models::Grid::make(0, 4, 12);
   models::OnlineTableBuilder offline(g);
   daemon::OnlineFot fot(g, std::min(0.05 * g.step(), 0.02), [&](const models::FotNode& n, double) { (void)offline.add(n); });
+  fot.set_spacing(0.001 * 200);  // as online: 1 ms polls at time scale 200
   b.store->for_each_sample(r.run_id, 0, 1LL << 40, [&](const db::SampleRow& s) { fot.feed(s.t, s.disp, s.force, true); });
   fot.finish();
   REQUIRE(offline.complete());

@@ -12,6 +12,8 @@
 #include "fake_rig.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
+#include "hystlab/daemon/online_fot.hpp"
+#include "hystlab/daemon/sequencer.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 
 namespace fs = std::filesystem;
@@ -292,4 +294,51 @@ TEST_CASE("randomized fault schedules: never moving while latched, never armed w
     CHECK((h.sup->state() == RigState::idle || h.sup->latched() || h.sup->state() == RigState::disconnected ||
            h.sup->state() == RigState::holding));
   }
+}
+
+// A FOT row 3 on a 0..4 mm grid of 4 cells: up to 3 mm, then down to 0 in 0.1 mm steps 10 ms
+// apart, with one jump from `from` to `to` taking `jump_s`. Returns the β of each node found.
+std::vector<double> fot_row_with_jump(double spacing, double from, double to, double jump_s, bool* pending_at_bottom = nullptr) {
+  std::vector<double> betas;
+  daemon::OnlineFot fot(models::Grid::make(0, 4, 4), 0.02, [&](const models::FotNode& n, double) { betas.push_back(n.beta); });
+  fot.set_spacing(spacing);
+  double t = 0;
+  for (int k = 0; k <= 30; ++k) fot.feed(t += 0.01, 0.1 * k, 10.0 * k, true);
+  for (int k = 29; k >= 0; --k) {
+    const double x = 0.1 * k;
+    if (x < from - 1e-9 && x > to + 1e-9) continue;  // inside the jump: not sampled
+    t += std::fabs(x - to) < 1e-9 ? jump_s : 0.01;
+    fot.feed(t, x, 5.0 * k, true);
+  }
+  if (pending_at_bottom) *pending_at_bottom = fot.bottom_pending(3);
+  for (int k = 1; k <= 5; ++k) fot.feed(t += 0.01, 0.1 * k, 0.0, true);  // the next rise turns the bottom
+  return betas;
+}
+
+TEST_CASE("online FOT: a node inside a hole in the data is left missing, not interpolated; coarse regular sampling is no hole") {
+  bool pending = false;
+  CHECK(fot_row_with_jump(0.01, 0.0, 0.0, 0.01, &pending) == std::vector<double>{2, 1, 0});  // no jump
+  CHECK(pending);  // δ1 passed, the bottom (δ0) waits for the next reversal
+  // 2.3 -> 1.6 mm in 0.5 s: node δ2 = 2 mm is inside the hole.
+  CHECK(fot_row_with_jump(0.01, 2.3, 1.6, 0.5) == std::vector<double>{1, 0});
+  // The same jump at the regular spacing (coarse sampling, not late): interpolated.
+  CHECK(fot_row_with_jump(0.01, 2.3, 1.6, 0.01) == std::vector<double>{2, 1, 0});
+  // Offline data (no spacing given): every crossing is interpolated, as before.
+  CHECK(fot_row_with_jump(0.0, 2.3, 1.6, 0.5) == std::vector<double>{2, 1, 0});
+}
+
+TEST_CASE("sequencer: in position once within the tolerance, then the dwell runs") {
+  daemon::Sequencer seq({{1.0, 2.0, 0.5, daemon::SegmentKind::waypoint, 0}, {0.0, 2.0, 0.0, daemon::SegmentKind::waypoint, 0}}, 0.01);
+  REQUIRE(seq.step(0.0, 0.0));  // the first command
+  CHECK_FALSE(seq.in_position());
+  CHECK_FALSE(seq.step(0.3, 0.6));
+  CHECK_FALSE(seq.in_position());
+  CHECK_FALSE(seq.step(0.6, 0.995));
+  CHECK(seq.in_position());
+  CHECK(seq.index() == 0);
+  CHECK_FALSE(seq.step(1.0, 1.0));  // dwelling until 1.1
+  const auto next = seq.step(1.2, 1.0);
+  REQUIRE(next);
+  CHECK(next->target_mm == 0.0);
+  CHECK_FALSE(seq.in_position());
 }

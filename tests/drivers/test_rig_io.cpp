@@ -195,6 +195,7 @@ TEST_CASE("modbus tcp, block reads: every sample once, on the controller's clock
   REQUIRE_FALSE(rig.read_samples(steady_now(), block));
   REQUIRE(block.size() == 1);  // the first block anchors the controller's clock to ours
   RigSample last = block.back();
+  const std::uint32_t first_counter = last.sample_counter;
   std::size_t taken = 0;
   REQUIRE_FALSE(rig.hold(false));
   REQUIRE_FALSE(rig.set_mode(1));
@@ -225,7 +226,8 @@ TEST_CASE("modbus tcp, block reads: every sample once, on the controller's clock
   CAPTURE(longest_interval);
   CHECK(rig.health().lost_samples == gaps);
   CHECK(longest_block > 12);  // more than one page in one read
-  if (gaps == 0) CHECK(taken >= 61);
+  CHECK(taken + gaps == last.sample_counter - first_counter);  // every record since the first: taken, or counted lost
+  CHECK(taken >= 30);
   CHECK(last.command_mm > 0.1);  // the commands still go through: the controller is ramping
   CHECK(last.displacement_mm > 0.05);
 
@@ -549,7 +551,11 @@ TEST_CASE("controller: the host heartbeat watchdog stops the frame with fault 4 
   REQUIRE_FALSE(rig.set_mode(1));
   REQUIRE_FALSE(rig.arm(true));
   REQUIRE_FALSE(rig.command(10.0, 2.0));
-  for (std::uint32_t k = 1; k <= 10; ++k, sleep_ms(40)) REQUIRE_FALSE(rig.write_host_heartbeat(70000 + k));  // wraps to 16 bits
+  for (std::uint32_t k = 1; k <= 10; ++k, sleep_ms(40)) {  // wraps to 16 bits; a starved host may time out a write: again
+    std::error_code ec = rig.write_host_heartbeat(70000 + k);
+    for (int again = 0; again < 3 && ec == RigError::timeout; ++again) ec = rig.write_host_heartbeat(70000 + k);
+    REQUIRE_FALSE(ec);
+  }
   RigSample s = read_now(rig);
   CHECK(s.fault_code == 0);
   CHECK((s.status_word & protocols::status::enabled) != 0);

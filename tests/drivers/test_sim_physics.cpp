@@ -10,6 +10,7 @@
 #include "hystlab/protocols/signals.hpp"
 #include "load_frame_sim.hpp"
 #include "pacer.hpp"
+#include "world_clock.hpp"
 #include "shaker_sim.hpp"
 
 using namespace hystlab;
@@ -330,4 +331,16 @@ TEST_CASE("pacer: a time-scaled world waits for its host, and one late request d
   CHECK(p.window_s() == doctest::Approx(0.15));
   for (int k = 1; k <= 8; ++k) (void)p.on_request(1.01 + 0.1 * k, 2.0);
   CHECK(p.window_s() == doctest::Approx(sim::Pacer::kMaxWindow_s));
+}
+
+TEST_CASE("world clock: steps follow the wall clock; after a freeze at most 20 ms is caught up, the rest counted lost") {
+  sim::WorldClock w(10.0, 0.001, false);  // time scale 10, 1 kHz: 10 steps a wall millisecond
+  long steps = 0;
+  for (int k = 1; k <= 15; ++k) steps += w.steps_due(0.001 * k);
+  CHECK(steps == 150);
+  CHECK(w.lost_s() == 0);
+  steps = w.steps_due(0.515);  // the machine froze for half a second
+  CHECK(steps == 200);          // 20 ms of it, at time scale 10
+  CHECK(w.lost_s() == doctest::Approx(0.48));
+  CHECK(w.steps_due(0.516) == 10);  // and on as before
 }

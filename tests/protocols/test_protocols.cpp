@@ -195,6 +195,15 @@ TEST_CASE("sample windows: the shipped map's window, and records that encode and
   CHECK(decode_record(m, w, words, out) == ProtocolError::out_of_range);
 }
 
+TEST_CASE("the controller's sample clock: sample_period_s, or the window's period; a bad one is named") {
+  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json")).sample_period_s() == doctest::Approx(0.001));
+  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json")).sample_period_s() == doctest::Approx(0.001));
+  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json")).sample_period_s() == 0.0);  // it does not say
+  refused_after([](auto& j) { j["sample_period_s"] = 0; }, "sample_period_s must be a number of seconds > 0 and <= 1");
+  refused_after([](auto& j) { j["sample_period_s"] = "1 ms"; }, "sample_period_s must be a number of seconds > 0 and <= 1");
+  refused_after([](auto& j) { j["sample_period_s"] = 0.002; }, "sample_period_s differs from sample_window.period_s");
+}
+
 TEST_CASE("sample windows: a bad window is rejected with the field named") {
   refused_after([](auto& j) { j["sample_window"] = 3; }, "sample_window must be an object");
   refused_after([](auto& j) { j["sample_window"]["depth"] = 3; }, "sample_window has an unknown field 'depth'");

@@ -18,6 +18,10 @@ class OnlineFot {
   OnlineFot(models::Grid grid, double dead_band_mm, NodeSink sink);
   // collect = false outside the identification input (training cycles, preambles).
   void feed(double t, double x, double f, bool collect);
+  // The expected time between samples: with it, a node inside a hole in the data (samples over
+  // half a cell and 3 spacings apart) is left missing instead of interpolated. 0 (the default,
+  // offline data): every crossing is interpolated.
+  void set_spacing(double seconds) noexcept { spacing_s_ = seconds; }
   // Ends a descent still open at the end of the input (its bottom gives the δmin node).
   void finish();
   [[nodiscard]] int descents_completed() const noexcept { return descents_; }
@@ -36,7 +40,7 @@ class OnlineFot {
   NodeSink sink_;
   int dir_ = 0;  // +1 rising, -1 falling, 0 unknown
   double ext_x_ = 0, ext_f_ = 0, ext_t_ = 0;
-  double prev_x_ = 0, prev_f_ = 0;
+  double prev_x_ = 0, prev_f_ = 0, prev_t_ = 0, spacing_s_ = 0;
   bool have_prev_ = false;
   int row_ = -1, next_j_ = -1;  // open descent: row i and the next δ_j to pass
   double f_alpha_ = 0;
