@@ -26,11 +26,14 @@ std::string slurp(const std::string& p) {
   return s.str();
 }
 
-ModbusRigConfig tcp_config(int port, const std::string& map_text = protocols::kDefaultLoadFrameMap) {
+// The answer timeout: 1.5 s, beyond the whole-machine freezes of the CI VMs (0.05-0.66 s, both
+// vCPUs at once: a transaction caught in one timed out at 50 ms though nothing was wrong). The
+// tests of timeouts themselves give a shorter one, and a fault longer still.
+ModbusRigConfig tcp_config(int port, const std::string& map_text = protocols::kDefaultLoadFrameMap, double timeout_s = 1.5) {
   ModbusRigConfig c;
   c.port = port;
   c.map = protocols::RegisterMap::from_json(map_text);
-  c.response_timeout_s = 0.05;
+  c.response_timeout_s = timeout_s;
   c.stale_after_s = 0.2;
   c.reconnect_min_s = 0.02;
   return c;
@@ -62,9 +65,9 @@ RigSample move_to(Rig& rig, double mm) {
 // The simulator and a driver connected to it, one good read done.
 struct ConnectedRig {
   SimProcess sim{std::vector<std::string>{"--port", "0", "--noise", "0"}};
-  ModbusRig rig{tcp_config(sim.modbus_port)};
+  ModbusRig rig;
   RigSample s;
-  ConnectedRig() {
+  explicit ConnectedRig(double timeout_s = 1.5) : rig(tcp_config(sim.modbus_port, protocols::kDefaultLoadFrameMap, timeout_s)) {
     REQUIRE_FALSE(rig.connect(steady_now()));
     REQUIRE_FALSE(rig.read_sample(steady_now(), s));
   }
@@ -102,19 +105,20 @@ TEST_CASE("modbus tcp: samples, commands and the specimen's force through the de
 }
 
 TEST_CASE("modbus tcp: every injected fault is its typed error, and the driver recovers") {
-  ConnectedRig connected;
+  ConnectedRig connected(0.2);
   auto& [sim, rig, s] = connected;
 
   struct Case {
     const char* fault;
     RigError expected;
   };
-  for (const Case c : {Case{"fault delay 200", RigError::timeout}, Case{"fault exception 4", RigError::exception_response},
+  for (const Case c : {Case{"fault delay 1000", RigError::timeout}, Case{"fault exception 4", RigError::exception_response},
                        Case{"fault overload", RigError::out_of_range}, Case{"fault drop", RigError::connection_lost}}) {
     CAPTURE(c.fault);
     REQUIRE(sim.control(c.fault).rfind("ok", 0) == 0);
     sleep_ms(10);
-    const std::error_code ec = rig.read_sample(steady_now(), s);
+    std::error_code ec;  // a machine frozen past the delay finds the answer there: asked again
+    for (int k = 0; k < 5 && !ec; ++k) ec = rig.read_sample(steady_now(), s);
     CHECK(ec == c.expected);
     REQUIRE(sim.control("clear").rfind("ok", 0) == 0);
     CHECK_FALSE(read_until_ok(rig, s));
@@ -141,22 +145,23 @@ TEST_CASE("modbus tcp: every injected fault is its typed error, and the driver r
 TEST_CASE("modbus tcp: a late answer to a timed-out read is never taken for the next one's") {
   // libmodbus flushes only what has arrived; an answer arriving after that flush would answer
   // the next request, and the one after, for ever (seen in CI: 2000 reads refused in a row).
-  ConnectedRig connected;
+  ConnectedRig connected(0.2);
   auto& [sim, rig, s] = connected;
-  REQUIRE(sim.control("fault delay 80").rfind("ok", 0) == 0);
+  REQUIRE(sim.control("fault delay 400").rfind("ok", 0) == 0);
   sleep_ms(10);
-  // A host starved past the 80 ms finds the answer there when it looks: then it asks again.
+  // A machine frozen past the 400 ms finds the answer there when it looks: then it asks again.
   bool timed_out = false;
   for (int k = 0; k < 10 && !timed_out; ++k) timed_out = rig.read_sample(steady_now(), s) == RigError::timeout;
   CHECK(timed_out);
   REQUIRE(sim.control("clear").rfind("ok", 0) == 0);
-  sleep_ms(100);  // the late answer is now waiting in the socket
+  sleep_ms(300);  // the late answer is now waiting in the socket
   int refused = 0;
   for (int k = 0; k < 50; ++k) {  // a 1 kHz poll, as in a campaign
     if (rig.read_sample(steady_now(), s)) ++refused;
     sleep_ms(1);
   }
-  CHECK(refused == 0);
+  CHECK(refused <= 2);  // a freeze may time one out; the bug was every read refused, for ever
+  CHECK(rig.health().errors_of(RigError::protocol_error) == 0);
   CHECK(rig.read_sample(steady_now(), s) == std::error_code{});
   CHECK(rig.health().reconnects >= 1);  // a fresh connection cannot carry the old answer
 }
@@ -389,7 +394,7 @@ TEST_CASE("shaker over modbus: base excitation moves the mass") {
 TEST_CASE("rigs from configuration: a simulated rig is only a different address") {
   SimProcess sim({"--port", "0", "--noise", "0"});
   const nlohmann::json cfg = {{"name", "frame A"}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"},
-                              {"port", sim.modbus_port}, {"map", "default"}, {"response_timeout_ms", 50}};
+                              {"port", sim.modbus_port}, {"map", "default"}, {"response_timeout_ms", 1500}};
   const auto rig = make_rig(cfg, "rigs[0]");
   REQUIRE_FALSE(rig->connect(steady_now()));
   RigSample s;
