@@ -300,7 +300,9 @@ TEST_CASE("can over a socketpair: the real driver code, a silent rig, recovery")
   REQUIRE(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv) == 0);
   SimProcess sim({"--transport", "can", "--can-fd", "3", "--can-rate", "500", "--time-scale", "10", "--noise", "0"}, sv[1]);
   close(sv[1]);
-  CanRig rig(std::make_unique<FdCanChannel>(sv[0], "socketpair"), CanRigConfig{1, 100, 20, 0.5, "sim over can"});
+  // A status cycle is awaited for 1.5 s: beyond the CI VMs' whole-machine freezes (up to 0.66 s),
+  // which held back the simulator's frames past a 100 ms wait.
+  CanRig rig(std::make_unique<FdCanChannel>(sv[0], "socketpair"), CanRigConfig{1, 1500, 20, 2.0, "sim over can"});
   REQUIRE_FALSE(rig.connect(steady_now()));
   CHECK(rig.set_mode(4) == RigError::out_of_range);  // the frame's mode field is 0..3
   REQUIRE_FALSE(rig.set_mode(1));
