@@ -1,3 +1,4 @@
+#include <filesystem>
 #include "cli_support.hpp"
 
 #include <cerrno>
@@ -242,6 +243,12 @@ LoadedModel load_model(const Options& opt) {
   }
   m.model = std::make_unique<models::SimplifiedSmaModel>(p);
   return m;
+}
+
+void require_database(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw CliError("--db: no database at '" + path + "' (hystlabd creates it; give the path it uses)");
 }
 
 }  // namespace hystlab::cli

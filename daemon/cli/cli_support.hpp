@@ -34,6 +34,9 @@ class Options {
 };
 
 [[nodiscard]] std::string read_file(const std::string& path);
+// --db must name hystlabd's database: a CliError when no such file (a mistyped path would
+// otherwise create an empty database).
+void require_database(const std::string& path);
 void write_file(const std::string& path, const std::string& text);
 // Writes to the file, or to stdout when path is empty or "-".
 void write_output(const std::string& path, const std::string& text);

@@ -1,29 +1,39 @@
-// hystlab campaign / tables / runs: the daemon's records, read and commanded through the db file
-// (until the HTTP API lands). Commands are queued for hystlabd, which acts on them within 0.1 s.
+// hystlab campaign / tables / runs. Submitting and commanding a campaign go to the running
+// hystlabd over its HTTP API (daemon_client.hpp); its records are read from the database file.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
-#include "hystlab/daemon/plan.hpp"
+#include "daemon_client.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/table_export.hpp"
 
 namespace hystlab::cli {
 namespace {
-const char* kCampaignHelp = R"(usage: hystlab campaign submit --plan P.json [--rig NAME] [--db hystlab.db]
+const char* kCampaignHelp = R"(usage: hystlab campaign submit --plan P.json [--rig NAME] [--daemon URL] [--token T]
+       hystlab campaign preview --plan P.json [--rig NAME] [--daemon URL] [--token T]
+       hystlab campaign pause|resume|abort|estop ID [--daemon URL] [--token T]
        hystlab campaign list [--db hystlab.db]
-       hystlab campaign show ID [--db hystlab.db]
-       hystlab campaign pause|resume|abort|estop ID [--db hystlab.db]
+       hystlab campaign show ID [--json] [--db hystlab.db]
 
-Campaigns run on hystlabd's rigs one after another. submit validates the plan (an error names the
-field) and queues it; pause holds the rig; resume continues (after a long pause, or for an
-interrupted campaign, with a wipe-out preamble and the rows not yet measured); abort drives to
-the safe position; estop triggers the rig's e-stop at once (no motion). The rig defaults to the only one the daemon has. A waveform plan may give "points_csv": a CSV
-file (beside the plan) whose displacement_mm column is the input, e.g. a random validation path.
+Campaigns run on hystlabd's rigs one after another. submit, preview and the commands go to the
+running daemon over its HTTP API: --daemon (or $HYSTLAB_DAEMON, default http://127.0.0.1:8080),
+with the daemon's token when it has one ($HYSTLAB_TOKEN, or --token, which others see in ps). submit validates the plan
+(an error names the field) and queues it; preview says what it would do (duration, samples, peak
+speed and force) without queueing it; pause holds the rig; resume continues (after a long pause,
+or for an interrupted or held campaign, with a wipe-out preamble and the rows not yet measured);
+abort drives to the safe position; estop triggers the rig's e-stop at once (no motion). The rig
+defaults to the only one the daemon has. A waveform plan may give "points_csv": a CSV file
+(beside the plan) whose displacement_mm column is the input, e.g. a random validation path.
+list and show read the daemon's database file, with or without a daemon running.
 )";
 const char* kTablesHelp = R"(usage: hystlab tables list [--db hystlab.db]
-       hystlab tables export ID [-o T.json] [--db hystlab.db]
+       hystlab tables export ID [--format json|csv|m|h] [-o FILE] [--db hystlab.db]
+
+--db must name hystlabd's database (it is never created here).
 )";
 const char* kRunsHelp = R"(usage: hystlab runs export RUN_ID [-o X.csv] [--db hystlab.db]
 
@@ -43,18 +53,97 @@ std::int64_t id_arg(const Args& args, std::size_t k, const char* what) {
 
 Args rest(const Args& args, std::size_t from) { return Args(args.begin() + static_cast<std::ptrdiff_t>(std::min(from, args.size())), args.end()); }
 
-std::int64_t rig_for(db::Store& store, const Options& opt) {
-  if (opt.has("rig")) return store.upsert_rig(opt.get("rig"), "{}", now_iso8601());
-  db::Statement st(store.database(), "SELECT id, name FROM rigs ORDER BY id");
-  std::vector<std::pair<std::int64_t, std::string>> rigs;
-  while (st.step()) rigs.emplace_back(st.column_int(0), st.column_text(1));
-  if (rigs.empty()) return store.upsert_rig("simulated load frame", "{}", now_iso8601());  // hystlabd's default
-  if (rigs.size() > 1) {
-    std::string names;
-    for (const auto& r : rigs) names += (names.empty() ? "" : ", ") + r.second;
-    throw CliError("several rigs (" + names + "): choose one with --rig");
+// The daemon's database: it must exist (a mistyped --db would otherwise create an empty one).
+db::Store open_store(const Options& opt) {
+  const std::string path = opt.get("db", "hystlab.db");
+  require_database(path);
+  return db::Store(path);
+}
+
+// A waveform's points_csv: a file beside the plan, by name only (no other folder, no device).
+std::filesystem::path points_file(const std::string& plan_path, const nlohmann::json& name) {
+  if (!name.is_string() || name.get<std::string>().empty()) throw CliError(plan_path + ": points_csv must be a file name");
+  const std::filesystem::path file = name.get<std::string>();
+  if (file.has_parent_path() || file.is_absolute() || file == "." || file == "..")
+    throw CliError(plan_path + ": points_csv '" + file.string() + "' must be a file beside the plan (a name, no folder)");
+  const std::filesystem::path full = std::filesystem::path(plan_path).parent_path() / file;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(full, ec)) throw CliError(plan_path + ": points_csv '" + full.string() + "' is not a file");
+  if (std::filesystem::file_size(full, ec) > (64U << 20)) throw CliError(plan_path + ": points_csv '" + full.string() + "' is over 64 MiB");
+  return full;
+}
+
+// The plan file as JSON, a waveform's points_csv read into points_mm (the daemon has no access to
+// the user's files); the daemon checks the plan itself and names the field that is wrong.
+nlohmann::json load_plan(const std::string& path) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(read_file(path));
+  } catch (const nlohmann::json::exception& e) {
+    throw CliError(path + ": not valid JSON (" + e.what() + ")");
   }
-  return rigs.front().first;
+  if (j.is_object() && j.contains("points_csv")) {
+    j["points_mm"] = Csv::load(points_file(path, j["points_csv"]).string()).column("displacement_mm");
+    j.erase("points_csv");
+  }
+  return j;
+}
+
+std::string round_g(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
+// One line of a table's accuracy: "RMS 3.2 N (0.4 % of range), max 12 N", or "".
+std::string accuracy_line(const std::string& json_text) {
+  const auto a = nlohmann::json::parse(json_text, nullptr, false);
+  if (a.is_discarded() || !a.is_object() || !a.contains("overall")) return "";
+  const auto& o = a["overall"];
+  return "RMS " + round_g(o.value("rms_N", 0.0)) + " N (" + round_g(100 * o.value("rms_norm", 0.0)) + " % of range), max " +
+         round_g(o.value("max_N", 0.0)) + " N";
+}
+
+int print_preview(const nlohmann::json& p) {
+  std::cout << p.value("kind", "") << " on '" << p.value("rig", "") << "': " << round_g(p.value("duration_s", 0.0)) << " s, "
+            << p.value("samples", std::int64_t{0}) << " samples at " << round_g(p.value("sample_rate_hz", 0.0)) << " Hz";
+  if (p.value("nodes", 0) > 0) std::cout << ", " << p.value("nodes", 0) << " FOT nodes";
+  std::cout << "\n  peak speed " << round_g(p.value("peak_speed_mm_s", 0.0)) << " mm/s";
+  if (p.contains("peak_force_N") && p["peak_force_N"].is_number())
+    std::cout << ", peak force " << round_g(p["peak_force_N"].get<double>()) << " N (limit " << round_g(p.value("force_limit_N", 0.0)) << " N; from "
+              << p.value("force_source", "") << ")";
+  if (p.contains("peak_accel_m_s2") && p["peak_accel_m_s2"].is_number()) std::cout << ", peak acceleration " << round_g(p["peak_accel_m_s2"].get<double>()) << " m/s^2";
+  std::cout << "\n";
+  return 0;
+}
+
+int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
+  const auto runs = store.runs(row.id);
+  const auto tables = store.tables(row.id);
+  if (as_json) {
+    nlohmann::json j{{"id", row.id}, {"kind", db::to_string(row.kind)}, {"state", db::to_string(row.state)}, {"plan", nlohmann::json::parse(row.plan, nullptr, false)},
+                     {"runs", nlohmann::json::array()}, {"tables", nlohmann::json::array()}, {"events", nlohmann::json::array()}};
+    for (const auto& r : runs) j["runs"].push_back({{"id", r.id}, {"state", r.state}, {"samples", r.samples}, {"nodes", r.nodes}});
+    for (const auto& t : tables) j["tables"].push_back({{"id", t.id}, {"method", t.method}, {"n", t.n}, {"accuracy", nlohmann::json::parse(t.accuracy_json, nullptr, false)}});
+    for (const auto& e : store.events(row.id)) j["events"].push_back({{"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", e.detail}});
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "campaign " << row.id << ": " << db::to_string(row.kind) << " on " << store.rig_name(row.rig_id) << ", " << db::to_string(row.state) << " (updated " << row.updated_at << ")\n";
+  for (const auto& r : runs) std::cout << "  run " << r.id << ": " << r.state << ", " << r.samples << " samples, " << r.nodes << " FOT nodes\n";
+  for (const auto& t : tables) {
+    const std::string acc = accuracy_line(t.accuracy_json);
+    std::cout << "  table " << t.id << ": " << t.method << ", n = " << t.n << ", " << round_g(t.range_lo) << "–" << round_g(t.range_hi) << " mm"
+              << (acc.empty() ? "" : ", " + acc) << "\n";
+  }
+  std::cout << "  events (newest last):\n";
+  for (const auto& e : store.events(row.id)) {
+    if (e.kind == "gap") continue;  // one per hole: the "gaps" summary says it in one line
+    std::cout << "    " << e.at.substr(0, 19) << "  " << e.kind << (e.to_state.empty() ? "" : " -> " + e.to_state);
+    if (!e.detail.empty() && e.detail.size() < 160) std::cout << ": " << e.detail;
+    std::cout << "\n";
+  }
+  return 0;
 }
 }  // namespace
 
@@ -64,59 +153,41 @@ int run_campaign_cmd(const Args& args) {
     return args.empty() ? 2 : 0;
   }
   const std::string verb = args[0];
-  if (verb == "submit") {
-    const Options opt(rest(args, 1), {"plan", "rig", "db"}, {});
-    const std::string path = opt.require("plan");
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(read_file(path));
-    } catch (const nlohmann::json::exception& e) {
-      throw CliError(path + ": not valid JSON (" + e.what() + ")");
-    }
-    if (j.is_object() && j.contains("points_csv")) {  // a waveform from a CSV: its points go into the stored plan
-      if (!j["points_csv"].is_string()) throw CliError(path + ": points_csv must be a file name");
-      const std::filesystem::path csv = std::filesystem::path(path).parent_path() / j["points_csv"].get<std::string>();
-      j["points_mm"] = Csv::load(csv.string()).column("displacement_mm");
-      j.erase("points_csv");
-    }
-    const daemon::Plan plan = daemon::parse_plan(j);
-    db::Store store(opt.get("db", "hystlab.db"));
-    const auto id = store.create_campaign(rig_for(store, opt), plan.kind, j.dump(), now_iso8601());
-    std::cout << "campaign " << id << " queued (" << plan.kind << ")\n";
+  if (verb == "submit" || verb == "preview") {
+    refuse_db_option(args, "campaign " + verb);
+    const Options opt(rest(args, 1), {"plan", "rig", "daemon", "token"}, {});
+    nlohmann::json body{{"plan", load_plan(opt.require("plan"))}};
+    if (opt.has("rig")) body["rig"] = opt.get("rig");
+    const DaemonAddress daemon = daemon_address(opt);
+    if (verb == "preview") return print_preview(post_to_daemon(daemon, "/api/plans/preview", body.dump()));
+    const auto c = post_to_daemon(daemon, "/api/campaigns", body.dump());
+    const std::string state = c.value("state", "");  // the daemon may have started it before it answered
+    std::cout << "campaign " << c.value("id", std::int64_t{0}) << " queued (" << c.value("kind", "") << " on '" << c.value("rig", "") << "'"
+              << (state == "queued" ? "" : "; now " + state) << ")\n";
     return 0;
   }
   if (verb == "list") {
     const Options opt(rest(args, 1), {"db"}, {});
-    db::Store store(opt.get("db", "hystlab.db"));
+    db::Store store = open_store(opt);
     std::printf("%6s  %-9s %-12s %s\n", "id", "kind", "state", "updated");
-    for (const auto& c : store.campaigns()) std::printf("%6lld  %-9s %-12s %s\n", static_cast<long long>(c.id), c.kind.c_str(), c.state.c_str(), c.updated_at.c_str());
+    for (const auto& c : store.campaigns()) std::printf("%6lld  %-9s %-12s %s\n", static_cast<long long>(c.id), db::to_string(c.kind), db::to_string(c.state), c.updated_at.c_str());
     return 0;
   }
+  const bool command = verb == "pause" || verb == "resume" || verb == "abort" || verb == "estop";
+  if (!command && verb != "show") throw CliError("unknown campaign verb '" + verb + "' (see --help)");
   const std::int64_t id = id_arg(args, 1, "campaign ID");
-  const Options opt(rest(args, 2), {"db"}, {});
-  db::Store store(opt.get("db", "hystlab.db"));
+  if (command) {
+    refuse_db_option(args, "campaign " + verb);
+    const Options opt(rest(args, 2), {"daemon", "token"}, {});
+    const auto a = post_to_daemon(daemon_address(opt), "/api/campaigns/" + std::to_string(id) + "/" + verb, "");
+    std::cout << verb << " sent to campaign " << id << " (" << a.value("state", "") << ")\n";
+    return 0;
+  }
+  const Options opt(rest(args, 2), {"db"}, {"json"});
+  db::Store store = open_store(opt);
   const auto row = store.campaign(id);
   if (!row) throw CliError("no campaign " + std::to_string(id));
-  if (verb == "show") {
-    std::cout << "campaign " << row->id << ": " << row->kind << ", " << row->state << "\nplan: " << row->plan << "\nevents:\n";
-    for (const auto& e : store.events(id))
-      std::cout << "  " << e.at << "  " << e.kind << "  " << (e.from_state.empty() ? "" : e.from_state + " -> ") << e.to_state
-                << (e.detail.empty() ? "" : "  " + e.detail) << "\n";
-    db::Statement runs(store.database(), "SELECT id, state, (SELECT coalesce(sum(n),0) FROM sample_blocks WHERE run_id = runs.id), "
-                                         "(SELECT count(*) FROM fot_nodes WHERE run_id = runs.id) FROM runs WHERE campaign_id = ?");
-    runs.bind(1, id);
-    while (runs.step())
-      std::cout << "run " << runs.column_int(0) << ": " << runs.column_text(1) << ", " << runs.column_int(2) << " samples, "
-                << runs.column_int(3) << " FOT nodes\n";
-    db::Statement tables(store.database(), "SELECT id, method, n FROM tables WHERE campaign_id = ?");
-    tables.bind(1, id);
-    while (tables.step()) std::cout << "table " << tables.column_int(0) << ": " << tables.column_text(1) << ", n = " << tables.column_int(2) << "\n";
-    return 0;
-  }
-  if (verb != "pause" && verb != "resume" && verb != "abort" && verb != "estop") throw CliError("unknown campaign verb '" + verb + "' (see --help)");
-  store.add_command(id, verb, now_iso8601());
-  std::cout << verb << " sent to campaign " << id << " (" << row->state << ")\n";
-  return 0;
+  return show_campaign(store, *row, opt.has("json"));
 }
 
 int run_tables_cmd(const Args& args) {
@@ -126,22 +197,32 @@ int run_tables_cmd(const Args& args) {
   }
   if (args[0] == "list") {
     const Options opt(rest(args, 1), {"db"}, {});
-    db::Store store(opt.get("db", "hystlab.db"));
-    db::Statement st(store.database(), "SELECT id, coalesce(campaign_id, 0), method, n, range_lo, range_hi, created_at FROM tables ORDER BY id");
-    std::printf("%6s %9s  %-8s %4s  %-12s %s\n", "id", "campaign", "method", "n", "range (mm)", "created");
-    while (st.step())
-      std::printf("%6lld %9lld  %-8s %4lld  %5.3g..%-5.3g %s\n", static_cast<long long>(st.column_int(0)), static_cast<long long>(st.column_int(1)),
-                  st.column_text(2).c_str(), static_cast<long long>(st.column_int(3)), st.column_double(4), st.column_double(5), st.column_text(6).c_str());
+    db::Store store = open_store(opt);
+    std::printf("%6s %9s  %-8s %4s  %-12s  %-44s %s\n", "id", "campaign", "method", "n", "range (mm)", "accuracy", "created");
+    for (const auto& t : store.tables()) {
+      const std::string range = round_g(t.range_lo) + ".." + round_g(t.range_hi), acc = accuracy_line(t.accuracy_json);
+      std::printf("%6lld %9s  %-8s %4lld  %-12s  %-44s %s\n", static_cast<long long>(t.id), t.campaign ? std::to_string(*t.campaign).c_str() : "-",
+                  t.method.c_str(), static_cast<long long>(t.n), range.c_str(), acc.empty() ? "-" : acc.c_str(), t.created_at.c_str());
+    }
     return 0;
   }
   if (args[0] != "export") throw CliError("unknown tables verb '" + args[0] + "' (see --help)");
   const std::int64_t id = id_arg(args, 1, "table ID");
-  const Options opt(rest(args, 2), {"db", "output"}, {});
-  db::Store store(opt.get("db", "hystlab.db"));
-  db::Statement st(store.database(), "SELECT document FROM tables WHERE id = ?");
-  st.bind(1, id);
-  if (!st.step()) throw CliError("no table " + std::to_string(id));
-  write_output(opt.get("output"), nlohmann::json::parse(st.column_text(0)).dump(2) + "\n");
+  const Options opt(rest(args, 2), {"db", "output", "format"}, {});
+  const std::string format = opt.get("format", "json");
+  if (format != "json" && format != "csv" && format != "m" && format != "h") throw CliError("--format: '" + format + "' is not json, csv, m or h");
+  db::Store store = open_store(opt);
+  const auto doc = store.table_document(id);
+  if (!doc) throw CliError("no table " + std::to_string(id));
+  if (format == "json") {
+    write_output(opt.get("output"), nlohmann::json::parse(*doc).dump(2) + "\n");
+    return 0;
+  }
+  const models::TableDocument t = models::table_from_json(*doc);
+  const std::string name = "hystlab_table_" + std::to_string(id);
+  write_output(opt.get("output"), format == "csv" ? models::table_to_csv(t.table, t.provenance)
+                                  : format == "m" ? models::table_to_matlab(t.table, t.provenance)
+                                                  : models::table_to_c_header(t.table, t.provenance, name));
   return 0;
 }
 
@@ -155,7 +236,7 @@ int run_runs_cmd(const Args& args) {
   }
   const std::int64_t id = id_arg(args, 1, "run ID");
   const Options opt(rest(args, 2), {"db", "output"}, {});
-  db::Store store(opt.get("db", "hystlab.db"));
+  db::Store store = open_store(opt);
   if (store.max_seq(id) < 0) throw CliError("no samples for run " + std::to_string(id));
   std::string out = "time_s,command_mm,displacement_mm,force_N,status\n";
   store.for_each_sample(id, 0, std::int64_t{1} << 50, [&](const db::SampleRow& r) {

@@ -1,20 +1,22 @@
-// hystlab rig reset|estop NAME: the operator's commands for a rig itself, queued for hystlabd
-// through the db file (as campaign commands are); the daemon acts on them within 0.1 s.
+// hystlab rig reset|estop NAME: the operator's commands for a rig itself, sent to the running
+// hystlabd over its HTTP API (daemon_client.hpp), as the page's e-stop button sends them.
 #include <iostream>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
-#include "hystlab/db/store.hpp"
+#include "daemon_client.hpp"
 
 namespace hystlab::cli {
 namespace {
-const char* kRigHelp = R"(usage: hystlab rig reset NAME [--db hystlab.db]
-       hystlab rig estop NAME [--db hystlab.db]
+const char* kRigHelp = R"(usage: hystlab rig reset NAME [--daemon URL] [--token T]
+       hystlab rig estop NAME [--daemon URL] [--token T]
 
 estop triggers the rig's e-stop at once, from any state; it stays latched in hystlabd as in the
 controller. reset releases the rig's e-stop and fault signals; the latch clears when the rig then
 reports ready without e-stop or fault (GET /api/rigs/NAME shows the state, or why it refused).
-Nothing arms while a rig is latched.
+Nothing arms while a rig is latched. Both go to the running daemon: --daemon (or
+$HYSTLAB_DAEMON, default http://127.0.0.1:8080), with its token when it has one ($HYSTLAB_TOKEN,
+or --token, which others see in ps).
 )";
 }  // namespace
 
@@ -25,17 +27,10 @@ int run_rig_cmd(const Args& args) {
   }
   const std::string verb = args[0], name = args[1];
   if (verb != "reset" && verb != "estop") throw CliError("unknown rig verb '" + verb + "' (reset or estop)");
-  const Options opt(Args(args.begin() + 2, args.end()), {"db"}, {});
-  db::Store store(opt.get("db", "hystlab.db"));
-  std::string names;
-  bool found = false;
-  for (const auto& n : store.rig_names()) {
-    found = found || n == name;
-    names += (names.empty() ? "" : ", ") + n;
-  }
-  if (!found) throw CliError("no rig named '" + name + "'" + (names.empty() ? "" : " (the daemon's rigs: " + names + ")"));
-  store.add_rig_command(name, verb, now_iso8601());
-  std::cout << verb << " sent to rig '" << name << "'\n";
+  refuse_db_option(args, "rig " + verb);
+  const Options opt(Args(args.begin() + 2, args.end()), {"daemon", "token"}, {});
+  const auto a = post_to_daemon(daemon_address(opt), "/api/rigs/" + url_segment(name) + "/" + verb, "");
+  std::cout << verb << " sent to rig '" << a.value("rig", name) << "' (" << a.value("state", "") << ")\n";
   return 0;
 }
 

@@ -30,8 +30,9 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
   check      wiping-out and congruency of a record, as numbers
   compare    accuracy of a table or model against a record
   demo       the paper's §3.3 study on Table 1, with a report and plots
-  campaign   submit, list, show, pause, resume, abort campaigns of hystlabd (on its db file)
-  rig        reset or estop one of hystlabd's rigs (on its db file)
+  campaign   submit, preview, pause, resume, abort, estop campaigns of the running hystlabd
+             (over its HTTP API); list and show them from its db file
+  rig        estop or reset one of the running hystlabd's rigs (over its HTTP API)
   tables     list and export the tables hystlabd identified
   runs       export a run's samples as CSV
   simulate   the base-excited isolator (sdof): time histories, transmissibility sweeps
@@ -63,6 +64,10 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
+  }
+  if (std::strcmp(argv[1], "--version") == 0) {
+    std::cout << "hystlab " << HYSTLAB_VERSION << "\n";
+    return 0;
   }
   const Args args(argv + 2, argv + argc);
   try {

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "hystlab/daemon/daemon.hpp"
+#include "hystlab/daemon/daemon_control.hpp"
 #include "hystlab/db/sqlite.hpp"
 #include "hystlab/web/http_api.hpp"
 
@@ -37,6 +38,10 @@ int main(int argc, char** argv) {
     const std::string a = argv[k];
     if (a == "--help" || a == "-h") {
       std::cout << kHelp;
+      return 0;
+    }
+    if (a == "--version") {
+      std::cout << "hystlabd " << HYSTLAB_VERSION << "\n";
       return 0;
     }
     if ((a == "--config" || a == "--db" || a == "--port" || a == "--bind") && k + 1 < argc)
@@ -77,9 +82,10 @@ int main(int argc, char** argv) {
     }
     hystlab::daemon::check_http_security(cfg.http, std::getenv("HYSTLAB_TOKEN"));
     hystlab::daemon::Daemon daemon(cfg);
+    const auto control = hystlab::daemon::make_control(daemon);
     std::unique_ptr<hystlab::web::HttpApi> http;
     try {
-      if (cfg.http.enabled) http = std::make_unique<hystlab::web::HttpApi>(daemon, cfg.http);
+      if (cfg.http.enabled) http = std::make_unique<hystlab::web::HttpApi>(*control, cfg.http);
     } catch (const std::runtime_error& e) {  // the port is taken (another daemon?): refused, nothing ran
       std::cerr << "hystlabd: error: " << e.what() << "\n";
       return 2;

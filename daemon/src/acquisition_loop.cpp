@@ -11,26 +11,28 @@
 namespace hystlab::daemon {
 using nlohmann::json;
 
-const char* to_string(CampaignEnd e) noexcept {
+db::CampaignState state_of(CampaignEnd e) noexcept {
   switch (e) {
-    case CampaignEnd::completed: return "completed";
-    case CampaignEnd::failed: return "failed";
-    case CampaignEnd::aborted: return "aborted";
-    case CampaignEnd::interrupted: return "interrupted";
+    case CampaignEnd::completed: return db::CampaignState::completed;
+    case CampaignEnd::failed: return db::CampaignState::failed;
+    case CampaignEnd::aborted: return db::CampaignState::aborted;
+    case CampaignEnd::interrupted: return db::CampaignState::interrupted;
     case CampaignEnd::none: break;
   }
-  return "running";
+  return db::CampaignState::running;
 }
 
-Loop::Loop(const CampaignJob& j, RunnerContext& c)
-    : job(j), plan(j.plan), ctx(c), shaker(j.plan.kind == "sine"), safety(j.plan.limits),
-      watchdog(c.watchdog_hold_periods, c.watchdog_fail_periods) {}
+const char* to_string(CampaignEnd e) noexcept { return db::to_string(state_of(e)); }
 
-void Loop::state(const std::string& to, const std::string& reason) {
+Loop::Loop(const CampaignJob& j, RunnerContext& c)
+    : job(j), plan(j.plan), ctx(c), shaker(j.plan.kind == db::CampaignKind::sine), safety(j.plan.limits),
+      watchdog(c.watchdog_hold_periods, c.watchdog_fail_periods), health0(c.rig.health()) {}
+
+void Loop::state(db::CampaignState to, const std::string& reason) {
   const std::string now = ctx.now_iso();
   const auto id = job.id;
   ctx.writer.post([id, to, reason, now](db::Store& s) { s.transition(id, to, reason, now); });
-  if (ctx.on_state) ctx.on_state(to);
+  if (ctx.on_state) ctx.on_state(db::to_string(to));
 }
 
 void Loop::event(const std::string& kind, const json& detail) {
@@ -134,7 +136,7 @@ bool arm(Loop& L) {
       v = view_of(s);
     }
     if (ec == drivers::RigError::unsupported)
-      return L.end(CampaignEnd::failed, std::string("a ") + L.plan.kind + " campaign needs a " + (L.shaker ? "shaker" : "load frame") +
+      return L.end(CampaignEnd::failed, std::string("a ") + db::to_string(L.plan.kind) + " campaign needs a " + (L.shaker ? "shaker" : "load frame") +
                                             "; this rig is not one"),
              false;
     if (ec) {
@@ -176,7 +178,7 @@ bool handle_control(Loop& L, Strategy& strategy, double t, double x) {
     strategy.on_pause(L, t);
     L.paused = true;
     L.pause_started = t;
-    L.state("paused", "operator");
+    L.state(db::CampaignState::paused, "operator");
   } else if (*c == Control::resume && L.paused) {
     sup.release(t, "resumed by the operator");
     if (sup.state() != RigState::armed) return true;  // still held (the link): resumed when it answers
@@ -364,6 +366,23 @@ void leave_rig(Loop& L) {
   sup.disarm(t, std::string("campaign ") + to_string(L.result.end) + (L.result.reason.empty() ? "" : ": " + L.result.reason));
 }
 
+// What the run's data can be trusted for, stored with it (the API shows it beside each result):
+// samples, missed deadlines, late wake-ups, samples the controller's buffer lost, I/O errors and
+// reconnects during the run, holes in the time axis, and the rate stored in rig time.
+void record_quality(Loop& L) {
+  const drivers::IoHealthSnapshot h = L.ctx.rig.health();
+  const RunnerResult& r = L.result;
+  const double span = std::isnan(L.last_t) ? 0.0 : L.last_t;
+  L.event("quality", {{"run", r.run_id}, {"samples", r.samples}, {"missed_deadlines", r.missed_deadlines}, {"late_wakeups", r.late_wakeups},
+                      {"dropped", r.dropped}, {"lost_samples", h.lost_samples - L.health0.lost_samples},
+                      {"io_errors", h.total_errors() - L.health0.total_errors()},
+                      {"timeouts", h.errors_of(drivers::RigError::timeout) - L.health0.errors_of(drivers::RigError::timeout)},
+                      {"reconnects", h.reconnects - L.health0.reconnects}, {"gaps", r.gaps}, {"gap_total_s", r.gap_total_s},
+                      {"longest_gap_s", r.longest_gap_s}, {"rig_seconds", span},
+                      {"rate_hz", span > 0 && r.samples > 1 ? static_cast<double>(r.samples - 1) / span : 0.0},
+                      {"requested_rate_hz", L.plan.sample_rate_hz}});
+}
+
 void hand_off(Loop& L, Strategy& strategy) {
   FinishJob fj;
   fj.campaign = L.job.id;
@@ -372,6 +391,7 @@ void hand_off(Loop& L, Strategy& strategy) {
   fj.result = L.result;
   if (L.result.gaps > 0)
     L.event("gaps", {{"count", L.result.gaps}, {"total_ms", L.result.gap_total_s * 1e3}, {"longest_ms", L.result.longest_gap_s * 1e3}});
+  record_quality(L);
   if (L.ctx.finish) {
     L.ctx.finish(std::move(fj));
     return;
@@ -407,10 +427,10 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
     hand_off(L, *strategy);
     return L.result;
   }
-  L.state("arming", "started by the daemon");
+  L.state(db::CampaignState::arming, "started by the daemon");
   const std::uint64_t dropped_before = ctx.writer.stats().dropped_full;
   if (create_run(L) && arm(L)) {
-    L.state("running", "armed");
+    L.state(db::CampaignState::running, "armed");
     run_ticks(L, *strategy);
   }
   leave_rig(L);

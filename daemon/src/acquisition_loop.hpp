@@ -53,6 +53,7 @@ struct Loop {
   static constexpr double kLoopStall_s = 0.02;  // of wall time: beyond any scheduling delay of a host that runs
   CampaignEnd safing_end = CampaignEnd::aborted;
   double last_t = NAN, spacing = 0;  // the time axis: the last sample's time and the expected spacing
+  drivers::IoHealthSnapshot health0;  // the rig's I/O counters when the run began (the run's own are the difference)
 
   [[nodiscard]] double rig_time() { return (ctx.clock.now() - wall0) * ctx.time_scale; }
   // The first end wins: a trip during an abort stays an abort with both reasons said.
@@ -61,7 +62,7 @@ struct Loop {
     result.end = e;
     result.reason = reason;
   }
-  void state(const std::string& to, const std::string& reason);
+  void state(db::CampaignState to, const std::string& reason);
   void event(const std::string& kind, const nlohmann::json& detail);
   // The safe ramp (abort or trip): the loop keeps sampling, storing and publishing until the
   // rig is within the in-position tolerance of the safe position, or holds where it stopped.

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <thread>
 #include <condition_variable>
 #include <future>
 #include <limits>
@@ -56,8 +57,12 @@ struct Daemon::Impl {
   }
 
   // A campaign's command that its rig's thread carries out now; false when it is not running.
-  bool direct(std::int64_t campaign, const std::string& verb) {
-    const Control c = verb == "pause" ? Control::pause : verb == "resume" ? Control::resume : verb == "estop" ? Control::estop : Control::abort;
+  bool direct(std::int64_t campaign, CampaignCommand cmd) {
+    const std::string verb = to_string(cmd);
+    const Control c = cmd == CampaignCommand::pause    ? Control::pause
+                      : cmd == CampaignCommand::resume ? Control::resume
+                      : cmd == CampaignCommand::estop  ? Control::estop
+                                                       : Control::abort;
     for (auto& w : workers)
       if (w->running_campaign == campaign) {
         w->push_control(c);
@@ -69,25 +74,27 @@ struct Daemon::Impl {
   }
 
   // An operator command that found no running campaign: the main loop, with the database.
-  void route(std::int64_t campaign, const std::string& verb) {
-    if (direct(campaign, verb)) return;
+  void route(std::int64_t campaign, CampaignCommand cmd) {
+    if (direct(campaign, cmd)) return;
     const auto row = store.campaign(campaign);
     if (!row) return;
+    using C = CampaignCommand;
     RigWorker* w = worker_of(row->rig_id);
-    if (verb == "estop" && w) w->push_rig_command(RigCommand::estop);
-    if (verb == "resume" && (row->state == "interrupted" || row->state == "paused" || row->state == "held")) {
+    if (cmd == C::estop && w) w->push_rig_command(RigCommand::estop);
+    using S = db::CampaignState;
+    if (cmd == C::resume && (row->state == S::interrupted || row->state == S::paused || row->state == S::held)) {
       dispatched.erase(campaign);
-      store.transition(campaign, "queued",
-                       row->state == "held" ? "released by the operator" : "re-queued to resume: wipe-out preamble, then the rows not yet measured",
+      store.transition(campaign, S::queued,
+                       row->state == S::held ? "released by the operator" : "re-queued to resume: wipe-out preamble, then the rows not yet measured",
                        now_iso());
-    } else if ((verb == "abort" || verb == "estop") && (row->state == "queued" || row->state == "held")) {
+    } else if ((cmd == C::abort || cmd == C::estop) && (row->state == S::queued || row->state == S::held)) {
       if (w && w->has_queued(campaign) && !w->cancel_queued(campaign)) {  // it just started: stop it there
-        (void)direct(campaign, verb);
+        (void)direct(campaign, cmd);
         return;
       }
-      store.transition(campaign, "aborted", "aborted by the operator before it started", now_iso());
+      store.transition(campaign, S::aborted, "aborted by the operator before it started", now_iso());
     } else {
-      store.add_event(campaign, "command", "'" + verb + "' ignored: the campaign is " + row->state, now_iso());
+      store.add_event(campaign, "command", std::string("'") + to_string(cmd) + "' ignored: the campaign is " + db::to_string(row->state), now_iso());
     }
   }
 
@@ -112,11 +119,11 @@ struct Daemon::Impl {
       job.plan = parse_plan(json::parse(row->plan));
       job.plan.limits = check_plan_against(job.plan, w.entry.envelope, w.entry.supervision, w.info.kind == "shaker");
     } catch (const std::exception& e) {  // a plan stored by an older or foreign tool: fail it, say why
-      store.transition(id, "failed", e.what(), now_iso());
+      store.transition(id, db::CampaignState::failed, e.what(), now_iso());
       return std::nullopt;
     }
     for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) job.prior_nodes.push_back({a, b, fa, fab});
-    if (job.plan.kind == "fot" && !job.prior_nodes.empty())  // the fits after a resume use every run
+    if (job.plan.kind == db::CampaignKind::fot && !job.prior_nodes.empty())  // the fits after a resume use every run
       for (const std::int64_t run : store.runs_of_campaign(id))
         store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(),
                               [&job](const db::SampleRow& r) { job.prior_series.add(r.disp, r.force); });
@@ -144,14 +151,11 @@ struct Daemon::Impl {
     for (auto& j : todo) j();
   }
 
-  // One pass over what the database brings: the CLI's commands, queued campaigns. A busy or
-  // failing database is retried with back-off and reported once per episode; it never ends run().
+  // One pass over the queued campaigns (operators' commands arrive through the interface, never
+  // the database). A busy or failing database is retried with back-off and reported once per
+  // episode; it never ends run().
   void poll_database() {
     try {
-      for (const auto& c : store.take_commands(now_iso())) route(c.campaign_id, c.command);
-      for (const auto& c : store.take_rig_commands(now_iso()))
-        for (auto& w : workers)
-          if (w->info.name == c.rig) w->push_rig_command(c.command == "reset" ? RigCommand::reset : RigCommand::estop);
       dispatch();
       if (db_backoff_s > 0) spdlog::info("the database answers again");
       db_backoff_s = 0;
@@ -266,31 +270,47 @@ std::size_t Daemon::rig_index(const std::string& name) const {
   throw std::invalid_argument("rig: no rig named '" + name + "'");
 }
 
-std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) {
+std::pair<Plan, std::size_t> Daemon::check_plan(const std::string& rig_name, const json& plan_json) const {
   Plan plan = parse_plan(plan_json);  // PlanError names the field
-  RigWorker& rig = *impl_->workers.at(rig_index(rig_name));
+  const std::size_t k = rig_index(rig_name);
+  const RigWorker& rig = *impl_->workers.at(k);
   const bool shaker = rig.info.kind == "shaker";
-  if ((plan.kind == "sine") != shaker)
-    throw std::invalid_argument("plan.kind: a " + plan.kind + " plan cannot run on rig '" + rig.info.name + "', a " + rig.info.kind);
+  if ((plan.kind == db::CampaignKind::sine) != shaker)
+    throw std::invalid_argument(std::string("plan.kind: a ") + db::to_string(plan.kind) + " plan cannot run on rig '" + rig.info.name + "', a " + rig.info.kind);
   (void)check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, shaker);  // PlanError names the field
+  return {std::move(plan), k};
+}
+
+std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) {
+  const auto [plan, k] = check_plan(rig_name, plan_json);
+  RigWorker& rig = *impl_->workers.at(k);
   if (const RigSupervision s = rig.snapshot(); s.latched)
     throw std::invalid_argument("rig: '" + rig.info.name + "' is " + s.state + " (" + s.latch_reason + "): reset it first");
   const std::int64_t rig_id = rig.info.id;
-  const std::string kind = plan.kind, text = plan_json.dump();
+  const db::CampaignKind kind = plan.kind;
+  const std::string text = plan_json.dump();
   return impl_->on_main<std::int64_t>([this, rig_id, kind, text] { return impl_->store.create_campaign(rig_id, kind, text, now_iso()); });
 }
 
-void Daemon::command(std::int64_t campaign_id, const std::string& verb) {
-  if (verb != "pause" && verb != "resume" && verb != "abort" && verb != "estop")
-    throw std::invalid_argument("command: '" + verb + "' is not pause, resume, abort or estop");
-  if (impl_->direct(campaign_id, verb)) return;  // no database on the way to a running campaign
-  impl_->on_main<int>([this, campaign_id, verb] {
-    impl_->route(campaign_id, verb);
+void Daemon::command(std::int64_t campaign_id, CampaignCommand cmd) {
+  if (impl_->direct(campaign_id, cmd)) return;  // no database on the way to a running campaign
+  impl_->on_main<int>([this, campaign_id, cmd] {
+    impl_->route(campaign_id, cmd);
     return 0;
   });
 }
 
-void Daemon::rig_command(std::size_t rig, RigCommand c) { impl_->workers.at(rig)->push_rig_command(c); }
+void Daemon::rig_command(std::size_t rig, RigCommand c) {
+  RigWorker& w = *impl_->workers.at(rig);
+  w.push_rig_command(c);
+  if (c != RigCommand::estop) return;
+  // The operator's e-stop is latched before the answer, so a submission right after it is refused
+  // rather than accepted in the moment before the rig's thread takes the command (the review of
+  // stop 21 found a script could do that). The rig's thread takes it within a period, or 0.2 s
+  // between campaigns; 2 s bounds the wait for a rig whose thread is stuck in I/O.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (!w.snapshot().latched && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+}
 
 int run_daemon(const DaemonConfig& config, const std::atomic<bool>& stop) {
   Daemon d(config);

@@ -1,3 +1,4 @@
+#include <cctype>
 #include <cmath>
 
 #include "hystlab/daemon/daemon.hpp"
@@ -21,9 +22,16 @@ HttpConfig parse_http(const json& h, HttpConfig c) {
     if (k == "enabled") {
       if (!v.is_boolean()) fail("http.enabled", "must be true or false");
       c.enabled = v.get<bool>();
-    } else if (k == "bind" || k == "token" || k == "web_root" || k == "vendor_root") {
+    } else if (k == "bind" || k == "token" || k == "read_token" || k == "web_root" || k == "vendor_root") {
       if (!v.is_string() || (k == "bind" && v.get<std::string>().empty())) fail("http." + k, "must be a non-empty string");
-      (k == "bind" ? c.bind : k == "token" ? c.token : k == "web_root" ? c.web_root : c.vendor_root) = v.get<std::string>();
+      (k == "bind" ? c.bind : k == "token" ? c.token : k == "read_token" ? c.read_token : k == "web_root" ? c.web_root : c.vendor_root) =
+          v.get<std::string>();
+    } else if (k == "allowed_hosts") {
+      if (!v.is_array()) fail("http.allowed_hosts", "must be a list of host names (the names this daemon is reached by)");
+      for (const auto& name : v) {
+        if (!name.is_string() || name.get<std::string>().empty()) fail("http.allowed_hosts", "must be a list of non-empty host names");
+        c.allowed_hosts.push_back(name.get<std::string>());
+      }
     } else if (k == "port" || k == "max_stream_clients") {
       if (!v.is_number_integer() || v.get<long long>() < (k == "port" ? 0 : 1) || v.get<long long>() > (k == "port" ? 65535 : 1000))
         fail("http." + k, k == "port" ? "must be a port number (0 to 65535; 0 picks a free one)" : "must be a whole number from 1 to 1000");
@@ -32,7 +40,9 @@ HttpConfig parse_http(const json& h, HttpConfig c) {
       if (!v.is_number_integer() || v.get<long long>() < 1024) fail("http.max_body_bytes", "must be a whole number of at least 1024");
       c.max_body_bytes = v.get<std::size_t>();
     } else {
-      fail("http." + k, "is not a known field (enabled, bind, port, token, web_root, vendor_root, max_stream_clients, max_body_bytes)");
+      fail("http." + k,
+           "is not a known field (enabled, bind, port, token, read_token, allowed_hosts, web_root, vendor_root, max_stream_clients, "
+           "max_body_bytes)");
     }
   }
   return c;
@@ -56,10 +66,21 @@ AcquisitionSettings parse_acquisition(const json& a) {
   }
   return s;
 }
+
+// A token guessable in a few tries is no token: at least 16 characters that are not blank.
+void check_token(const std::string& token, const char* field) {
+  std::size_t solid = 0;
+  for (const char ch : token) solid += std::isspace(static_cast<unsigned char>(ch)) ? 0U : 1U;
+  if (!token.empty() && solid < 16)
+    throw ConfigError(std::string("config: ") + field + " has " + std::to_string(solid) +
+                      " non-blank characters: a token needs at least 16 (e.g. from 'openssl rand -hex 16')");
+}
 }  // namespace
 
 void check_http_security(HttpConfig& http, const char* env_token) {
   if (http.token.empty() && env_token && *env_token) http.token = env_token;
+  check_token(http.token, "http.token (or $HYSTLAB_TOKEN)");
+  check_token(http.read_token, "http.read_token");
   if (http.enabled && !loopback(http.bind) && http.token.size() < 16)
     throw ConfigError("config: http.bind is '" + http.bind +
                       "', not loopback: set a token of at least 16 characters (http.token or $HYSTLAB_TOKEN) that every "

@@ -38,7 +38,7 @@ void known(const json& j, const std::string& where, std::initializer_list<const 
     if (!ok) bad(where + "." + k, "is not a known field (" + list + ")");
   }
 }
-[[noreturn]] void refuse(const std::string& field, const std::string& why) { throw PlanError("plan: " + field + " " + why); }
+[[noreturn]] void refuse(const std::string& field, const std::string& why) { throw PlanError(field, "plan: " + field + " " + why); }
 }  // namespace
 
 RigEnvelope parse_envelope(const json& j, const std::string& where, bool shaker) {
@@ -117,7 +117,7 @@ void check_shaker(const Plan& p, const RigEnvelope& e) {
 
 void check_frame(const Plan& p, const RigEnvelope& e) {
   const std::string stroke = "[" + num(e.stroke_min_mm) + ", " + num(e.stroke_max_mm) + "] mm";
-  if (p.kind == "fot" && (p.lo_mm < e.stroke_min_mm || p.hi_mm > e.stroke_max_mm))
+  if (p.kind == db::CampaignKind::fot && (p.lo_mm < e.stroke_min_mm || p.hi_mm > e.stroke_max_mm))
     refuse("range_mm", "[" + num(p.lo_mm) + ", " + num(p.hi_mm) + "] exceeds the rig's stroke " + stroke);
   for (std::size_t k = 0; k < p.points_mm.size(); ++k)
     if (p.points_mm[k] < e.stroke_min_mm || p.points_mm[k] > e.stroke_max_mm)

@@ -42,7 +42,7 @@ void Finisher::run() {
     } catch (const std::exception& e) {  // a fit that throws fails the campaign; the thread goes on
       spdlog::error("campaign {}: finishing failed: {}", id, e.what());
       const std::string now = now_iso(), reason = std::string("finishing failed: ") + e.what();
-      writer_.post([id, reason, now](db::Store& s) { s.transition(id, "failed", reason, now); });
+      writer_.post([id, reason, now](db::Store& s) { s.transition(id, db::CampaignState::failed, reason, now); });
     }
   }
 }

@@ -1,18 +1,26 @@
 #include "hystlab/daemon/plan.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 namespace hystlab::daemon {
+
+std::string plan_number(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
 namespace {
 using nlohmann::json;
 
-[[noreturn]] void fail(const std::string& field, const std::string& why) { throw PlanError("plan: " + field + " " + why); }
+[[noreturn]] void fail(const std::string& field, const std::string& why) { throw PlanError(field, "plan: " + field + " " + why); }
 
 double number(const json& j, const char* f, double def, double lo, double hi) {
   if (!j.contains(f)) return def;
   if (!j[f].is_number() || !std::isfinite(j[f].get<double>())) fail(f, "must be a number");
   const double v = j[f].get<double>();
-  if (v < lo || v > hi) fail(f, "must be between " + std::to_string(lo) + " and " + std::to_string(hi));
+  if (v < lo || v > hi) fail(f, "must be between " + plan_number(lo) + " and " + plan_number(hi));
   return v;
 }
 
@@ -77,20 +85,23 @@ Plan parse_plan(const json& j) {
   if (!j.is_object()) fail("", "must be a JSON object");
   Plan p;
   p.source = j;
-  if (!j.contains("kind") || !j["kind"].is_string()) fail("kind", "is required: \"fot\" or \"waveform\"");
-  p.kind = j["kind"].get<std::string>();
+  if (!j.contains("kind") || !j["kind"].is_string()) fail("kind", "is required: \"fot\", \"waveform\" or \"sine\"");
+  const std::string kind = j["kind"].get<std::string>();
+  const auto parsed_kind = db::campaign_kind_from(kind);
+  if (!parsed_kind) fail("kind", "must be \"fot\", \"waveform\" or \"sine\" (got \"" + kind + "\")");
+  p.kind = *parsed_kind;
   static const char* common[] = {"kind", "ramp_rate_mm_s", "dwell_s", "sample_rate_hz", "limits", "name"};
   auto known = [&](const std::vector<std::string>& extra) {
     for (const auto& [k, _] : j.items()) {
       bool ok = std::find(std::begin(common), std::end(common), k) != std::end(common);
       for (const auto& e : extra) ok = ok || e == k;
-      if (!ok) fail(k, "is not a field of a " + p.kind + " plan");
+      if (!ok) fail(k, std::string("is not a field of a ") + db::to_string(p.kind) + " plan");
     }
   };
   p.ramp_rate_mm_s = number(j, "ramp_rate_mm_s", 0.5, 1e-4, 1e3);
   p.dwell_s = number(j, "dwell_s", 0.0, 0.0, 3600.0);
   p.sample_rate_hz = number(j, "sample_rate_hz", 1000.0, 1.0, 10000.0);
-  if (p.kind == "fot") {
+  if (p.kind == db::CampaignKind::fot) {
     known({"range_mm", "subdivisions", "repeats", "training_cycles"});
     if (!j.contains("range_mm")) fail("range_mm", "is required");
     std::tie(p.lo_mm, p.hi_mm) = pair_of(j["range_mm"], "range_mm");
@@ -102,7 +113,7 @@ Plan parse_plan(const json& j) {
     p.limits = parse_limits(j.value("limits", json()), p.lo_mm, p.hi_mm);
     if (p.lo_mm < p.limits.displacement_min_mm || p.hi_mm > p.limits.displacement_max_mm)
       fail("range_mm", "must lie inside limits.displacement_mm");
-  } else if (p.kind == "waveform") {
+  } else if (p.kind == db::CampaignKind::waveform) {
     known({"points_mm"});
     if (!j.contains("points_mm") || !j["points_mm"].is_array() || j["points_mm"].size() < 2)
       fail("points_mm", "must be an array of at least two displacements");
@@ -118,11 +129,9 @@ Plan parse_plan(const json& j) {
     for (std::size_t k = 0; k < p.points_mm.size(); ++k)
       if (p.points_mm[k] < p.limits.displacement_min_mm || p.points_mm[k] > p.limits.displacement_max_mm)
         fail("points_mm[" + std::to_string(k) + "]", "lies outside limits.displacement_mm");
-  } else if (p.kind == "sine") {
+  } else {
     known({"frequencies_hz", "sweep", "amplitude_mm", "settle_cycles", "measured_cycles"});
     parse_sine(j, p);
-  } else {
-    fail("kind", "must be \"fot\", \"waveform\" or \"sine\" (got \"" + p.kind + "\")");
   }
   // Only against a rate the plan wrote: without one, the rig's envelope decides at submission and
   // names its own maximum (check_plan_against), not a default the user never saw.

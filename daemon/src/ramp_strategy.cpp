@@ -21,7 +21,7 @@ class RampStrategy final : public Strategy {
       : plan_(L.plan), seq_(schedule(L.plan), L.ctx.supervisor.settings().in_position_mm), settings_(L.ctx.supervisor.settings()),
         time_scale_(L.ctx.time_scale) {
     series_ = L.job.prior_series;
-    if (plan_.kind != "fot") return;
+    if (plan_.kind != db::CampaignKind::fot) return;
     const models::Grid g = models::Grid::make(plan_.lo_mm, plan_.hi_mm, plan_.subdivisions);
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
     for (const models::FotNode& n : L.job.prior_nodes) (void)builder_->add(n);
@@ -61,16 +61,16 @@ class RampStrategy final : public Strategy {
 
   void on_resume(Loop& L, double t, bool after_link_loss) override {
     const Segment* cur = seq_.current();
-    if (!after_link_loss && plan_.kind == "fot" && cur && t - L.pause_started > L.ctx.resume_preamble_after_s) {
+    if (!after_link_loss && plan_.kind == db::CampaignKind::fot && cur && t - L.pause_started > L.ctx.resume_preamble_after_s) {
       // Memory-aware resume: the specimen drifted while held; wipe its memory at δmin and
       // re-take the row that was in progress.
       const std::size_t k = cur->kind == SegmentKind::descent ? seq_.index() - 1 : seq_.index();
       seq_.restart_at(k);
       seq_.insert_before_current({{plan_.lo_mm, plan_.ramp_rate_mm_s, plan_.dwell_s, SegmentKind::preamble, 0}});
-      L.state("running", "resumed after a long pause: wipe-out preamble to δmin, row re-taken");
+      L.state(db::CampaignState::running, "resumed after a long pause: wipe-out preamble to δmin, row re-taken");
     } else {
       seq_.restart_at(seq_.index());  // re-issue the current segment's command
-      L.state("running", after_link_loss ? "link back: segment taken again" : "resumed");
+      L.state(db::CampaignState::running, after_link_loss ? "link back: segment taken again" : "resumed");
     }
     deadline_ = 1e300;
   }
@@ -88,7 +88,7 @@ class RampStrategy final : public Strategy {
   }
 
  private:
-  static std::vector<Segment> schedule(const Plan& p) { return p.kind == "fot" ? fot_schedule(p) : waveform_schedule(p); }
+  static std::vector<Segment> schedule(const Plan& p) { return p.kind == db::CampaignKind::fot ? fot_schedule(p) : waveform_schedule(p); }
 
   void resume_rows_only(Loop& L) {  // a resumed campaign drives only the rows not yet complete
     const std::vector<Segment> all = schedule(L.plan);

@@ -210,7 +210,7 @@ void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, do
   }
   if (const std::int64_t id = w.running_campaign.exchange(0)) {
     const std::string now = now_iso(), reason = "error on the acquisition thread: " + what + "; the rig is held";
-    writer.post([id, reason, now](db::Store& s) { s.transition(id, "failed", reason, now); });
+    writer.post([id, reason, now](db::Store& s) { s.transition(id, db::CampaignState::failed, reason, now); });
   }
   w.live.campaign = 0;
 }

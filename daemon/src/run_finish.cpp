@@ -82,7 +82,7 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
       tables = fot_tables(j, now, note);
     }
   }
-  const std::string state = to_string(r.end);
+  const db::CampaignState state = state_of(r.end);
   const std::string reason = (r.reason.empty() ? std::string("finished") : r.reason) + note;
   const auto campaign = j.campaign, run = r.run_id;
   // Retried: a busy database delays the end of a campaign, it never loses it.

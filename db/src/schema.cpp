@@ -43,14 +43,16 @@ CREATE TABLE transmissibility(
 CREATE TABLE io_stats(
   id INTEGER PRIMARY KEY, rig_id INTEGER REFERENCES rigs(id), at TEXT NOT NULL, stats TEXT NOT NULL);
 )sql",
-    // 2: operator commands for the daemon (written by the CLI; the daemon marks them handled).
+    // 2: operator commands for the daemon, once written by the CLI. Since stop 21 nothing reads or
+    // writes 2 and 3 (commands reach hystlabd only through its interface, the HTTP API); they stay
+    // so that an older hystlabd on the same file never finds them dropped under it.
     R"sql(
 CREATE TABLE commands(
   id INTEGER PRIMARY KEY, campaign_id INTEGER NOT NULL REFERENCES campaigns(id), command TEXT NOT NULL,
   created_at TEXT NOT NULL, handled_at TEXT);
 CREATE INDEX commands_pending ON commands(handled_at, id);
 )sql",
-    // 3: operator commands for a rig (reset, estop), apart from any campaign.
+    // 3: operator commands for a rig (reset, estop), apart from any campaign (unused since stop 21).
     R"sql(
 CREATE TABLE rig_commands(
   id INTEGER PRIMARY KEY, rig TEXT NOT NULL, command TEXT NOT NULL, created_at TEXT NOT NULL, handled_at TEXT);

@@ -1,3 +1,6 @@
+#include <fcntl.h>
+#include <unistd.h>
+
 #include "hystlab/db/sqlite.hpp"
 
 #include <sqlite3.h>
@@ -10,6 +13,12 @@ namespace {
 }  // namespace
 
 Database::Database(const std::string& path, bool synchronous_full) : path_(path) {
+  // A new file is the owner's alone (0600): it holds the lab's data and the commands for its rigs.
+  // SQLite gives its -wal and -shm files the database file's mode.
+  if (!path.empty() && path != ":memory:") {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd >= 0) ::close(fd);
+  }
   const int rc = sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, nullptr);
   if (rc != SQLITE_OK) {
     const std::string msg = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(rc);

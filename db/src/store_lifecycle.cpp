@@ -1,5 +1,5 @@
 // The store's campaign life cycle beyond single rows: finishing a run in one transaction,
-// holding what a restart found queued, and the rig commands of the CLI.
+// holding what a restart found queued, the rigs' names and I/O statistics.
 #include "hystlab/db/store.hpp"
 
 namespace hystlab::db {
@@ -11,7 +11,7 @@ int Store::hold_queued(const std::string& now) {
     Statement st(db_, "SELECT id FROM campaigns WHERE state = 'queued' ORDER BY id");
     while (st.step()) ids.push_back(st.column_int(0));
   }
-  for (auto id : ids) transition(id, "held", "held after restart: nothing moves until an operator releases it (resume)", now);
+  for (auto id : ids) transition(id, CampaignState::held, "held after restart: nothing moves until an operator releases it (resume)", now);
   return static_cast<int>(ids.size());
 }
 
@@ -31,7 +31,7 @@ std::vector<std::int64_t> Store::runs_of_campaign(std::int64_t campaign) {
 }
 
 std::vector<std::int64_t> Store::finish_run(std::int64_t campaign, std::int64_t run, const std::vector<TableRecord>& tables,
-                                            const std::string& state, const std::string& reason, const std::string& now) {
+                                            CampaignState state, const std::string& reason, const std::string& now) {
   std::vector<std::int64_t> ids;
   Transaction tx(db_);
   if (table_count(campaign) == 0)
@@ -41,27 +41,6 @@ std::vector<std::int64_t> Store::finish_run(std::int64_t campaign, std::int64_t 
   tx.commit();
   records_changed();
   return ids;
-}
-
-std::int64_t Store::add_rig_command(const std::string& rig, const std::string& command, const std::string& now) {
-  Statement st(db_, "INSERT INTO rig_commands(rig, command, created_at) VALUES(?,?,?)");
-  st.bind(1, rig).bind(2, command).bind(3, now);
-  st.step();
-  return db_.last_insert_rowid();
-}
-
-std::vector<Store::RigCommand> Store::take_rig_commands(const std::string& now) {
-  Transaction tx(db_);
-  std::vector<RigCommand> out;
-  {
-    Statement st(db_, "SELECT id, rig, command FROM rig_commands WHERE handled_at IS NULL ORDER BY id");
-    while (st.step()) out.push_back({st.column_int(0), st.column_text(1), st.column_text(2)});
-  }
-  Statement up(db_, "UPDATE rig_commands SET handled_at = ? WHERE handled_at IS NULL");
-  up.bind(1, now);
-  up.step();
-  tx.commit();
-  return out;
 }
 
 std::vector<std::string> Store::rig_names() {

@@ -63,7 +63,7 @@ daemon::RunnerResult acquire(bool blocks, int port, double seconds, db::Store& s
   for (int k = 0; k <= legs; ++k) points.push_back(k % 2 ? 3.0 : 0.0);  // 1.5 s legs at 2 mm/s
   const auto plan = daemon::parse_plan({{"kind", "waveform"}, {"points_mm", points}, {"ramp_rate_mm_s", 2.0}, {"sample_rate_hz", 1000},
                                         {"limits", {{"displacement_mm", {-1, 4}}, {"force_N", 400}, {"rate_mm_s", 50}}}});
-  const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), "waveform", plan.source.dump(), "t");
+  const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), hystlab::db::CampaignKind::waveform, plan.source.dump(), "t");
   std::vector<float> periods;
   periods.reserve(static_cast<std::size_t>(seconds * 1100));
   daemon::SteadyClock clock;

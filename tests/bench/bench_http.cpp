@@ -10,7 +10,7 @@
 #include <string>
 #include <thread>
 
-#include "daemon_process.hpp"
+#include "../support/daemon_process.hpp"
 
 namespace {
 struct WrkResult {
@@ -51,7 +51,7 @@ WrkResult run_wrk(int port, int seconds) {
 int main(int argc, char** argv) {
   const int seconds = argc > 2 && std::string(argv[1]) == "--seconds" ? std::atoi(argv[2]) : 10;
   try {
-    hystlab::bench::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1}}]})");
+    hystlab::test_support::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1}}]})");
     httplib::Client c("127.0.0.1", daemon.port());
     auto status = c.Get("/api/status");
     if (!status || status->status != 200) throw std::runtime_error("hystlabd does not answer /api/status");

@@ -22,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-#include "daemon_process.hpp"
+#include "../support/daemon_process.hpp"
 
 namespace {
 double mono_now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
   const double stretch = 4;
   constexpr int kRounds = 6;
   try {
-    hystlab::bench::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1}}]})");
+    hystlab::test_support::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1}}]})");
     httplib::Client c("127.0.0.1", daemon.port());
     const nlohmann::json plan{{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 12}, {"ramp_rate_mm_s", 0.5}, {"sample_rate_hz", 1000},
                               {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};

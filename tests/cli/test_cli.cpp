@@ -1,6 +1,12 @@
 // The hystlab CLI as a user runs it: the real binary, real files, exit codes and messages.
 #include <doctest/doctest.h>
+
+#include <nlohmann/json.hpp>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -9,7 +15,14 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+
+#include <chrono>
+#include <functional>
 #include <string>
+#include <thread>
+
+#include "../support/daemon_process.hpp"
+#include "hystlab/db/store.hpp"
 
 #include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
@@ -42,8 +55,10 @@ class Workdir {
   ~Workdir() { fs::remove_all(dir_); }
   fs::path operator/(const std::string& name) const { return dir_ / name; }
   void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
-  Result run(const std::string& args) const {
-    const std::string cmd = "cd '" + dir_.string() + "' && '" HYSTLAB_CLI "' " + args + " > out.txt 2> err.txt < /dev/null";
+  Result run(const std::string& args) const { return run_raw("env -u HYSTLAB_DAEMON -u HYSTLAB_TOKEN '" HYSTLAB_CLI "' " + args); }
+  // command: a shell command line (the CLI with an environment of its own).
+  Result run_raw(const std::string& command) const {
+    const std::string cmd = "cd '" + dir_.string() + "' && " + command + " > out.txt 2> err.txt < /dev/null";
     const int status = std::system(cmd.c_str());
     Result r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -262,25 +277,124 @@ TEST_CASE("cli: every error is one line naming the problem, exit code 2") {
   check_error(w.run("identify --fot fot.csv -o F.json"), "missing node (alpha 3 mm, beta 1 mm)");
 }
 
-TEST_CASE("cli: campaigns on the daemon's db: submit validates, a waveform CSV is inlined, commands are queued") {
+TEST_CASE("cli: the daemon's records, read from its file with no daemon running") {
   Workdir w;
-  w.write("plan.json", R"({"kind": "waveform", "points_csv": "path.csv", "ramp_rate_mm_s": 0.5})");
-  w.write("path.csv", "displacement_mm\n0\n2.5\n1\n3\n0\n");
-  const Result ok = w.run("campaign submit --plan plan.json --db d.db");
-  CAPTURE(ok.err);
-  REQUIRE(ok.code == 0);
-  CHECK(ok.out.find("campaign 1 queued (waveform)") != std::string::npos);
+  // Never a database by accident: --db must name hystlabd's file.
+  check_error(w.run("campaign list --db d.db"), "no database at 'd.db'");
+  CHECK_FALSE(std::filesystem::exists(w / "d.db"));
+  {
+    hystlab::db::Store daemons((w / "d.db").string());
+    const auto rig = daemons.upsert_rig("sim frame", "{}", "2026-01-01T00:00:00Z");
+    (void)daemons.create_campaign(rig, hystlab::db::CampaignKind::waveform, R"({"kind": "waveform", "points_mm": [0, 2.5, 1, 3, 0]})",
+                                  "2026-01-01T00:00:01Z");
+  }
   const Result list = w.run("campaign list --db d.db");
   CHECK(list.out.find("queued") != std::string::npos);
-  CHECK(w.run("campaign pause 1 --db d.db").code == 0);
   const Result show = w.run("campaign show 1 --db d.db");
-  CHECK(show.out.find("\"points_mm\":[0.0,2.5,1.0,3.0,0.0]") != std::string::npos);
-  w.write("bad.json", R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 0})");
-  check_error(w.run("campaign submit --plan bad.json --db d.db"), "plan: subdivisions must be an integer");
+  CHECK(show.out.find("campaign 1: waveform on sim frame, queued") != std::string::npos);  // readable lines
+  const Result shown = w.run("campaign show 1 --json --db d.db");
+  const auto j = nlohmann::json::parse(shown.out);
+  CHECK(j["plan"]["points_mm"] == nlohmann::json::parse("[0,2.5,1,3,0]"));
+  CHECK(w.run("tables list --db d.db").out.find("accuracy") != std::string::npos);
+  check_error(w.run("tables export 1 --format xls --db d.db"), "--format: 'xls'");
+  CHECK(w.run("--version").out.rfind("hystlab ", 0) == 0);
   check_error(w.run("campaign show 99 --db d.db"), "no campaign 99");
-  check_error(w.run("campaign pause x --db d.db"), "campaign ID must be a positive whole number");
+  check_error(w.run("campaign show x --db d.db"), "campaign ID must be a positive whole number");
+  check_error(w.run("campaign frobnicate 1"), "unknown campaign verb 'frobnicate'");
   check_error(w.run("tables export 5 --db d.db"), "no table 5");
   check_error(w.run("runs export 3 --db d.db"), "no samples for run 3");
+}
+
+// A loopback port nothing listens on: bound to learn a free one, then closed.
+int closed_port() {
+  const int s = socket(AF_INET, SOCK_STREAM, 0);
+  REQUIRE(s >= 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof a;
+  REQUIRE(bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
+  REQUIRE(getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) == 0);
+  close(s);
+  return ntohs(a.sin_port);
+}
+
+// Until pred() holds for the CLI's answer to args, at most `seconds`; returns the last answer.
+Result run_until(const Workdir& w, const std::string& args, const std::function<bool(const Result&)>& pred, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  Result r = w.run(args);
+  while (!pred(r) && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    r = w.run(args);
+  }
+  return r;
+}
+
+TEST_CASE("cli: submit, preview and the commands go to the running hystlabd over HTTP, with its checks and its token") {
+  Workdir w;
+  w.write("plan.json", R"({"kind": "waveform", "points_csv": "path.csv", "ramp_rate_mm_s": 0.05})");
+  w.write("path.csv", "displacement_mm\n0\n2.5\n1\n3\n0\n");
+  w.write("bad.json", R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 0})");
+  w.write("climb.json", R"({"kind": "waveform", "points_csv": "../path.csv", "ramp_rate_mm_s": 0.5})");
+  // Refused before any connection: a file the plan may not reach, an address that is not one, --db.
+  check_error(w.run("campaign submit --plan climb.json"), "must be a file beside the plan");
+  check_error(w.run("campaign submit --plan plan.json --daemon localhost:8080"), "--daemon: 'localhost:8080' is not the daemon's address");
+  check_error(w.run("campaign pause 1 --db d.db"), "--db: 'campaign pause' is sent to the running hystlabd");
+  check_error(w.run("rig estop 'sim frame' --db d.db"), "--db: 'rig estop' is sent to the running hystlabd");
+  // No daemon at the address: a port the kernel just gave out and took back.
+  const std::string closed = "http://127.0.0.1:" + std::to_string(closed_port());
+  check_error(w.run("campaign pause 1 --daemon " + closed), "no hystlabd answers at " + closed + " (nothing accepts a connection there)");
+
+  const std::string token = "cli-test-token-0123456789";
+  hystlab::test_support::DaemonProcess d(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 10}}], "http": {"token": ")" + token + R"("}})");
+  const std::string at = " --daemon http://127.0.0.1:" + std::to_string(d.port());
+  const std::string auth = at + " --token " + token;
+  CAPTURE(d.log());
+  check_error(w.run("campaign submit --plan plan.json" + at), "needs its token");
+  // The daemon's own checks, in its words: the plan's field, the rig's name.
+  check_error(w.run("campaign submit --plan bad.json" + auth), "plan: subdivisions must be an integer");
+  check_error(w.run("campaign submit --plan plan.json --rig 'frame B'" + auth), "no rig named 'frame B'");
+  const Result preview = w.run("campaign preview --plan plan.json" + auth);
+  CAPTURE(preview.err);
+  REQUIRE(preview.code == 0);
+  CHECK(preview.out.find("waveform on 'sim frame'") != std::string::npos);
+  CHECK(preview.out.find("peak speed 0.05 mm/s") != std::string::npos);
+  const Result none = run_until(w, "campaign list --db " + d.db_path(), [](const Result& r) { return r.code == 0; }, 10);
+  CHECK(none.code == 0);
+  CHECK(none.out.find("waveform") == std::string::npos);  // a preview queues nothing
+
+  // $HYSTLAB_DAEMON and $HYSTLAB_TOKEN stand for the options.
+  const std::string env = "env HYSTLAB_DAEMON=http://127.0.0.1:" + std::to_string(d.port()) + " HYSTLAB_TOKEN=" + token + " '" HYSTLAB_CLI "' ";
+  const Result queued = w.run_raw(env + "campaign submit --plan plan.json");
+  CAPTURE(queued.err);
+  REQUIRE(queued.code == 0);
+  CHECK(queued.out.find("campaign 1 queued (waveform on 'sim frame'") != std::string::npos);
+  const Result shown = w.run("campaign show 1 --json --db " + d.db_path());
+  CHECK(nlohmann::json::parse(shown.out)["plan"]["points_mm"] == nlohmann::json::parse("[0.0,2.5,1.0,3.0,0.0]"));  // the CSV, inlined
+
+  // Commands: abort ends it (the daemon drives the rig to its safe position); a second abort no
+  // longer applies, in the API's words.
+  const Result running = run_until(w, "campaign show 1 --db " + d.db_path(), [](const Result& r) { return r.out.find(", running") != std::string::npos; }, 60);
+  CAPTURE(running.out);
+  REQUIRE(running.out.find(", running") != std::string::npos);
+  CHECK(w.run("campaign pause 1" + auth).out.find("pause sent to campaign 1") != std::string::npos);
+  CHECK(w.run("campaign abort 1" + auth).out.find("abort sent to campaign 1") != std::string::npos);
+  const Result aborted = run_until(w, "campaign show 1 --db " + d.db_path(), [](const Result& r) { return r.out.find(", aborted") != std::string::npos; }, 60);
+  CAPTURE(aborted.out);
+  REQUIRE(aborted.out.find(", aborted") != std::string::npos);
+  check_error(w.run("campaign abort 1" + auth), "campaign 1 is aborted: 'abort' does not apply");
+  check_error(w.run("campaign pause 7" + auth), "campaign 7");
+
+  // The rig's e-stop latches in the daemon: a submission is refused until the operator's reset.
+  const Result estop = w.run("rig estop 'sim frame'" + auth);
+  CAPTURE(estop.err);
+  CHECK(estop.out.find("estop sent to rig 'sim frame' (estopped)") != std::string::npos);  // latched before the answer
+  check_error(w.run("campaign submit --plan plan.json" + auth), "reset it first");  // at once, never a moment later
+  CHECK(w.run("rig reset 'sim frame'" + auth).code == 0);
+  const Result again = run_until(w, "campaign submit --plan plan.json" + auth, [](const Result& r) { return r.code == 0; }, 30);
+  CAPTURE(again.err);
+  CHECK(again.out.find("campaign 2 queued") != std::string::npos);
+  check_error(w.run("rig estop 'frame B'" + auth), "frame B");
 }
 
 TEST_CASE("cli: simulate sdof: time history, sweep up and down with the linear comparison, and its refusals") {

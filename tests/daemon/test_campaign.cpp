@@ -48,7 +48,7 @@ struct Bench {  // a db file, a writer, and a campaign row
     store.reset();
     fs::remove_all(dir);
   }
-  std::int64_t submit(const nlohmann::json& plan) { return store->create_campaign(rig_id, plan["kind"], plan.dump(), "t"); }
+  std::int64_t submit(const nlohmann::json& plan) { return store->create_campaign(rig_id, daemon::parse_plan(plan).kind, plan.dump(), "t"); }
   fs::path dir;
   std::string path;
   std::unique_ptr<db::Store> store;
@@ -110,7 +110,7 @@ daemon::RunnerResult run(std::int64_t id, const daemon::Plan& plan, daemon::Runn
   daemon::CampaignJob j;
   j.id = id;
   j.plan = plan;
-  j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, plan.kind == "sine");
+  j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, plan.kind == db::CampaignKind::sine);
   return daemon::run_campaign(j, ctx);
 }
 std::string end_of(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }
@@ -155,7 +155,7 @@ TEST_CASE("fot campaign n = 12: the online table equals the offline one and the 
   CHECK(r.nodes >= 78);  // 78 nodes, and the nodes of rows taken again after a hole in the data
   REQUIRE(r.table_id);
   CHECK(r.lsq_table_id);
-  CHECK(b.store->campaign(id)->state == "completed");
+  CHECK(b.store->campaign(id)->state == db::CampaignState::completed);
   // Offline: the same identification over the samples as stored.
   const models::Grid g = models::Grid::make(0, 4, 12);
   models::OnlineTableBuilder offline(g);

@@ -1,5 +1,5 @@
-// hystlabd as a user runs it: a real process with its supervised simulator, driven through the
-// CLI on its db file; stopped by SIGTERM, and killed with SIGKILL mid-campaign.
+// hystlabd as a user runs it: a real process with its supervised simulator, commanded through the
+// CLI over its HTTP API and observed in its db file; stopped by SIGTERM, killed with SIGKILL.
 #include <doctest/doctest.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <regex>
 #include <thread>
 
 #include "hystlab/db/store.hpp"
@@ -67,13 +68,38 @@ int wait_exit(pid_t pid) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -WTERMSIG(st);
 }
 
-int cli(const std::string& args) {
-  const std::string cmd = std::string("'") + HYSTLAB_CLI + "' " + args + " > /dev/null 2>&1";
-  const int st = std::system(cmd.c_str());
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+struct CliRun {
+  int code = -1;
+  std::string out;  // stdout and stderr
+};
+CliRun cli(const std::string& args) {
+  const std::string cmd = std::string("env -u HYSTLAB_DAEMON -u HYSTLAB_TOKEN '") + HYSTLAB_CLI + "' " + args + " 2>&1";
+  CliRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p)) r.out += buf;
+  const int st = pclose(p);
+  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
 }
 
-std::string state_of(const std::string& db, std::int64_t id) { return db::Store(db).campaign(id)->state; }
+std::string log_of(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// " --daemon http://127.0.0.1:PORT" of the daemon writing `log`, once it serves (started with --port 0).
+std::string daemon_at(const fs::path& log) {
+  static const std::regex re("serving the API and the page on (http://127\\.0\\.0\\.1:\\d+)/");
+  std::smatch m;
+  std::string text;
+  for (int k = 0; k < 1200 && !std::regex_search(text = log_of(log), m, re); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  REQUIRE_MESSAGE(std::regex_search(text, m, re), "hystlabd did not serve: " << text);
+  return " --daemon " + m[1].str();
+}
+
+std::string state_of(const std::string& db, std::int64_t id) { return db::to_string(db::Store(db).campaign(id)->state); }
 // The daemon is up once its rig is registered: after it held what was queued before it started
 // (a campaign submitted when only the file exists may be held as left over from a restart).
 bool daemon_ready(const std::string& db) { return fs::exists(db) && db::Store(db).rig_names().size() == 1; }
@@ -117,7 +143,7 @@ TEST_CASE("hystlabd: SIGTERM holds, marks the campaign interrupted, exits 0") {
   const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
   REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
-  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + daemon_at(d.path / "log")).code == 0);
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "running"; }));
   kill(pid, SIGTERM);
   CHECK(wait_exit(pid) == 0);
@@ -131,7 +157,7 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
   pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
   REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
-  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + daemon_at(d.path / "log")).code == 0);
   std::int64_t committed = -1;
   REQUIRE(eventually([&] {  // well into the campaign: some rows of the table measured
     db::Store s(d.db());
@@ -150,11 +176,11 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
     CHECK(s.integrity_check() == "ok");
     CHECK(s.max_seq(1) >= committed);
     CHECK(s.sample_count(1) == s.max_seq(1) + 1);  // no holes
-    CHECK(s.campaign(1)->state == "running");      // as the crash left it
+    CHECK(s.campaign(1)->state == db::CampaignState::running);      // as the crash left it
   }
   pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log2");
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "interrupted"; }));
-  REQUIRE(cli("campaign resume 1 --db " + d.db()) == 0);
+  REQUIRE(cli("campaign resume 1" + daemon_at(d.path / "log2")).code == 0);
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "completed"; }, 40000));
   kill(pid, SIGTERM);
   CHECK(wait_exit(pid) == 0);
@@ -182,28 +208,39 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
 
 namespace {
 const char* kShortPlan = R"({"kind": "waveform", "points_mm": [0, 1.0, 0.5], "ramp_rate_mm_s": 1.0, "sample_rate_hz": 500})";
-std::string log_of(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
 }  // namespace
 
-TEST_CASE("hystlabd: a campaign queued while the daemon was down is held at start, and runs only when released") {
+TEST_CASE("hystlabd: a campaign still queued when the daemon died is held at restart, and runs only when released") {
   Dir d;
   d.write("cfg.json", kConfig);
+  d.write("long.json", kPlan);
   d.write("plan.json", kShortPlan);
-  REQUIRE(cli("campaign submit --rig 'sim frame' --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  {  // campaign 1 running, campaign 2 queued behind it on the one rig; then a crash
+    const pid_t first = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log0");
+    const Reaper r0{first};
+    REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
+    const std::string at = daemon_at(d.path / "log0");
+    REQUIRE(cli("campaign submit --plan " + (d.path / "long.json").string() + at).code == 0);
+    REQUIRE(cli("campaign submit --rig 'sim frame' --plan " + (d.path / "plan.json").string() + at).code == 0);
+    REQUIRE(eventually([&] { return state_of(d.db(), 1) == "running"; }));
+    CHECK(state_of(d.db(), 2) == "queued");
+    kill(first, SIGKILL);
+    wait_exit(first);
+  }
   const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
-  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "held"; }));
+  REQUIRE(eventually([&] { return state_of(d.db(), 2) == "held"; }));
+  CHECK(state_of(d.db(), 1) == "interrupted");
   std::this_thread::sleep_for(std::chrono::seconds(2));
-  CHECK(state_of(d.db(), 1) == "held");  // nothing moved by itself
+  CHECK(state_of(d.db(), 2) == "held");  // nothing moved by itself
   {
     db::Store s(d.db());
-    CHECK(s.runs_of_campaign(1).empty());
+    CHECK(s.runs_of_campaign(2).empty());
   }
-  REQUIRE(cli("campaign resume 1 --db " + d.db()) == 0);
-  CHECK(eventually([&] { return state_of(d.db(), 1) == "completed"; }));
+  REQUIRE(cli("campaign resume 2" + daemon_at(d.path / "log")).code == 0);
+  CHECK(eventually([&] { return state_of(d.db(), 2) == "completed"; }));
+  CHECK(has_event(d.db(), 2, "released by the operator"));
+  CHECK(state_of(d.db(), 1) == "interrupted");  // released one by one
   kill(pid, SIGTERM);
   CHECK(wait_exit(pid) == 0);
 }
@@ -216,19 +253,24 @@ TEST_CASE("hystlabd: e-stop latches the rig until a reset; then a campaign compl
   const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
   REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
-  REQUIRE(cli("rig estop 'sim frame' --db " + d.db()) == 0);
-  CHECK(cli("rig reset 'no such rig' --db " + d.db()) == 2);
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
-  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "failed"; }));
-  CHECK(has_event(d.db(), 1, "reset it first"));
-  REQUIRE(cli("rig reset 'sim frame' --db " + d.db()) == 0);
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
-  CHECK(eventually([&] { return state_of(d.db(), 2) == "completed"; }));
-  REQUIRE(cli("campaign submit --plan " + (d.path / "fast.json").string() + " --db " + d.db()) == 0);
-  REQUIRE(eventually([&] { return state_of(d.db(), 3) == "failed"; }));
-  CHECK(has_event(d.db(), 3, "ramp_rate_mm_s 500 exceeds the rig's maximum speed 20 mm/s"));
+  const std::string at = daemon_at(d.path / "log");
+  REQUIRE(cli("rig estop 'sim frame'" + at).code == 0);
+  CHECK(cli("rig reset 'no such rig'" + at).code == 2);
+  // Latched before the command's answer: the next submission is refused, with the reason.
+  const CliRun refused = cli("campaign submit --plan " + (d.path / "plan.json").string() + at);
+  CAPTURE(refused.out);
+  CHECK(refused.code == 2);
+  CHECK(refused.out.find("reset it first") != std::string::npos);
+  REQUIRE(cli("rig reset 'sim frame'" + at).code == 0);
+  CliRun accepted;
+  REQUIRE(eventually([&] { return (accepted = cli("campaign submit --plan " + (d.path / "plan.json").string() + at)).code == 0; }, 20000));
+  CHECK(accepted.out.find("campaign 1 queued") != std::string::npos);
+  CHECK(eventually([&] { return state_of(d.db(), 1) == "completed"; }));
+  // Beyond the rig's envelope: refused at submission, naming the limit.
+  const CliRun fast = cli("campaign submit --plan " + (d.path / "fast.json").string() + at);
+  CAPTURE(fast.out);
+  CHECK(fast.code == 2);
+  CHECK(fast.out.find("ramp_rate_mm_s 500 exceeds the rig's maximum speed 20 mm/s") != std::string::npos);
   kill(pid, SIGTERM);
   CHECK(wait_exit(pid) == 0);
 }
@@ -243,7 +285,7 @@ TEST_CASE("hystlabd: the supervised simulator killed; the next campaign runs on 
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   REQUIRE(std::system(("pkill -KILL -P " + std::to_string(pid) + " hystlab-sim").c_str()) == 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + " --db " + d.db()) == 0);
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + daemon_at(d.path / "log")).code == 0);
   CHECK(eventually([&] { return state_of(d.db(), 1) == "completed"; }));
   CHECK(log_of(d.path / "log").find("the simulator died") != std::string::npos);
   kill(pid, SIGTERM);

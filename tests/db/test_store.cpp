@@ -34,7 +34,7 @@ struct TempDb {
 
 std::int64_t campaign_with_run(Store& s) {
   const auto rig = s.upsert_rig("frame", "{}", "2026-01-01T00:00:00Z");
-  const auto c = s.create_campaign(rig, "fot", "{}", "2026-01-01T00:00:00Z");
+  const auto c = s.create_campaign(rig, CampaignKind::fot, "{}", "2026-01-01T00:00:00Z");
   return s.add_run(c, "2026-01-01T00:00:00Z", 1.7e9, 0.0);
 }
 }  // namespace
@@ -49,24 +49,73 @@ TEST_CASE("schema: a new file is migrated; a newer one is refused, not guessed a
   CHECK_THROWS_WITH_AS(Store(t.path), doctest::Contains("newer than this hystlab"), DbError);
 }
 
+TEST_CASE("a new database file, and its WAL, are the owner's alone (0600)") {
+  TempDb t;
+  {
+    Store s(t.path);
+    (void)campaign_with_run(s);
+    for (const std::string& f : {t.path, t.path + "-wal"}) {
+      CAPTURE(f);
+      REQUIRE(fs::exists(f));
+      CHECK((fs::status(f).permissions() & fs::perms::all) == (fs::perms::owner_read | fs::perms::owner_write));
+    }
+  }
+  // An existing file keeps the mode its owner gave it.
+  fs::permissions(t.path, fs::perms::group_read, fs::perm_options::add);
+  Store again(t.path);
+  CHECK((fs::status(t.path).permissions() & fs::perms::group_read) != fs::perms::none);
+}
+
 TEST_CASE("campaigns: every transition is stored with time and reason; a crash leaves them interrupted") {
   TempDb t;
   Store s(t.path);
   const auto rig = s.upsert_rig("frame", "{\"transport\":\"modbus-tcp\"}", "t0");
   CHECK(s.upsert_rig("frame", "{}", "t1") == rig);  // same name, same rig
-  const auto c = s.create_campaign(rig, "fot", "{\"n\":12}", "t0");
-  s.transition(c, "arming", "operator", "t1");
-  s.transition(c, "running", "armed", "t2");
-  CHECK(s.campaign(c)->state == "running");
+  const auto c = s.create_campaign(rig, CampaignKind::fot, "{\"n\":12}", "t0");
+  s.transition(c, CampaignState::arming, "operator", "t1");
+  s.transition(c, CampaignState::running, "armed", "t2");
+  CHECK(s.campaign(c)->state == CampaignState::running);
   CHECK(s.mark_interrupted("t3") == 1);
-  CHECK(s.campaign(c)->state == "interrupted");
+  CHECK(s.campaign(c)->state == CampaignState::interrupted);
   const auto ev = s.events(c);
   REQUIRE(ev.size() == 4);
   CHECK(ev[0].to_state == "queued");
   CHECK(ev[3].from_state == "running");
   CHECK(ev[3].to_state == "interrupted");
   CHECK(ev[3].at == "t3");
-  CHECK_THROWS_AS(s.transition(999, "running", "", "t"), DbError);
+  CHECK_THROWS_AS(s.transition(999, CampaignState::running, "", "t"), DbError);
+}
+
+TEST_CASE("campaign states and kinds: enums inside, their stored text round-trips; text this program never wrote is named") {
+  for (const CampaignState st : kCampaignStates) {
+    CAPTURE(to_string(st));
+    REQUIRE(campaign_state_from(to_string(st)).has_value());
+    CHECK(*campaign_state_from(to_string(st)) == st);
+  }
+  CHECK_FALSE(campaign_state_from("Completed").has_value());
+  CHECK_FALSE(campaign_state_from("").has_value());
+  for (const CampaignKind k : {CampaignKind::fot, CampaignKind::waveform, CampaignKind::sine}) CHECK(*campaign_kind_from(to_string(k)) == k);
+  CHECK_FALSE(campaign_kind_from("sweep").has_value());
+  CHECK(is_final(CampaignState::completed));
+  CHECK_FALSE(is_final(CampaignState::interrupted));  // an interrupted campaign can resume
+
+  TempDb t;
+  Store s(t.path);
+  const auto rig = s.upsert_rig("frame", "{}", "t0");
+  const auto c = s.create_campaign(rig, CampaignKind::sine, "{}", "t0");
+  CHECK(s.campaign(c)->kind == CampaignKind::sine);
+  s.transition(c, CampaignState::paused, "operator", "t1");
+  const auto counts = s.campaign_counts();
+  REQUIRE(counts.size() == 1);
+  CHECK(counts[0].first == CampaignState::paused);
+  CHECK(counts[0].second == 1);
+  {  // another tool wrote a state of its own
+    Statement st(s.database(), "UPDATE campaigns SET state = 'finished' WHERE id = ?");
+    st.bind(1, c);
+    st.step();
+  }
+  CHECK_THROWS_WITH_AS((void)s.campaign(c), doctest::Contains("unknown state 'finished'"), DbError);
+  CHECK_THROWS_WITH_AS((void)s.campaign_counts(), doctest::Contains("unknown campaign state 'finished'"), DbError);
 }
 
 TEST_CASE("transactions roll back unless committed") {

@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "hystlab/daemon/daemon.hpp"
+#include "hystlab/daemon/daemon_control.hpp"
 #include "hystlab/web/http_api.hpp"
 
 namespace hystlab::test {
@@ -51,7 +52,8 @@ class LiveDaemon {
     config.http.port = 0;
     if (adjust) adjust(config);
     d = std::make_unique<daemon::Daemon>(config);
-    http = std::make_unique<web::HttpApi>(*d, config.http);
+    control = daemon::make_control(*d);
+    http = std::make_unique<web::HttpApi>(*control, config.http);
     thread = std::thread([this] { d->run(stop); });
   }
   ~LiveDaemon() {
@@ -78,19 +80,26 @@ class LiveDaemon {
   TempDir dir;
   daemon::DaemonConfig config;
   std::unique_ptr<daemon::Daemon> d;
+  std::unique_ptr<control::DaemonInterface> control;
   std::unique_ptr<web::HttpApi> http;
   std::atomic<bool> stop{false};
   std::thread thread;
 };
 
-// One request as written, on a fresh connection; returns the whole answer.
-inline std::string raw_request(int port, const std::string& request) {
+// A fresh TCP connection to the daemon on loopback.
+inline int connect_loopback(int port) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_port = htons(static_cast<std::uint16_t>(port));
   a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   REQUIRE(connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
+  return fd;
+}
+
+// One request as written, on a fresh connection; returns the whole answer.
+inline std::string raw_request(int port, const std::string& request) {
+  const int fd = connect_loopback(port);
   timeval tv{5, 0};
   setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
   REQUIRE(write(fd, request.data(), request.size()) == static_cast<ssize_t>(request.size()));

@@ -4,10 +4,10 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <memory>
 
-#include "hystlab/daemon/plan.hpp"
 #include "hystlab/db/sqlite.hpp"
 #include "hystlab/models/formats.hpp"
 
@@ -18,22 +18,35 @@ void send_json(httplib::Response& res, const json& body, int status) {
   res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
 }
 
-void send_error(httplib::Response& res, int status, const std::string& error, const std::string& detail) {
-  send_json(res, json{{"error", error}, {"detail", detail}}, status);
+void send_error(httplib::Response& res, int status, const std::string& error, const std::string& detail, const std::string& field) {
+  json body{{"error", error}, {"detail", detail}};
+  if (!field.empty()) body["field"] = field;
+  send_json(res, body, status);
 }
+
+namespace {
+// "rig: no rig named 'x'" names its field before the colon ("rig", "plan.kind").
+std::string field_of(const std::string& text) {
+  const auto colon = text.find(": ");
+  if (colon == std::string::npos || colon == 0 || colon > 40) return {};
+  for (std::size_t k = 0; k < colon; ++k)
+    if (!(std::isalnum(static_cast<unsigned char>(text[k])) || text[k] == '_' || text[k] == '.' || text[k] == '[' || text[k] == ']')) return {};
+  return text.substr(0, colon);
+}
+}  // namespace
 
 httplib::Server::Handler guarded(std::function<void(const httplib::Request&, httplib::Response&)> f) {
   return [f = std::move(f)](const httplib::Request& req, httplib::Response& res) {
     try {
       f(req, res);
     } catch (const ApiError& e) {
-      send_error(res, e.status, e.error, e.what());
-    } catch (const daemon::PlanError& e) {
-      send_error(res, 400, "invalid plan", e.what());
+      send_error(res, e.status, e.error, e.what(), e.field);
+    } catch (const control::PlanError& e) {
+      send_error(res, 400, "invalid plan", e.what(), e.field.empty() ? std::string() : "plan." + e.field);
     } catch (const models::FormatError& e) {
       send_error(res, 400, "invalid document", e.what());
     } catch (const std::invalid_argument& e) {
-      send_error(res, 400, "invalid request", e.what());
+      send_error(res, 400, "invalid request", e.what(), field_of(e.what()));
     } catch (const db::DbError& e) {
       send_error(res, 500, "storage error", e.what());
     } catch (const std::exception& e) {
@@ -65,16 +78,7 @@ double query_number(const httplib::Request& req, const char* name, double def, d
   return v;
 }
 
-json body_object(const httplib::Request& req) {
-  json j;
-  try {
-    j = json::parse(req.body);
-  } catch (const json::parse_error& e) {
-    throw ApiError(400, "malformed JSON", std::string("the request body is not valid JSON: ") + e.what());
-  }
-  if (!j.is_object()) throw ApiError(400, "malformed JSON", "the request body must be a JSON object");
-  return j;
-}
+json body_object(const httplib::Request& req, bool allow_empty) { return parse_body(req.body, allow_empty); }
 
 void set_thread_nice(int nice) noexcept {
   (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), nice);

@@ -7,27 +7,25 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <regex>
+#include <utility>
+#include <vector>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 
-#include "hystlab/daemon/daemon.hpp"
+#include "hystlab/control/daemon_interface.hpp"
+#include "hystlab/control/http_config.hpp"
 #include "hystlab/db/store.hpp"
+#include "request_body.hpp"
 
 namespace hystlab::web {
 
 using nlohmann::json;
 
-// Thrown by handlers; turned into {"error": error, "detail": detail} with this status.
-struct ApiError : std::runtime_error {
-  ApiError(int status_code, std::string error_text, const std::string& detail_text)
-      : std::runtime_error(detail_text), status(status_code), error(std::move(error_text)) {}
-  int status;
-  std::string error;
-};
-
 void send_json(httplib::Response& res, const json& body, int status = 200);
-void send_error(httplib::Response& res, int status, const std::string& error, const std::string& detail);
+// field: the request's field at fault ("plan.ramp_rate_mm_s"), for a form to mark; empty: none.
+void send_error(httplib::Response& res, int status, const std::string& error, const std::string& detail, const std::string& field = {});
 
 // Wraps a handler: every exception becomes one JSON error (400 for bad input, 500 otherwise).
 httplib::Server::Handler guarded(std::function<void(const httplib::Request&, httplib::Response&)> f);
@@ -36,8 +34,8 @@ httplib::Server::Handler guarded(std::function<void(const httplib::Request&, htt
 std::int64_t path_id(const httplib::Request& req, std::size_t group = 1);
 // A query parameter as a number in [lo, hi]; def when absent; 400 naming it otherwise.
 double query_number(const httplib::Request& req, const char* name, double def, double lo, double hi);
-// The body as a JSON object; 400 naming the problem otherwise.
-json body_object(const httplib::Request& req);
+// The body as a JSON object (parse_body); an empty body as {} when allow_empty.
+json body_object(const httplib::Request& req, bool allow_empty = false);
 
 // This thread's read connection (WAL: never blocks the writer).
 db::Store& reader(const std::string& db_path);
@@ -50,13 +48,15 @@ void set_thread_nice(int nice) noexcept;  // this thread only; best effort (rais
 
 // Shared by the route files.
 struct ApiContext {
-  ApiContext(daemon::Daemon& d, const daemon::HttpConfig& c, std::string db) : daemon(d), config(c), db_path(std::move(db)) {}
-  daemon::Daemon& daemon;
-  const daemon::HttpConfig& config;
+  ApiContext(control::DaemonInterface& d, const control::HttpConfig& c, std::string db) : daemon(d), config(c), db_path(std::move(db)) {}
+  control::DaemonInterface& daemon;
+  const control::HttpConfig& config;
   std::string db_path;
   std::atomic<int> stream_clients{0};
   std::atomic<bool> stopping{false};
   std::atomic<std::uint64_t> requests{0};
+  // Every POST route, for requests with no body at all (request_guard.hpp); filled before listening.
+  std::vector<std::pair<std::regex, httplib::Server::Handler>> post_routes;
 };
 
 }  // namespace hystlab::web

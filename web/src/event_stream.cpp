@@ -26,14 +26,7 @@ struct StreamState {
   bool hello_sent = false;
 };
 
-StreamCursor newest(db::Store& store) {
-  auto max_id = [&](const char* table) {
-    db::Statement st(store.database(), std::string("SELECT coalesce(max(id), 0) FROM ") + table);
-    st.step();
-    return st.column_int(0);
-  };
-  return {max_id("events"), max_id("fot_nodes"), max_id("tables")};
-}
+StreamCursor newest(db::Store& store) { return {store.newest_id("events"), store.newest_id("fot_nodes"), store.newest_id("tables")}; }
 
 std::string frame(const std::string& type, const json& data, const std::string& id = {}) {
   std::string f = id.empty() ? "" : "id: " + id + "\n";
@@ -43,45 +36,38 @@ std::string frame(const std::string& type, const json& data, const std::string& 
 // Records stored since the cursor, as frames; advances the cursor.
 std::string records(db::Store& store, StreamCursor& cur) {
   std::string out;
-  db::Statement ev(store.database(), "SELECT id, campaign_id, at, kind, coalesce(from_state, ''), coalesce(to_state, ''), coalesce(detail, '') "
-                                     "FROM events WHERE id > ? ORDER BY id LIMIT 500");
-  ev.bind(1, cur.event);
-  while (ev.step()) {
-    cur.event = ev.column_int(0);
-    const std::string kind = ev.column_text(3), detail = ev.column_text(6);
-    json d = json::parse(detail, nullptr, false);
-    if (d.is_discarded()) d = detail;
-    json j{{"id", cur.event}, {"campaign", ev.column_int(1)}, {"at", ev.column_text(2)}, {"kind", kind}, {"detail", d}};
-    if (kind == "state") j["from"] = ev.column_text(4), j["to"] = ev.column_text(5);
-    out += frame(kind == "state" ? "campaign" : kind, j, cur.id());
+  for (const db::EventInfo& e : store.events_after(cur.event, 500)) {
+    cur.event = e.id;
+    json j{{"id", e.id}, {"campaign", e.campaign}, {"at", e.at}, {"kind", e.kind}, {"detail", e.detail.empty() ? json("") : parse_or_text(e.detail)}};
+    if (e.kind == "state") {
+      j["from"] = e.from_state, j["to"] = e.to_state;
+      const auto to = db::campaign_state_from(e.to_state);
+      j["active"] = to && db::is_active(*to);
+      j["final"] = to && db::is_final(*to);
+    }
+    out += frame(e.kind == "state" ? "campaign" : e.kind, j, cur.id());
   }
-  db::Statement nd(store.database(), kNodeSelect +
-                                     "WHERE f.id > ? ORDER BY f.id LIMIT 2000");
-  nd.bind(1, cur.node);
-  while (nd.step()) {
-    cur.node = nd.column_int(0);
-    out += frame("node", node_json(nd), cur.id());
+  for (const db::NodeInfo& n : store.nodes_after(cur.node, 2000)) {
+    cur.node = n.id;
+    out += frame("node", node_json(n), cur.id());
   }
-  db::Statement tb(store.database(), kTableSelect +
-                                     "WHERE id > ? ORDER BY id LIMIT 100");
-  tb.bind(1, cur.table);
-  while (tb.step()) {
-    cur.table = tb.column_int(0);
-    out += frame("table", table_row_json(tb), cur.id());
+  for (const db::TableInfo& t : store.tables_after(cur.table, 100)) {
+    cur.table = t.id;
+    out += frame("table", table_json(t), cur.id());
   }
   return out;
 }
 
 // New live samples of each rig, one frame per rig, every stride-th sample.
-std::string samples(const daemon::Daemon& d, StreamState& st) {
+std::string samples(const control::DaemonInterface& d, StreamState& st) {
   std::string out;
-  std::vector<daemon::LiveSample> got;
+  std::vector<control::LiveSample> got;
   for (std::size_t k = 0; k < st.rigs.size(); ++k) {
-    const daemon::RigLive& live = d.rig_live(st.rigs[k]);
-    const double rig_rate = live.campaign.load() != 0 ? live.sample_rate_hz.load() : 0.0;
+    const control::AcquisitionCounters live = d.rig_counters(st.rigs[k]);
+    const double rig_rate = live.campaign != 0 ? live.sample_rate_hz : 0.0;
     const auto stride = static_cast<std::size_t>(std::max(1.0, std::floor(rig_rate / st.rate_hz)));
     got.clear();
-    st.ring_pos[k] = live.ring.read(st.ring_pos[k], stride, got);
+    st.ring_pos[k] = d.read_live(st.rigs[k], st.ring_pos[k], stride, got);
     if (got.empty()) continue;
     json t, cmd, disp, force;
     for (const auto& s : got) t.push_back(s.t), cmd.push_back(s.cmd), disp.push_back(s.disp), force.push_back(s.force);
@@ -123,7 +109,7 @@ void add_stream_route(httplib::Server& s, ApiContext& c) {
     for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
       if (rig.empty() || c.daemon.rig_info(k).name == rig) st->rigs.push_back(k);
     if (st->rigs.empty()) throw ApiError(404, "not found", "rig: no rig named '" + rig + "'");
-    for (std::size_t k : st->rigs) st->ring_pos.push_back(c.daemon.rig_live(k).ring.head());
+    for (std::size_t k : st->rigs) st->ring_pos.push_back(c.daemon.live_head(k));
     if (c.stream_clients.fetch_add(1) >= c.config.max_stream_clients) {
       c.stream_clients.fetch_sub(1);
       throw ApiError(503, "too many streams", "at most " + std::to_string(c.config.max_stream_clients) + " event streams at once (http.max_stream_clients)");
@@ -140,7 +126,7 @@ void add_stream_route(httplib::Server& s, ApiContext& c) {
           if (!st->hello_sent) {
             st->hello_sent = true;
             set_thread_nice(kStreamNice);
-            (void)daemon::avoid_cpu(daemon::resolve_cpu(c.daemon.config().acquisition.cpu));
+            c.daemon.keep_off_acquisition_cpu(true);
             return write(sink, "retry: 2000\n\n" + frame("hello", {{"cursor", st->cursor.id()}, {"rate_hz", st->rate_hz}}));
           }
           std::this_thread::sleep_for(kTick);
@@ -161,7 +147,7 @@ void add_stream_route(httplib::Server& s, ApiContext& c) {
         },
         [&c](bool) {
           set_thread_nice(kRequestNice);  // a request thread again (stays at 19 without CAP_SYS_NICE)
-          (void)daemon::avoid_cpu(-1);
+          c.daemon.keep_off_acquisition_cpu(false);
           c.stream_clients.fetch_sub(1);
         });
   }));

@@ -7,47 +7,11 @@
 
 #include "api_support.hpp"
 #include "event_stream.hpp"
+#include "request_guard.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
 namespace {
-bool changes_state(const std::string& method) { return method != "GET" && method != "HEAD" && method != "OPTIONS"; }
-
-// Equal-time comparison: the token must not leak through timing.
-bool same_secret(const std::string& a, const std::string& b) {
-  unsigned char diff = a.size() == b.size() ? 0 : 1;
-  for (std::size_t k = 0; k < a.size(); ++k) diff |= static_cast<unsigned char>(a[k] ^ (k < b.size() ? b[k] : 0));
-  return diff == 0;
-}
-
-// Requests that change state: same origin only (no CORS, so no other site's page can drive the
-// rig through a browser on this machine), and the token when one is configured.
-httplib::Server::HandlerResponse guard_request(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
-  // HTTP threads yield to acquisition: each lowers its own priority once (no privilege needed).
-  static thread_local const bool lowered = (set_thread_nice(kRequestNice), true);
-  (void)lowered;
-  c.requests.fetch_add(1, std::memory_order_relaxed);
-  if (!changes_state(req.method)) return httplib::Server::HandlerResponse::Unhandled;
-  if (req.has_header("Origin")) {
-    const std::string origin = req.get_header_value("Origin"), host = req.get_header_value("Host");
-    if (origin != "http://" + host) {
-      send_error(res, 403, "cross-origin request refused", "Origin '" + origin + "' is not this server (" + host + ")");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-  }
-  if (c.config.token.empty()) return httplib::Server::HandlerResponse::Unhandled;
-  std::string given = req.get_header_value("X-Hystlab-Token");
-  const std::string auth = req.get_header_value("Authorization");
-  if (auth.rfind("Bearer ", 0) == 0) given = auth.substr(7);
-  if (!same_secret(given, c.config.token)) {
-    res.set_header("WWW-Authenticate", "Bearer realm=\"hystlabd\"");
-    send_error(res, 401, "unauthorized", given.empty() ? "this request changes state: send the daemon's token (Authorization: Bearer ...)"
-                                                       : "the token does not match");
-    return httplib::Server::HandlerResponse::Handled;
-  }
-  return httplib::Server::HandlerResponse::Unhandled;
-}
-
 // The configured folder; else the installed one beside the executable
 // (<bindir>/../share/hystlab/web/<sub>); else the source tree's.
 std::string default_dir(const std::string& configured, const std::string& installed_sub, const char* source_tree) {
@@ -61,25 +25,29 @@ std::string default_dir(const std::string& configured, const std::string& instal
 }  // namespace
 
 struct HttpApi::Impl {
-  Impl(daemon::Daemon& d, const daemon::HttpConfig& cfg) : config(cfg), ctx(d, config, d.config().db_path) {}
-  daemon::HttpConfig config;
+  Impl(control::DaemonInterface& d, const control::HttpConfig& cfg) : config(cfg), ctx(d, config, d.db_path()) {}
+  control::HttpConfig config;
   ApiContext ctx;
   httplib::Server server;
   std::thread thread;
   int port = 0;
 };
 
-HttpApi::HttpApi(daemon::Daemon& d, const daemon::HttpConfig& cfg) : impl_(std::make_unique<Impl>(d, cfg)) {
+HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg) : impl_(std::make_unique<Impl>(d, cfg)) {
   Impl& m = *impl_;
   httplib::Server& s = m.server;
   s.set_tcp_nodelay(true);  // without it every answer waits ~40 ms for the client's delayed ACK
-  const auto threads = static_cast<std::size_t>(cfg.max_stream_clients) + 16;  // each open stream holds one thread
+  // Each open stream holds a thread, and so does each connection still sending its request: 85
+  // clients sending headers at 1 byte/s once took all 80 threads, and /api/status went
+  // unanswered for 30 s. Threads are cheap beside that; a flood beyond 128 still queues.
+  const auto threads = static_cast<std::size_t>(cfg.max_stream_clients) + 128;
   s.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
   s.set_keep_alive_max_count(100);
   s.set_keep_alive_timeout(5);
   s.set_payload_max_length(cfg.max_body_bytes);
   s.set_default_headers({{"X-Content-Type-Options", "nosniff"},
-                         {"Content-Security-Policy", "default-src 'self'; img-src 'self' data: blob:; style-src 'self'"},
+                         {"Content-Security-Policy", "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; frame-ancestors 'none'"},
+                         {"X-Frame-Options", "DENY"},
                          {"Referrer-Policy", "no-referrer"}});
   s.set_pre_routing_handler([&m](const httplib::Request& req, httplib::Response& res) { return guard_request(m.ctx, req, res); });
   s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
@@ -91,6 +59,7 @@ HttpApi::HttpApi(daemon::Daemon& d, const daemon::HttpConfig& cfg) : impl_(std::
   add_status_routes(s, m.ctx);
   add_campaign_routes(s, m.ctx);
   add_data_routes(s, m.ctx);
+  add_loop_routes(s, m.ctx);
   add_stream_route(s, m.ctx);
   const std::string vendor = default_dir(cfg.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT), root = default_dir(cfg.web_root, "", HYSTLAB_WEB_ROOT);
   if (!s.set_mount_point("/vendor/uplot", vendor))

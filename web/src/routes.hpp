@@ -1,5 +1,5 @@
 #pragma once
-// The API's route groups, each in its own file.
+// The API's route groups, each in its own file, and the JSON of the rows they share.
 #include <httplib.h>
 
 #include <string>
@@ -11,13 +11,16 @@ namespace hystlab::web {
 void add_status_routes(httplib::Server& s, ApiContext& c);    // status, rigs
 void add_campaign_routes(httplib::Server& s, ApiContext& c);  // campaigns, commands, events, nodes, runs
 void add_data_routes(httplib::Server& s, ApiContext& c);      // samples, tables, exports, evaluation
+void add_loop_routes(httplib::Server& s, ApiContext& c);      // runs' x-y paths, plan previews
 
-// Row helpers shared by routes and the event stream: each reads the columns its SELECT names.
-inline const std::string kNodeSelect =
-    "SELECT f.id, r.campaign_id, f.run_id, alpha, beta, force_alpha, force_alpha_beta, f.t FROM fot_nodes f JOIN runs r ON r.id = f.run_id ";
-inline const std::string kTableSelect = "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy FROM tables ";
-json campaign_json(db::Store& store, const db::CampaignRow& row, bool details);
-json node_json(db::Statement& st);       // a row of kNodeSelect
-json table_row_json(db::Statement& st);  // a row of kTableSelect
+json campaign_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row, bool details);
+json node_json(const db::NodeInfo& n);
+json table_json(const db::TableInfo& t);
+json parse_or_text(const std::string& s);  // stored JSON text as JSON (or as the text itself)
+
+// A run's data quality, from its "quality" event (null while it runs), with warnings in words.
+json run_quality(db::Store& store, std::int64_t campaign, std::int64_t run);
+// The warnings of a result computed over a run (a table, a transmissibility point).
+json result_warnings(const json& quality);
 
 }  // namespace hystlab::web

@@ -2,69 +2,53 @@
 // transmissibility.
 #include <set>
 
-#include "hystlab/daemon/plan.hpp"
-#include "hystlab/db/sqlite.hpp"
 #include "hystlab/models/grid.hpp"
+#include "request_guard.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
 namespace {
-json parse_or_text(const std::string& s) {
-  if (s.empty()) return nullptr;
-  const json j = json::parse(s, nullptr, false);
-  return j.is_discarded() ? json(s) : j;
-}
-
 db::CampaignRow campaign_or_404(db::Store& store, std::int64_t id) {
   auto row = store.campaign(id);
   if (!row) throw ApiError(404, "not found", "no campaign " + std::to_string(id));
   return *row;
 }
 
-std::string rig_name(db::Store& store, std::int64_t rig_id) {
-  db::Statement st(store.database(), "SELECT name FROM rigs WHERE id = ?");
-  st.bind(1, rig_id);
-  return st.step() ? st.column_text(0) : std::string();
-}
-
 json runs_of(db::Store& store, std::int64_t campaign) {
   json runs = json::array();
-  db::Statement st(store.database(),
-                   "SELECT id, state, started_at, coalesce(ended_at, ''), (SELECT coalesce(sum(n), 0) FROM sample_blocks WHERE run_id = runs.id), "
-                   "(SELECT count(*) FROM fot_nodes WHERE run_id = runs.id) FROM runs WHERE campaign_id = ? ORDER BY id");
-  st.bind(1, campaign);
-  while (st.step())
-    runs.push_back({{"id", st.column_int(0)}, {"state", st.column_text(1)}, {"started_at", st.column_text(2)},
-                    {"ended_at", st.column_text(3)}, {"samples", st.column_int(4)}, {"nodes", st.column_int(5)}});
+  for (const db::RunInfo& r : store.runs(campaign))
+    runs.push_back({{"id", r.id}, {"state", r.state}, {"started_at", r.started_at}, {"ended_at", r.ended_at}, {"samples", r.samples},
+                    {"nodes", r.nodes}, {"quality", run_quality(store, campaign, r.id)}});
   return runs;
 }
 
-json tables_of(db::Store& store, std::int64_t campaign) {
+// Each table with the warnings of the run it was computed over (the campaign's last).
+json tables_of(db::Store& store, std::int64_t campaign, const json& runs) {
   json out = json::array();
-  db::Statement st(store.database(), kTableSelect +
-                                     "WHERE campaign_id = ? ORDER BY id");
-  st.bind(1, campaign);
-  while (st.step()) out.push_back(table_row_json(st));
+  for (const db::TableInfo& t : store.tables(campaign)) {
+    json j = table_json(t);
+    json warnings = json::array();
+    for (const json& r : runs)
+      for (const json& w : result_warnings(r["quality"])) warnings.push_back(w);
+    j["warnings"] = warnings;
+    out.push_back(j);
+  }
   return out;
 }
 
 // The newest online evaluation of the partial table ("fit" event), if any.
 json last_fit(db::Store& store, std::int64_t campaign) {
-  db::Statement st(store.database(), "SELECT detail FROM events WHERE campaign_id = ? AND kind = 'fit' ORDER BY id DESC LIMIT 1");
-  st.bind(1, campaign);
-  return st.step() ? parse_or_text(st.column_text(0)) : json(nullptr);
+  const auto fits = store.event_details(campaign, "fit");
+  return fits.empty() ? json(nullptr) : parse_or_text(fits.back());
 }
 
-json nodes_json(db::Store& store, const db::CampaignRow& row) {
+json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row) {
   json nodes = json::array();
-  db::Statement st(store.database(), kNodeSelect +
-                                     "WHERE r.campaign_id = ? ORDER BY f.id");
-  st.bind(1, row.id);
-  while (st.step()) nodes.push_back(node_json(st));
+  for (const db::NodeInfo& n : store.nodes(row.id)) nodes.push_back(node_json(n));
   json out{{"campaign", row.id}, {"nodes", nodes}};
-  if (row.kind != "fot") return out;
-  const daemon::Plan plan = daemon::parse_plan(json::parse(row.plan));
-  const models::Grid g = models::Grid::make(plan.lo_mm, plan.hi_mm, plan.subdivisions);
+  const auto grid = row.kind == db::CampaignKind::fot ? d.fot_grid(json::parse(row.plan)) : std::nullopt;
+  if (!grid) return out;
+  const models::Grid g = models::Grid::make(grid->lo_mm, grid->hi_mm, grid->subdivisions);
   std::set<std::pair<int, int>> seen;  // a resumed campaign may measure a node twice
   const double tol = 0.25 * g.step();
   for (const json& n : nodes) {
@@ -80,36 +64,25 @@ json nodes_json(db::Store& store, const db::CampaignRow& row) {
 }
 }  // namespace
 
-json node_json(db::Statement& st) {
-  const double fa = st.column_double(5), fab = st.column_double(6);
-  return {{"id", st.column_int(0)}, {"campaign", st.column_int(1)}, {"run", st.column_int(2)}, {"alpha", st.column_double(3)},
-          {"beta", st.column_double(4)}, {"force_alpha", fa}, {"force_alpha_beta", fab}, {"F", fa - fab}, {"t", st.column_double(7)}};
-}
-
-json table_row_json(db::Statement& st) {
-  return {{"id", st.column_int(0)},
-          {"campaign", st.column_is_null(1) ? json(nullptr) : json(st.column_int(1))},
-          {"run", st.column_is_null(2) ? json(nullptr) : json(st.column_int(2))},
-          {"method", st.column_text(3)}, {"n", st.column_int(4)}, {"range_mm", {st.column_double(5), st.column_double(6)}},
-          {"created_at", st.column_text(7)}, {"accuracy", parse_or_text(st.column_text(8))}};
-}
-
-json campaign_json(db::Store& store, const db::CampaignRow& row, bool details) {
-  json j{{"id", row.id}, {"rig", rig_name(store, row.rig_id)}, {"kind", row.kind}, {"state", row.state},
+json campaign_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row, bool details) {
+  json j{{"id", row.id}, {"rig", store.rig_name(row.rig_id)}, {"kind", db::to_string(row.kind)}, {"state", db::to_string(row.state)},
          {"created_at", row.created_at}, {"updated_at", row.updated_at}};
+  // What the state means, so that a page needs no list of states of its own.
+  json commands = json::array();
+  for (const control::CampaignCommand cmd : control::commands_for(row.state)) commands.push_back(control::to_string(cmd));
+  j["commands"] = commands;
+  j["active"] = db::is_active(row.state);
+  j["final"] = db::is_final(row.state);
   if (!details) {
-    db::Statement st(store.database(), "SELECT count(*) FROM tables WHERE campaign_id = ?");
-    st.bind(1, row.id);
-    st.step();
-    j["tables"] = st.column_int(0);
+    j["tables"] = store.table_count(row.id);
     return j;
   }
   j["plan"] = parse_or_text(row.plan);
   j["runs"] = runs_of(store, row.id);
-  j["tables"] = tables_of(store, row.id);
+  j["tables"] = tables_of(store, row.id, j["runs"]);
   j["fit"] = last_fit(store, row.id);
-  if (row.kind == "fot") {
-    const json nodes = nodes_json(store, row);
+  if (row.kind == db::CampaignKind::fot) {
+    const json nodes = nodes_json(d, store, row);
     j["progress"] = {{"nodes", nodes["identified"]}, {"required", nodes["required"]}};
   }
   return j;
@@ -119,34 +92,36 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   s.Get("/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
     const std::string state = req.has_param("state") ? req.get_param_value("state") : "";
+    if (!state.empty() && !db::campaign_state_from(state)) {
+      std::string known;
+      for (const db::CampaignState k : db::kCampaignStates) known += (known.empty() ? "" : ", ") + std::string(db::to_string(k));
+      throw ApiError(400, "invalid parameter", "state: '" + state + "' is not a campaign state (" + known + ")", "state");
+    }
     json out = json::array();
     for (const auto& row : store.campaigns())
-      if (state.empty() || row.state == state) out.push_back(campaign_json(store, row, false));
+      if (state.empty() || db::to_string(row.state) == state) out.push_back(campaign_json(c.daemon, store, row, false));
     send_json(res, out);
   }));
-  s.Post("/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    const json body = body_object(req);
-    for (const auto& [k, _] : body.items())
-      if (k != "plan" && k != "rig") throw ApiError(400, "invalid request", k + ": not a known field (plan, rig)");
-    if (!body.contains("plan") || !body["plan"].is_object()) throw ApiError(400, "invalid request", "plan: must be a JSON object (a campaign plan)");
-    if (body.contains("rig") && !body["rig"].is_string()) throw ApiError(400, "invalid request", "rig: must be a rig's name");
-    const std::int64_t id = c.daemon.submit(body.value("rig", std::string()), body["plan"]);
+  post_route(s, c, "/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    const PlanRequest r = decode_plan_request(body_object(req));
+    const std::int64_t id = c.daemon.submit(r.rig, r.plan);
     res.set_header("Location", "/api/campaigns/" + std::to_string(id));
-    send_json(res, campaign_json(reader(c.db_path), campaign_or_404(reader(c.db_path), id), false), 201);
+    send_json(res, campaign_json(c.daemon, reader(c.db_path), campaign_or_404(reader(c.db_path), id), false), 201);
   }));
   s.Get(R"(/api/campaigns/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
-    send_json(res, campaign_json(store, campaign_or_404(store, path_id(req)), true));
+    send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, path_id(req)), true));
   }));
-  s.Post(R"(/api/campaigns/(\d+)/(pause|resume|abort|estop))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+  post_route(s, c, R"(/api/campaigns/(\d+)/([a-z_]+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    const std::string verb = req.matches[2].str();
+    const auto cmd = control::campaign_command_from(verb);
+    if (!cmd) throw ApiError(404, "not found", "no command '" + verb + "' for a campaign (pause, resume, abort, estop)");
     auto& store = reader(c.db_path);
     const auto row = campaign_or_404(store, path_id(req));
-    const std::string verb = req.matches[2].str();
-    static const std::set<std::string> ended{"completed", "aborted", "failed"};
-    if (ended.count(row.state))
-      throw ApiError(409, "conflict", "campaign " + std::to_string(row.id) + " is " + row.state + ": '" + verb + "' does not apply");
-    c.daemon.command(row.id, verb);
-    send_json(res, json{{"campaign", row.id}, {"command", verb}, {"accepted", true}, {"state", row.state}}, 202);
+    if (db::is_final(row.state))
+      throw ApiError(409, "conflict", "campaign " + std::to_string(row.id) + " is " + db::to_string(row.state) + ": '" + verb + "' does not apply");
+    c.daemon.command(row.id, *cmd);
+    send_json(res, json{{"campaign", row.id}, {"command", verb}, {"accepted", true}, {"state", db::to_string(row.state)}}, 202);
   }));
   s.Get(R"(/api/campaigns/(\d+)/events)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
@@ -158,7 +133,7 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   }));
   s.Get(R"(/api/campaigns/(\d+)/nodes)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
-    send_json(res, nodes_json(store, campaign_or_404(store, path_id(req))));
+    send_json(res, nodes_json(c.daemon, store, campaign_or_404(store, path_id(req))));
   }));
   s.Get(R"(/api/campaigns/(\d+)/runs)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
@@ -168,13 +143,9 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
     auto& store = reader(c.db_path);
     const auto row = campaign_or_404(store, path_id(req));
     json out = json::array();
-    db::Statement st(store.database(), "SELECT t.id, t.run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad "
-                                       "FROM transmissibility t JOIN runs r ON r.id = t.run_id WHERE r.campaign_id = ? ORDER BY t.id");
-    st.bind(1, row.id);
-    while (st.step())
-      out.push_back({{"id", st.column_int(0)}, {"run", st.column_int(1)}, {"frequency_hz", st.column_double(2)},
-                     {"base_amplitude_mm", st.column_double(3)}, {"mass_amplitude_mm", st.column_double(4)},
-                     {"ratio", st.column_double(5)}, {"phase_rad", st.column_double(6)}});
+    for (const db::TransmissibilityInfo& t : store.transmissibility(row.id))
+      out.push_back({{"id", t.id}, {"run", t.run}, {"frequency_hz", t.frequency_hz}, {"base_amplitude_mm", t.base_amplitude_mm},
+                     {"mass_amplitude_mm", t.mass_amplitude_mm}, {"ratio", t.ratio}, {"phase_rad", t.phase_rad}});
     send_json(res, out);
   }));
 }

@@ -4,75 +4,38 @@
 #include <cstdio>
 #include <memory>
 
-#include "hystlab/db/sqlite.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/table_export.hpp"
+#include "request_guard.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
 namespace {
-constexpr std::size_t kMaxEvaluate = 1'000'000;
 constexpr std::int64_t kCsvChunk = 8192;
 
-struct RunRow {
-  std::int64_t id = 0, campaign = 0;
-  std::string state, started_at, ended_at;
-  double wall_anchor = 0;
-};
-
-RunRow run_or_404(db::Store& store, std::int64_t id) {
-  db::Statement st(store.database(), "SELECT id, campaign_id, state, started_at, coalesce(ended_at, ''), wall_anchor_unix FROM runs WHERE id = ?");
-  st.bind(1, id);
-  if (!st.step()) throw ApiError(404, "not found", "no run " + std::to_string(id));
-  return {st.column_int(0), st.column_int(1), st.column_text(2), st.column_text(3), st.column_text(4), st.column_double(5)};
-}
-
-std::pair<double, double> time_span(db::Store& store, std::int64_t run) {
-  db::Statement st(store.database(), "SELECT min(t_min), max(t_max) FROM sample_blocks WHERE run_id = ?");
-  st.bind(1, run);
-  st.step();
-  if (st.column_is_null(0)) return {0.0, 0.0};
-  return {st.column_double(0), st.column_double(1)};
+db::RunInfo run_or_404(db::Store& store, std::int64_t id) {
+  auto r = store.run(id);
+  if (!r) throw ApiError(404, "not found", "no run " + std::to_string(id));
+  return *r;
 }
 
 std::string table_document(db::Store& store, std::int64_t id) {
-  db::Statement st(store.database(), "SELECT document FROM tables WHERE id = ?");
-  st.bind(1, id);
-  if (!st.step()) throw ApiError(404, "not found", "no table " + std::to_string(id));
-  return st.column_text(0);
-}
-
-std::vector<double> displacement_series(const json& body) {
-  const auto it = body.find("displacement_mm");
-  if (it == body.end() || !it->is_array() || it->empty())
-    throw ApiError(400, "invalid request", "displacement_mm: must be a non-empty array of displacements in mm");
-  if (it->size() > kMaxEvaluate) throw ApiError(400, "invalid request", "displacement_mm: at most 1000000 values per request");
-  std::vector<double> x;
-  x.reserve(it->size());
-  for (std::size_t k = 0; k < it->size(); ++k) {
-    const json& v = (*it)[k];
-    if (!v.is_number() || !std::isfinite(v.get<double>()))
-      throw ApiError(400, "invalid request", "displacement_mm[" + std::to_string(k) + "]: must be a finite number");
-    x.push_back(v.get<double>());
-  }
-  return x;
+  auto doc = store.table_document(id);
+  if (!doc) throw ApiError(404, "not found", "no table " + std::to_string(id));
+  return *doc;
 }
 
 // The model named by the body: a stored table, a table document, or simplified-model parameters.
 std::unique_ptr<models::HysteresisModel> model_of(const json& body, db::Store& store) {
-  const int given = static_cast<int>(body.contains("table_id")) + static_cast<int>(body.contains("table")) + static_cast<int>(body.contains("params"));
-  if (given != 1) throw ApiError(400, "invalid request", "give exactly one of table_id, table (a table document) or params (simplified-model parameters)");
-  if (body.contains("table_id")) {
-    if (!body["table_id"].is_number_integer()) throw ApiError(400, "invalid request", "table_id: must be a table's id");
+  const ModelSource source = decode_model_source(body);
+  if (source == ModelSource::stored_table) {
     const auto doc = models::table_from_json(table_document(store, body["table_id"].get<std::int64_t>()));
     return std::make_unique<models::PreisachModel>(std::make_shared<const models::EverettTable>(doc.table));
   }
-  if (body.contains("table")) {
-    if (!body["table"].is_object()) throw ApiError(400, "invalid request", "table: must be a table document (JSON object)");
+  if (source == ModelSource::table_document) {
     const auto doc = models::table_from_json(body["table"].dump());
     return std::make_unique<models::PreisachModel>(std::make_shared<const models::EverettTable>(doc.table));
   }
-  if (!body["params"].is_object()) throw ApiError(400, "invalid request", "params: must be a parameters document (JSON object)");
   return std::make_unique<models::SimplifiedSmaModel>(models::params_from_json(body["params"].dump()));
 }
 
@@ -107,15 +70,16 @@ void stream_csv(httplib::Response& res, const std::string& db_path, std::int64_t
 void add_data_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/runs/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
-    const RunRow r = run_or_404(store, path_id(req));
-    const auto [t0, t1] = time_span(store, r.id);
+    const db::RunInfo r = run_or_404(store, path_id(req));
+    const auto [t0, t1] = store.time_span(r.id).value_or(std::make_pair(0.0, 0.0));
     send_json(res, {{"id", r.id}, {"campaign", r.campaign}, {"state", r.state}, {"started_at", r.started_at}, {"ended_at", r.ended_at},
-                    {"wall_anchor_unix", r.wall_anchor}, {"samples", store.sample_count(r.id)}, {"t_range_s", {t0, t1}}});
+                    {"wall_anchor_unix", r.wall_anchor_unix}, {"samples", r.samples}, {"t_range_s", {t0, t1}},
+                    {"quality", run_quality(store, r.campaign, r.id)}});
   }));
   s.Get(R"(/api/runs/(\d+)/samples)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
-    const RunRow r = run_or_404(store, path_id(req));
-    const auto [lo, hi] = time_span(store, r.id);
+    const db::RunInfo r = run_or_404(store, path_id(req));
+    const auto [lo, hi] = store.time_span(r.id).value_or(std::make_pair(0.0, 0.0));
     const double t0 = query_number(req, "t0", lo, -1e12, 1e12), t1 = query_number(req, "t1", hi, -1e12, 1e12);
     if (t1 < t0) throw ApiError(400, "invalid parameter", "t1 must not be before t0");
     const int points = static_cast<int>(query_number(req, "points", 1000, 1, 100000));
@@ -129,24 +93,21 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
                     {"force_min_N", f_min}, {"force_max_N", f_max}, {"n", n}});
   }));
   s.Get(R"(/api/runs/(\d+)/samples\.csv)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    const RunRow r = run_or_404(reader(c.db_path), path_id(req));
+    const db::RunInfo r = run_or_404(reader(c.db_path), path_id(req));
     stream_csv(res, c.db_path, r.id);
   }));
   s.Get("/api/tables", guarded([&c](const httplib::Request&, httplib::Response& res) {
     json out = json::array();
-    db::Statement st(reader(c.db_path).database(), kTableSelect + "ORDER BY id");
-    while (st.step()) out.push_back(table_row_json(st));
+    for (const db::TableInfo& t : reader(c.db_path).tables()) out.push_back(table_json(t));
     send_json(res, out);
   }));
   s.Get(R"(/api/tables/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
     const std::int64_t id = path_id(req);
-    const std::string doc = table_document(store, id);
-    db::Statement st(store.database(), kTableSelect + "WHERE id = ?");
-    st.bind(1, id);
-    st.step();
-    json j = table_row_json(st);
-    j["document"] = json::parse(doc);
+    const auto t = store.table(id);
+    if (!t) throw ApiError(404, "not found", "no table " + std::to_string(id));
+    json j = table_json(*t);
+    j["document"] = json::parse(table_document(store, id));
     send_json(res, j);
   }));
   s.Get(R"(/api/tables/(\d+)/export)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
@@ -163,13 +124,10 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
     if (format == "h") return res.set_content(models::table_to_c_header(doc.table, doc.provenance, "hystlab_table_" + std::to_string(id)), "text/x-c");
     res.set_content(models::table_to_matlab(doc.table, doc.provenance), "text/x-matlab");
   }));
-  s.Post("/api/evaluate", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+  post_route(s, c, "/api/evaluate", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     const json body = body_object(req);
-    for (const auto& [k, _] : body.items())
-      if (k != "table_id" && k != "table" && k != "params" && k != "displacement_mm")
-        throw ApiError(400, "invalid request", k + ": not a known field (table_id, table, params, displacement_mm)");
     const auto model = model_of(body, reader(c.db_path));
-    const std::vector<double> x = displacement_series(body);
+    const std::vector<double> x = decode_displacements(body);
     std::vector<double> f(x.size());
     for (std::size_t k = 0; k < x.size(); ++k) f[k] = model->step(x[k]);
     send_json(res, {{"force_N", f}, {"samples", f.size()}, {"saturations", model->saturation_count()}});

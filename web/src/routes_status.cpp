@@ -4,39 +4,34 @@
 #include <mutex>
 #include <vector>
 
-#include "hystlab/db/sqlite.hpp"
 #include "hystlab/protocols/signals.hpp"
+#include "request_guard.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
 namespace {
-constexpr const char* kErrorNames[] = {"", "timeout", "exception_response", "connection_lost", "crc_error",
-                                       "out_of_range", "protocol_error", "not_connected", "stale_data", "unsupported"};
-static_assert(sizeof kErrorNames / sizeof kErrorNames[0] == drivers::kRigErrorCount);
-
 std::map<std::string, std::int64_t> campaigns_by_state(db::Store& store) {
   std::map<std::string, std::int64_t> out;
-  for (const char* s : {"queued", "held", "arming", "running", "paused", "completed", "aborted", "failed", "interrupted"}) out[s] = 0;
-  db::Statement st(store.database(), "SELECT state, count(*) FROM campaigns GROUP BY state");
-  while (st.step()) out[st.column_text(0)] = st.column_int(1);
+  for (const db::CampaignState s : db::kCampaignStates) out[db::to_string(s)] = 0;
+  for (const auto& [state, n] : store.campaign_counts()) out[db::to_string(state)] = n;
   return out;
 }
 
-json health_json(const drivers::IoHealthSnapshot& h) {
+json health_json(const control::LinkHealth& h) {
   json errors = json::object();
-  for (std::size_t k = 1; k < drivers::kRigErrorCount; ++k) errors[kErrorNames[k]] = h.errors[k];
+  for (const auto& [kind, n] : h.errors) errors[kind] = n;
   return {{"reads", h.reads}, {"writes", h.writes}, {"reconnects", h.reconnects}, {"lost_samples", h.lost_samples}, {"errors", errors},
           {"last_transaction_us", h.last_transaction_us}, {"max_transaction_us", h.max_transaction_us},
-          {"latency_histogram_us", h.latency_histogram}};
+          {"latency_histogram_us", h.latency_histogram_us}};
 }
 
-json rig_json(const daemon::Daemon& d, std::size_t k) {
-  const daemon::RigInfo& info = d.rig_info(k);
-  const daemon::RigLive& live = d.rig_live(k);
+json rig_json(const control::DaemonInterface& d, std::size_t k) {
+  const control::RigInfo info = d.rig_info(k);
+  const control::AcquisitionCounters live = d.rig_counters(k);
   json j{{"id", info.id}, {"index", k}, {"name", info.name}, {"kind", info.kind}, {"description", info.description},
-         {"simulated", info.simulated}, {"campaign", live.campaign.load()}, {"samples", live.samples.load()},
-         {"missed_deadlines", live.missed_deadlines.load()}, {"late_wakeups", live.late_wakeups.load()}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
-  const daemon::RigSupervision sv = d.rig_supervision(k);
+         {"simulated", info.simulated}, {"campaign", live.campaign}, {"samples", live.samples},
+         {"missed_deadlines", live.missed_deadlines}, {"late_wakeups", live.late_wakeups}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
+  const control::RigSupervision sv = d.rig_supervision(k);
   j["state"] = sv.state;
   j["latched"] = sv.latched;
   j["latch_reason"] = sv.latch_reason.empty() ? json(nullptr) : json(sv.latch_reason);
@@ -54,9 +49,11 @@ json rig_json(const daemon::Daemon& d, std::size_t k) {
   j["transitions"] = sv.recent;
   j["envelope"] = sv.envelope;
   j["supervision"] = sv.supervision;
-  const std::uint64_t h = live.ring.head();
-  daemon::LiveSample s;
-  if (h > 0 && live.ring.get(h - 1, s)) {
+  const std::uint64_t h = d.live_head(k);
+  std::vector<control::LiveSample> last;
+  if (h > 0) (void)d.read_live(k, h - 1, 1, last);
+  if (!last.empty()) {
+    const control::LiveSample& s = last.back();
     const char* names[] = {"command_mm", "displacement_mm", "force_N"};
     const char* shaker[] = {"base_displacement_mm", "mass_displacement_mm", "mass_accel_m_s2"};
     const char** n = info.kind == "shaker" ? shaker : names;
@@ -91,27 +88,27 @@ void metric(std::string& out, const char* name, const char* type, const char* he
 }
 
 std::string metrics_text(ApiContext& c) {
-  const daemon::Daemon& d = c.daemon;
+  const control::DaemonInterface& d = c.daemon;
   std::string o;
   auto line = [&o](const std::string& name, const std::string& labels, double v) {
     o += name + (labels.empty() ? "" : "{" + labels + "}") + " " + json(v).dump() + "\n";
   };
-  const db::WriterStats w = d.writer_stats();
+  const control::WriterCounters w = d.writer();
   metric(o, "hystlab_samples_written_total", "counter", "Samples committed to the database.");
   line("hystlab_samples_written_total", "", static_cast<double>(w.written));
   metric(o, "hystlab_writer_queue_depth", "gauge", "Samples waiting for the writer thread.");
   line("hystlab_writer_queue_depth", "", static_cast<double>(w.depth));
   metric(o, "hystlab_writer_dropped_total", "counter", "Samples lost because the writer queue was full.");
-  line("hystlab_writer_dropped_total", "", static_cast<double>(w.dropped_full));
+  line("hystlab_writer_dropped_total", "", static_cast<double>(w.dropped));
   metric(o, "hystlab_writer_commits_total", "counter", "Write transactions committed.");
   line("hystlab_writer_commits_total", "", static_cast<double>(w.commits));
   metric(o, "hystlab_samples_acquired_total", "counter", "Samples acquired during campaigns.");
-  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_samples_acquired_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_live(k).samples.load()));
+  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_samples_acquired_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).samples));
   metric(o, "hystlab_missed_deadlines_total", "counter", "Samples not taken in time: late periods when polling, lost samples with block reads.");
-  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_missed_deadlines_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_live(k).missed_deadlines.load()));
+  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_missed_deadlines_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).missed_deadlines));
   metric(o, "hystlab_late_wakeups_total", "counter", "Acquisition periods that started more than a period late.");
-  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_late_wakeups_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_live(k).late_wakeups.load()));
-  std::vector<std::pair<std::string, drivers::IoHealthSnapshot>> rigs;  // one read per rig: families stay consistent
+  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_late_wakeups_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).late_wakeups));
+  std::vector<std::pair<std::string, control::LinkHealth>> rigs;  // one read per rig: families stay consistent
   for (std::size_t k = 0; k < d.rig_count(); ++k) rigs.emplace_back("rig=\"" + label(d.rig_info(k).name) + "\"", d.rig_health(k));
   auto family = [&](const char* name, const char* type, const char* help, auto value) {
     metric(o, name, type, help);
@@ -124,14 +121,14 @@ std::string metrics_text(ApiContext& c) {
   family("hystlab_rig_transaction_max_seconds", "gauge", "Longest rig transaction.", [](const auto& h) { return h.max_transaction_us * 1e-6; });
   metric(o, "hystlab_rig_errors_total", "counter", "Rig I/O errors by kind.");
   for (const auto& [rl, h] : rigs)
-    for (std::size_t e = 1; e < drivers::kRigErrorCount; ++e)
-      line("hystlab_rig_errors_total", rl + ",kind=\"" + kErrorNames[e] + "\"", static_cast<double>(h.errors[e]));
+    for (const auto& [kind, n] : h.errors) line("hystlab_rig_errors_total", rl + ",kind=\"" + kind + "\"", static_cast<double>(n));
   metric(o, "hystlab_rig_transaction_seconds", "histogram", "Rig transaction time.");
   for (const auto& [rl, h] : rigs) {
     std::uint64_t cum = 0;
-    for (std::size_t b = 0; b < drivers::kLatencyBuckets; ++b) {
-      cum += h.latency_histogram[b];
-      const std::string le = b + 1 == drivers::kLatencyBuckets ? "+Inf" : json(static_cast<double>(1ULL << (b + 1)) * 1e-6).dump();
+    const std::size_t buckets = h.latency_histogram_us.size();
+    for (std::size_t b = 0; b < buckets; ++b) {
+      cum += h.latency_histogram_us[b];
+      const std::string le = b + 1 == buckets ? "+Inf" : json(static_cast<double>(1ULL << (b + 1)) * 1e-6).dump();
       line("hystlab_rig_transaction_seconds_bucket", rl + ",le=\"" + le + "\"", static_cast<double>(cum));
     }
     line("hystlab_rig_transaction_seconds_sum", rl, h.total_transaction_us * 1e-6);
@@ -179,11 +176,11 @@ void add_status_routes(httplib::Server& s, ApiContext& c) {
     if (cache->body.empty() || now - cache->at > std::chrono::milliseconds(250)) {
       json rigs = json::array();
       for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
-        rigs.push_back({{"name", c.daemon.rig_info(k).name}, {"kind", c.daemon.rig_info(k).kind}, {"campaign", c.daemon.rig_live(k).campaign.load()}});
-      const auto w = c.daemon.writer_stats();
+        rigs.push_back({{"name", c.daemon.rig_info(k).name}, {"kind", c.daemon.rig_info(k).kind}, {"campaign", c.daemon.rig_counters(k).campaign}});
+      const control::WriterCounters w = c.daemon.writer();
       cache->body = json{{"name", "hystlabd"}, {"version", HYSTLAB_VERSION}, {"uptime_s", c.daemon.uptime_s()},
                          {"database", c.db_path}, {"rigs", rigs}, {"campaigns", campaigns_by_state(reader(c.db_path))},
-                         {"writer", {{"written", w.written}, {"queue_depth", w.depth}, {"dropped", w.dropped_full}}},
+                         {"writer", {{"written", w.written}, {"queue_depth", w.depth}, {"dropped", w.dropped}}},
                          {"stream_clients", c.stream_clients.load()}}
                         .dump();
       cache->at = now;
@@ -199,10 +196,10 @@ void add_status_routes(httplib::Server& s, ApiContext& c) {
     send_json(res, rig_json(c.daemon, rig_of(c, req.matches[1].str())));
   }));
   // The operator's e-stop and reset: straight to the rig's thread, whatever runs (or nothing).
-  s.Post(R"(/api/rigs/([^/]+)/(reset|estop))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+  post_route(s, c, R"(/api/rigs/([^/]+)/(reset|estop))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     const std::size_t k = rig_of(c, req.matches[1].str());
     const std::string verb = req.matches[2].str();
-    c.daemon.rig_command(k, verb == "reset" ? daemon::RigCommand::reset : daemon::RigCommand::estop);
+    c.daemon.rig_command(k, verb == "reset" ? control::RigCommand::reset : control::RigCommand::estop);
     send_json(res, json{{"rig", c.daemon.rig_info(k).name}, {"command", verb}, {"accepted", true}, {"state", c.daemon.rig_supervision(k).state}}, 202);
   }));
   s.Get("/metrics", guarded([&c](const httplib::Request&, httplib::Response& res) {

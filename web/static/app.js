@@ -1,58 +1,55 @@
 // hystlab's page: follows the daemon over its API and its event stream (docs/API.md).
+// The pieces: the rig panel (rigs.js), the form (form.js), data quality (quality.js), the
+// plots (plots.js); this file holds the campaign being shown and the live stream.
+import { api, post, token } from './api.js';
 import { XYPlot, TimePlot, TriangleHeatmap } from './plots.js';
+import { RigPanel } from './rigs.js';
+import { PlanForm } from './form.js';
+import { showQuality } from './quality.js';
+import { count, num, round2, roughly, localTime, el } from './fmt.js';
 
 const $ = id => document.getElementById(id);
-const KEEP = 20000;  // samples kept per plot
+const KEEP = 20000;         // live samples kept per plot
+const LOOP_POINTS = 2000;   // the completed loop, from the server (shape-preserving)
 
 const S = {
-  campaigns: [], selected: null, follow: true, detail: null, runId: null,
-  loopX: [], loopY: [], modelTable: null, trans: [], lastEventId: '', es: null, online: false,
+  campaigns: [], selected: null, follow: true, detail: null, runId: null, events: [],
+  trans: [], lastEventId: '', es: null, online: false, warnings: [], loopInfo: null,
 };
 
 const loop = new XYPlot($('loop-plot'), 'displacement (mm)', 'force (N)',
-  [{ label: 'measured', color: '#1565c0' }, { label: 'identified model', color: '#ef6c00', width: 2 }]);
+  [{ label: 'measured', color: '#1565c0', width: 1.2 }, { label: 'identified model', color: '#ef6c00', width: 2 }]);
 const heat = new TriangleHeatmap($('heatmap-plot'));
 const timeplot = new TimePlot($('time-plot'), ['displacement (mm)', 'force (N)']);
-const trans = new XYPlot($('trans-plot'), 'frequency (Hz)', 'mass / base amplitude', [{ label: 'transmissibility', color: '#6a1b9a', points: true }]);
+const trans = new XYPlot($('trans-plot'), 'frequency (Hz)', 'mass / base amplitude', [{ label: 'transmissibility', color: '#6a1b9a', points: true }],
+  { aspect: 0.5, maxHeight: 420 });
+const rigPanel = new RigPanel($('rigs'), { onChange: rigs => planForm.setRigs(rigs) });
+// In the chain with the stream's handlers: a select() running beside them would reset what
+// they just added (a sweep's first transmissibility point, say).
+const planForm = new PlanForm($('plan-form'), { rigPanel, onSubmitted: c => serial(async () => { S.follow = true; await refreshList(); if (S.selected !== c.id) await select(c.id); })() });
 
 // For tests and the curious: what the page shows, as numbers.
 window.hystlab = {
   state: () => S.detail && S.detail.state, selected: () => S.selected,
   loopPoints: () => loop.points(0), modelPoints: () => loop.points(1),
-  heatmapIdentified: () => heat.identified(), heatmapRequired: () => heat.required(),
+  loopPath: () => loop.path(0), modelPath: () => loop.path(1), loopInfo: () => S.loopInfo,
+  loadLoop: points => new Promise((resolve, reject) => serial(() => loadLoop(points).then(resolve, reject))()),
+  heatmapIdentified: () => heat.identified(), heatmapRequired: () => heat.required(), heatmapLimits: () => heat.limits(),
   transmissibilityPoints: () => trans.points(0), online: () => S.online,
+  rigs: () => rigPanel.rigs(), warnings: () => S.warnings.slice(),
 };
-
-// ---- API ----
-const API_TIMEOUT_MS = 20000;  // a request that never ends must not stall every later update
-async function api(path, options = {}) {
-  const headers = Object.assign({}, options.body ? { 'Content-Type': 'application/json' } : {}, options.headers || {});
-  const token = sessionStorage.getItem('hystlab-token');
-  if (token && options.method && options.method !== 'GET') headers.Authorization = 'Bearer ' + token;
-  const res = await fetch(path, Object.assign({ signal: AbortSignal.timeout(API_TIMEOUT_MS) }, options, { headers }));
-  const body = res.headers.get('Content-Type')?.includes('json') ? await res.json() : await res.text();
-  if (res.status === 401 && !options.retried) {
-    const t = window.prompt('This daemon needs its token for changes:');
-    if (t) { sessionStorage.setItem('hystlab-token', t); return api(path, Object.assign({}, options, { retried: true })); }
-  }
-  if (!res.ok) throw new Error(body && body.error ? `${body.error}: ${body.detail}` : `HTTP ${res.status}`);
-  return body;
-}
 
 // ---- the campaign list and the selected campaign ----
 async function refreshList() {
   S.campaigns = await api('/api/campaigns');
-  const ul = $('campaigns');
-  ul.replaceChildren(...S.campaigns.slice().reverse().map(c => {
-    const li = document.createElement('li');
-    li.textContent = `#${c.id} ${c.kind} — ${c.state}` + (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : '');
-    li.dataset.id = c.id;
-    li.className = c.id === S.selected ? 'selected' : '';
+  $('campaigns').replaceChildren(...S.campaigns.slice().reverse().map(c => {
+    const li = el('li', { 'data-id': c.id, class: c.id === S.selected ? 'selected' : '',
+                          text: `#${c.id} ${c.kind} — ${c.state}` + (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : '') });
     li.addEventListener('click', serial(() => { S.follow = false; return select(c.id); }));
     return li;
   }));
   if (S.follow) {
-    const live = S.campaigns.find(c => ['running', 'paused', 'arming'].includes(c.state));
+    const live = S.campaigns.find(c => c.active);
     const pick = live || S.campaigns[S.campaigns.length - 1];
     if (pick && pick.id !== S.selected) await select(pick.id);
   }
@@ -61,14 +58,13 @@ async function refreshList() {
 async function select(id) {
   S.selected = id;
   for (const li of $('campaigns').children) li.className = Number(li.dataset.id) === id ? 'selected' : '';
-  S.loopX = []; S.loopY = []; S.modelTable = null; S.trans = [];
+  S.trans = []; S.loopInfo = null;
   loop.set(0, [], []); loop.set(1, [], []); timeplot.clear();
   heat.setGrid(null);
   await refreshDetail();  // for a FOT campaign, with its nodes
   const d = S.detail;
   if (d.kind === 'sine') { S.trans = await api(`/api/campaigns/${id}/transmissibility`); drawTrans(); }
-  if (S.runId) await loadRun(S.runId);
-  await overlayModel();
+  if (S.runId) { await loadRun(S.runId); await loadLoop(LOOP_POINTS); }
   redraw();
 }
 
@@ -83,65 +79,90 @@ async function loadNodes(id) {
 async function refreshDetail() {
   if (S.selected == null) return;
   const d = S.detail = await api(`/api/campaigns/${S.selected}`);
+  // The list follows too: a state change the stream did not bring (a starved machine) would
+  // leave "running" in the list beside "completed" in the header.
+  const listed = S.campaigns.find(c => c.id === d.id);
+  if (listed && listed.state !== d.state) {
+    await refreshList();
+    if (S.selected !== d.id) return;  // the list moved the page to another campaign
+  }
   // The stored count is the truth: a node missed on the stream (or a failed load) is fetched again.
   if (d.kind === 'fot' && d.progress && (heat.grid ? d.progress.nodes !== heat.identified() : true)) await loadNodes(d.id);
   S.runId = d.runs.length ? d.runs[d.runs.length - 1].id : null;
   $('title').textContent = `Campaign #${d.id}: ${d.kind} on ${d.rig}`;
   $('state').textContent = d.state;
   $('state').className = 'state ' + d.state;
-  const active = ['running', 'paused', 'arming'].includes(d.state);
-  $('pause').disabled = d.state !== 'running';
-  $('resume').disabled = !(d.state === 'paused' || d.state === 'interrupted');
-  $('abort').disabled = !(active || d.state === 'queued');
+  // The server says which commands apply in this state (GET /api/campaigns/ID: commands).
+  const can = cmd => (d.commands || []).includes(cmd);
+  $('pause').disabled = !can('pause');
+  $('resume').disabled = !can('resume');
+  $('abort').disabled = !can('abort');
   document.querySelector('.fot-only').hidden = d.kind !== 'fot';
   document.querySelector('.sine-only').hidden = d.kind !== 'sine';
   const shaker = d.kind === 'sine';
   timeplot.setLabels(shaker ? ['base displacement (mm)', 'mass displacement (mm)'] : ['displacement (mm)', 'force (N)']);
-  $('loop-caption').textContent = shaker ? 'Mass against base displacement' : 'Force–displacement';
   $('time-caption').textContent = shaker ? 'Base and mass displacement against time' : 'Displacement and force against time';
   loop.relabel(shaker ? 'base displacement (mm)' : 'displacement (mm)', shaker ? 'mass displacement (mm)' : 'force (N)');
-  showProgress(d);
+  showLoopCaption();
   showAccuracy(d);
+  S.warnings = showQuality(d, $('quality'), $('warnings'));
   showDownloads(d);
-  const events = await api(`/api/campaigns/${d.id}/events`);
-  $('events').replaceChildren(...events.slice(-50).reverse().map(e => {
-    const li = document.createElement('li');
-    li.textContent = `${e.at} ${e.kind}${e.to ? ' → ' + e.to : ''}: ${describe(e)}`;
-    return li;
-  }));
+  S.events = await api(`/api/campaigns/${d.id}/events`);
+  showProgress(d);
+  $('events').replaceChildren(...S.events.slice(-50).reverse().map(e =>
+    el('li', { text: `${localTime(e.at)} ${e.kind}${e.to ? ' → ' + e.to : ''}: ${describe(e)}` })));
 }
 
 function describe(e) {
   const d = e.detail;
   if (typeof d === 'string') return d;
-  if (e.kind === 'fit' && d && d.accuracy) return `partial table of ${d.nodes}/${d.required} nodes: RMS ${d.accuracy.overall.rms_N.toFixed(2)} N over the samples so far`;
-  if (e.kind === 'transmissibility' && d) return `${d.frequency_hz.toFixed(2)} Hz: ratio ${d.ratio.toFixed(3)}`;
+  if (!d) return '';
+  if (e.kind === 'fit' && d.accuracy) return `partial table of ${d.nodes}/${d.required} nodes: RMS ${round2(d.accuracy.overall.rms_N)} N over the samples so far`;
+  if (e.kind === 'transmissibility') return `${num(d.frequency_hz)} Hz: ratio ${num(d.ratio)}`;
+  if (e.kind === 'gap') return `no samples for ${num(d.length_ms / 1000, 2)} s of rig time (from ${num(d.from_s)} s)`;
+  if (e.kind === 'gaps') return `${d.count} holes in the time axis, ${num(d.total_ms / 1000, 2)} s in all, the longest ${num(d.longest_ms / 1000, 2)} s`;
+  if (e.kind === 'quality') return `run #${d.run}: ${d.samples} samples at ${num(d.rate_hz, 3)} Hz of rig time, ${d.missed_deadlines} missed deadlines, ` +
+    `${d.lost_samples} lost samples, ${d.io_errors} I/O errors, ${d.gaps} gaps`;
+  if (e.kind === 'limits') return Object.entries(d).map(([k, v]) => `${k.replace(/_/g, ' ')} ${Array.isArray(v) ? v.map(x => num(x)).join('…') : num(v)}`).join(', ');
   return JSON.stringify(d);
+}
+
+// Seconds the campaign has spent running, from its state events: paused (or held) time does
+// not count, so the ETA does not jump after a pause.
+function activeSeconds(events, now) {
+  let total = 0, since = null;
+  for (const e of Array.isArray(events) ? events : []) {  // a failed events request leaves no list
+    if (e.kind !== 'state' && e.kind !== 'campaign') continue;
+    const t = Date.parse(e.at);
+    if (!Number.isFinite(t)) continue;
+    if (e.to === 'running') { if (since == null) since = t; } else if (since != null) { total += t - since; since = null; }
+  }
+  if (since != null) total += Math.max(0, now - since);
+  return total / 1000;
 }
 
 function showProgress(d) {
   if (!d.progress) { $('progress').textContent = ''; $('eta').textContent = ''; return; }
   const k = d.progress.nodes, n = d.progress.required;
   $('progress').textContent = `node ${k} of ${n}`;
-  const run = d.runs[d.runs.length - 1];
-  if (d.state === 'running' && run && k > 0 && k < n) {
-    const elapsed = (Date.now() - Date.parse(run.started_at)) / 1000;
-    $('eta').textContent = `ETA ${Math.round(elapsed / k * (n - k))} s`;
-  } else $('eta').textContent = '';
+  const active = activeSeconds(S.events, Date.now());
+  $('eta').textContent = d.state === 'running' && k > 0 && k < n && active > 0 ? `ETA ${roughly(active / k * (n - k))}` : '';
   $('coverage').textContent = `— ${k} of ${n} nodes identified`;
 }
 
+// One line per table: "RMS 3.2 N (0.4 % of range) · max 12 N": the percentage is the RMS's.
 function showAccuracy(d) {
-  const parts = [];
-  if (d.fit && d.fit.accuracy) parts.push(`partial table (${d.fit.nodes}/${d.fit.required} nodes): RMS ${d.fit.accuracy.overall.rms_N.toFixed(2)} N`);
+  const line = (what, a) => `${what}: RMS ${round2(a.rms_N)} N (${num(100 * a.rms_norm, 2)} % of range) · max ${round2(a.max_N)} N`;
+  const lines = [];
+  if (d.fit && d.fit.accuracy && !d.tables.length) lines.push(line(`partial table (${d.fit.nodes}/${d.fit.required} nodes, samples so far)`, d.fit.accuracy.overall));
   for (const t of d.tables) {
     const a = t.accuracy && t.accuracy.overall;
-    if (a) parts.push(`table #${t.id} (${t.method}, n=${t.n}): RMS ${a.rms_N.toFixed(2)} N, max ${a.max_N.toFixed(2)} N (${(100 * a.rms_norm).toFixed(1)} % of range)`);
+    if (a) lines.push(line(`table #${t.id} (${t.method}, n = ${t.n})`, a));
   }
-  $('accuracy').textContent = parts.join(' · ');
+  $('accuracy').replaceChildren(...lines.map(l => el('div', { text: l })));
 }
 
-function link(href, text) { const a = document.createElement('a'); a.href = href; a.textContent = text; a.setAttribute('download', ''); return a; }
+function link(href, text) { return el('a', { href, download: true, text }); }
 function showDownloads(d) {
   const links = [];
   for (const t of d.tables)
@@ -150,26 +171,44 @@ function showDownloads(d) {
   $('downloads').replaceChildren(...links);
 }
 
-// The run's history, decimated by the server (min and max per bucket: no peak is lost).
+// The run's history against time, decimated by the server (min and max per bucket, both drawn).
 async function loadRun(runId) {
+  if (S.detail.kind === 'sine') return;  // the sweep's signals come live; its history is the .csv
   const s = await api(`/api/runs/${runId}/samples?points=3000`);
-  const x = [], y = [], t = [], a = [], b = [];
-  for (let k = 0; k < s.buckets; k++) {
-    x.push(s.displacement_min_mm[k], s.displacement_max_mm[k]);
-    y.push(s.force_min_N[k], s.force_max_N[k]);
-    t.push(s.t_min[k]); a.push(s.displacement_min_mm[k]); b.push(s.force_min_N[k]);
-  }
-  if (S.detail.kind !== 'sine') { S.loopX = x; S.loopY = y; timeplot.clear(); timeplot.push(t, a, b, KEEP); }
+  if (runId !== S.runId) return;
+  timeplot.setBuckets(s, s.displacement_min_mm, s.displacement_max_mm, s.force_min_N, s.force_max_N);
 }
 
-// The newest table of the campaign, evaluated on the measured displacement (Figs. 14-16).
-async function overlayModel() {
-  const d = S.detail;
-  const table = d && d.tables.find(t => t.method === 'fot');
-  if (!table || !S.loopX.length) return;
-  const r = await api('/api/evaluate', { method: 'POST', body: JSON.stringify({ table_id: table.id, displacement_mm: S.loopX }) });
-  S.modelTable = table.id;
-  loop.set(1, S.loopX.slice(), r.force_N);
+// The run's loop from the server, in sample order with every reversal kept, and the identified
+// model's force on the same x (computed there: no samples travel through the browser). An older
+// daemon has no /loop: the loop is then what the stream brought, if anything.
+async function loadLoop(points = LOOP_POINTS) {
+  const runId = S.runId;
+  if (!runId) return false;
+  let l;
+  // The first request for a long run reads it from SQLite (about 4-7 s per 10^6 samples on a
+  // small machine): a longer wait than other requests, which must never stall the page.
+  try { l = await api(`/api/runs/${runId}/loop?points=${points}`, { signal: AbortSignal.timeout(120000) }); } catch (e) {
+    if (e.status === 404) return false;
+    throw e;
+  }
+  if (runId !== S.runId || !l || !Array.isArray(l.x)) return false;
+  if (l.x_label && l.y_label) loop.relabel(l.x_label, l.y_label);
+  loop.set(0, l.x, l.y);
+  const model = l.model && Array.isArray(l.model.force_N) ? l.model : null;
+  loop.set(1, model ? l.x : [], model ? model.force_N : []);
+  S.loopInfo = { samples: l.samples, reversals: l.reversals, points: l.x.length, table: model ? model.table : null };
+  showLoopCaption();
+  redraw();
+  return true;
+}
+
+function showLoopCaption() {
+  const shaker = S.detail && S.detail.kind === 'sine', i = S.loopInfo;
+  let text = shaker ? 'Mass against base displacement' : 'Force–displacement';
+  if (i) text += ` — ${count(i.samples)} samples, ${count(i.reversals)} reversals (drawn with ${count(i.points)} points)` +
+    (i.table ? `; orange: table #${i.table}` : '');
+  $('loop-caption').textContent = text;
 }
 
 function drawTrans() {
@@ -178,19 +217,18 @@ function drawTrans() {
   trans.redraw();
 }
 
-function redraw() {
-  loop.set(0, S.loopX, S.loopY);
-  loop.redraw(); timeplot.redraw(); heat.redraw();
-}
+function redraw() { loop.redraw(); timeplot.redraw(); heat.redraw(); }
 
 // Handlers that refresh from the API run one after another, so an older answer never
 // overwrites a newer one.
 let chain = Promise.resolve();
-const serial = fn => (...args) => { chain = chain.then(() => fn(...args)).catch(e => console.warn(e)); };
+const serial = fn => (...args) => { chain = chain.then(() => fn(...args)).catch(e => console.warn(e)); return chain; };
 
 // ---- live: the event stream (reconnects by itself, resuming after the last record seen) ----
 function connect() {
-  const url = '/api/stream?rate=50' + (S.lastEventId ? '&last_event_id=' + encodeURIComponent(S.lastEventId) : '');
+  const t = token();
+  const url = '/api/stream?rate=50' + (S.lastEventId ? '&last_event_id=' + encodeURIComponent(S.lastEventId) : '') +
+    (t ? '&token=' + encodeURIComponent(t) : '');
   const es = S.es = new EventSource(url);
   es.addEventListener('hello', serial(async () => {
     setOnline(true);
@@ -216,34 +254,15 @@ function setOnline(on) {
 
 async function refreshStatus() {
   const s = await api('/api/status');
-  $('daemon').textContent = `hystlabd ${s.version} · ${s.rigs.map(r => r.name).join(', ')}`;
-  const chosen = form.rig.value;
-  form.rig.replaceChildren(...s.rigs.map(r => {
-    const o = document.createElement('option');
-    o.value = r.name; o.textContent = `${r.name} (${r.kind === 'shaker' ? 'shaker' : 'load frame'})`; o.dataset.kind = r.kind;
-    return o;
-  }));
-  if (chosen) form.rig.value = chosen;
-  else pickRigFor(form.kind.value);
-}
-
-// The first rig that can run this kind of plan (a sine sweep needs a shaker).
-function pickRigFor(kind) {
-  const want = kind === 'sine' ? 'shaker' : 'load_frame';
-  const o = [...form.rig.options].find(x => x.dataset.kind === want);
-  if (o) form.rig.value = o.value;
+  $('daemon').textContent = `hystlabd ${s.version}`;
+  if (!rigPanel.rigs().length) planForm.setRigs(s.rigs);
 }
 
 function onSamples(m) {
   if (!S.detail || m.run !== S.runId) return;
-  if (S.detail.kind === 'sine') {
-    timeplot.push(m.t, m.cmd, m.disp, KEEP);
-    for (let k = 0; k < m.t.length; k++) { S.loopX.push(m.cmd[k]); S.loopY.push(m.disp[k]); }
-  } else {
-    timeplot.push(m.t, m.disp, m.force, KEEP);
-    for (let k = 0; k < m.t.length; k++) { S.loopX.push(m.disp[k]); S.loopY.push(m.force[k]); }
-  }
-  if (S.loopX.length > KEEP * 2) { S.loopX.splice(0, S.loopX.length - KEEP); S.loopY.splice(0, S.loopY.length - KEEP); }
+  if (S.detail.kind === 'sine') { timeplot.push(m.t, m.cmd, m.disp, KEEP); loop.append(0, m.cmd, m.disp); }
+  else { timeplot.push(m.t, m.disp, m.force, KEEP); loop.append(0, m.disp, m.force); }
+  if (loop.points(0) > KEEP * 2) loop.trim(0, KEEP);
   scheduleRedraw();
 }
 
@@ -251,13 +270,20 @@ let redrawPending = false;
 function scheduleRedraw() {
   if (redrawPending) return;
   redrawPending = true;
-  requestAnimationFrame(() => { redrawPending = false; redraw(); });
+  requestAnimationFrame(() => { redrawPending = false; loop.redraw(); timeplot.redraw(); });
 }
 
 async function onCampaign(ev) {
   await refreshList();
-  if (ev.campaign === S.selected) { await refreshDetail(); if (ev.to === 'running' && !S.runId) await select(ev.campaign); }
-  if (S.follow && ev.to === 'arming') await select(ev.campaign);
+  if (ev.campaign === S.selected) {
+    const before = S.runId;
+    await refreshDetail();
+    // A new run (started, or resumed after an interruption): show it from its start. Only
+    // then: selecting again would throw away the live samples already drawn.
+    if (S.runId !== before) await select(ev.campaign);
+    // Ended: the whole run from the store (a sine sweep makes no table to trigger it).
+    else if (ev.final && S.runId) { await loadRun(S.runId); await loadLoop(LOOP_POINTS); redraw(); }
+  } else if (S.follow && ev.to === 'arming') await select(ev.campaign);
 }
 function onNode(n) {
   if (n.campaign !== S.selected) return;
@@ -268,8 +294,7 @@ function onNode(n) {
 async function onTable(t) {
   if (t.campaign !== S.selected) return;
   await refreshDetail();
-  if (S.runId) await loadRun(S.runId);  // the whole run at full detail, not the live decimation
-  await overlayModel();
+  if (S.runId) { await loadRun(S.runId); await loadLoop(LOOP_POINTS); }  // the whole run, with the model
   redraw();
 }
 async function onRecord(kind, r) {
@@ -278,52 +303,19 @@ async function onRecord(kind, r) {
   await refreshDetail();
 }
 
-// ---- controls ----
+// ---- controls: no body (the server takes an empty POST) ----
 for (const verb of ['pause', 'resume', 'abort']) {
   $(verb).addEventListener('click', async () => {
     $('command-error').textContent = '';
-    try { await api(`/api/campaigns/${S.selected}/${verb}`, { method: 'POST' }); } catch (e) { $('command-error').textContent = e.message; }
+    try { await post(`/api/campaigns/${S.selected}/${verb}`); } catch (e) { $('command-error').textContent = `${verb}: ${e.message}`; }
   });
 }
 
-const form = $('plan-form');
-form.kind.addEventListener('change', () => {
-  form.querySelector('.fot').hidden = form.kind.value !== 'fot';
-  form.querySelector('.sine').hidden = form.kind.value !== 'sine';
-  pickRigFor(form.kind.value);
-});
-
-function planFromForm() {
-  if (form.json.value.trim()) return JSON.parse(form.json.value);
-  const num = name => Number(form[name].value);
-  if (form.kind.value === 'sine') {
-    return { kind: 'sine', frequencies_hz: form.freqs.value.split(',').map(Number), amplitude_mm: num('amp'),
-             settle_cycles: num('settle'), measured_cycles: num('measured'), sample_rate_hz: num('hz') };
-  }
-  const lo = num('lo'), hi = num('hi'), span = hi - lo;
-  return { kind: 'fot', range_mm: [lo, hi], subdivisions: num('n'), ramp_rate_mm_s: num('rate'), dwell_s: num('dwell'),
-           sample_rate_hz: num('hz'), limits: { displacement_mm: [lo - 0.1 * span, hi + 0.1 * span], force_N: num('force'), rate_mm_s: 20 * num('rate') } };
-}
-
-form.addEventListener('submit', e => {
-  e.preventDefault();
-  $('form-error').textContent = '';
-  serial(async () => {
-    try {
-      const body = { plan: planFromForm() };
-      if (form.rig.value) body.rig = form.rig.value;
-      const c = await api('/api/campaigns', { method: 'POST', body: JSON.stringify(body) });
-      S.follow = true;
-      await refreshList();
-      await select(c.id);
-    } catch (err) { $('form-error').textContent = err.message; }
-  })();
-});
-
+rigPanel.start();
 connect();
 // Now and then, the selected campaign from the API, while it is live: a record the stream
-// missed (or a request that failed) never leaves the page stale for long.
+// missed (or a request that failed) never leaves the page stale for long; the ETA moves on.
 setInterval(() => {
   const d = S.detail;
-  if (S.online && d && ['queued', 'arming', 'running', 'paused'].includes(d.state)) serial(refreshDetail)();
+  if (S.online && d && !d.final) serial(refreshDetail)();
 }, 5000);

@@ -1,9 +1,9 @@
 // The page's plots, all drawn by uPlot (served from npm's package by the daemon): the
 // force-displacement loop and the transmissibility as x-y plots, signals against time, and the
-// Preisach triangle as a heatmap drawn in a uPlot plot's own coordinates.
+// Preisach triangle as a heatmap drawn in a uPlot plot's own coordinates. Every plot takes its
+// width from its container and follows it (ResizeObserver), so a wide screen is used.
 /* global uPlot */
-
-const W = 460, H = 320;
+import { num, round2 } from './fmt.js';
 
 // Range of a set of arrays with a margin; a fallback when empty.
 function extent(arrays, fallback) {
@@ -14,22 +14,59 @@ function extent(arrays, fallback) {
   return [lo - pad, hi + pad];
 }
 
-// An x-y plot (uPlot's mode 2): series of [xs, ys] drawn as lines in the order given.
+// Calls fn(width) when the element's width changes (not its height: that is ours to set).
+function onWidth(el, fn) {
+  let last = 0;
+  new ResizeObserver(entries => {
+    const w = Math.floor(entries[0].contentRect.width);
+    if (w > 0 && Math.abs(w - last) >= 2) { last = w; fn(w); }
+  }).observe(el);
+}
+
+// The x-y path in sample order, through every point. uPlot's own path builders thin points
+// per pixel column assuming x only increases; a hysteresis loop goes back and forth in x, so
+// they dropped the unloading branches. A break (NaN) lifts the pen.
+function inOrder(u, si) {
+  const [xs, ys] = u.data[si];
+  const p = new Path2D();
+  let pen = false;
+  for (let i = 0; i < xs.length; i++) {
+    const x = xs[i], y = ys[i];
+    if (!Number.isFinite(x) || !Number.isFinite(y)) { pen = false; continue; }
+    const px = u.valToPos(x, 'x', true), py = u.valToPos(y, 'y', true);
+    if (pen) p.lineTo(px, py); else { p.moveTo(px, py); pen = true; }
+  }
+  return { stroke: p, fill: null, clip: null, band: null, gaps: null, flags: 0 };
+}
+
+// An x-y plot (uPlot's mode 2): series of [xs, ys] drawn as paths in the order given.
 export class XYPlot {
-  constructor(el, xLabel, yLabel, series) {
-    this.el = el; this.series = series;
+  constructor(el, xLabel, yLabel, series, { aspect = 0.62, maxHeight = 640, minHeight = 240 } = {}) {
+    this.el = el; this.series = series; this.aspect = aspect; this.maxHeight = maxHeight; this.minHeight = minHeight;
     this.data = series.map(() => [[], []]);
     this.build(xLabel, yLabel);
+    onWidth(el, w => this.u.setSize(this.size(w)));
+  }
+  size(w = this.el.clientWidth) {
+    const width = Math.max(200, w);
+    return { width, height: Math.round(Math.min(this.maxHeight, Math.max(this.minHeight, width * this.aspect))) };
   }
   build(xLabel, yLabel) {
-    const series = this.series;
     this.labels = [xLabel, yLabel];
     const opts = {
-      mode: 2, width: W, height: H, legend: { live: false },
+      mode: 2, ...this.size(), legend: { live: false },
+      // No drag-zoom: the scales are ours (redraw), a zoom would be undone by the next sample.
+      cursor: { drag: { x: false, y: false, setScale: false }, points: { show: false } },
       scales: { x: { time: false, auto: false }, y: { auto: false } },
       axes: [{ label: xLabel }, { label: yLabel }],
-      series: [{}, ...series.map(s => ({ label: s.label, stroke: s.color, width: s.width || 1.5, points: { show: !!s.points, size: 5, fill: s.color },
-                                         facets: [{ scale: 'x', auto: true }, { scale: 'y', auto: true }] }))],
+      series: [{}, ...this.series.map(s => ({
+        label: s.label, stroke: s.color, width: s.width || 1.5, paths: s.points ? undefined : inOrder,
+        points: { show: !!s.points, size: 5, fill: s.color },
+        facets: [{ scale: 'x', auto: false }, { scale: 'y', auto: false }],
+      }))],
+      // A legend click hides that series only; the scales stay those of all the data, so the
+      // other series is drawn as before (uPlot re-ranged from the hidden one, blanking it).
+      hooks: { setSeries: [() => this.redraw()] },
     };
     this.u = new uPlot(opts, [null, ...this.data], this.el);
   }
@@ -40,8 +77,12 @@ export class XYPlot {
     this.build(xLabel, yLabel);
   }
   set(k, xs, ys) { this.data[k] = [xs, ys]; }
+  append(k, xs, ys) { const d = this.data[k]; for (let i = 0; i < xs.length; i++) { d[0].push(xs[i]); d[1].push(ys[i]); } }
+  // Keep the newest `keep` points of series k (a live loop must not grow without end).
+  trim(k, keep) { const d = this.data[k]; if (d[0].length > keep) { const n = d[0].length - keep; d[0].splice(0, n); d[1].splice(0, n); } }
   points(k) { return this.data[k][0].length; }
-  // uPlot's x-y mode does not range its scales from the data: we do.
+  path(k) { return { x: this.data[k][0].slice(), y: this.data[k][1].slice() }; }
+  // uPlot's x-y mode does not range its scales from the data: we do, over every series.
   redraw() {
     const [x0, x1] = extent(this.data.map(d => d[0]), [0, 1]), [y0, y1] = extent(this.data.map(d => d[1]), [0, 1]);
     this.u.batch(() => {
@@ -58,11 +99,12 @@ export class TimePlot {
     this.el = el;
     this.t = []; this.a = []; this.b = [];
     this.build(labels);
+    onWidth(el, w => this.u.setSize({ width: Math.max(200, w), height: 260 }));
   }
   build(labels) {
     this.labels = labels;
     this.u = new uPlot({
-      width: W * 2 + 20, height: 240, legend: { live: false },
+      width: Math.max(200, this.el.clientWidth), height: 260, legend: { live: false },
       scales: { x: { time: false }, a: {}, b: {} },
       axes: [{ label: 'rig time (s)' }, { scale: 'a', label: labels[0], stroke: '#1565c0' },
              { scale: 'b', side: 1, label: labels[1], stroke: '#c62828', grid: { show: false } }],
@@ -82,32 +124,61 @@ export class TimePlot {
     }
     if (this.t.length > keep) { const d = this.t.length - keep; this.t.splice(0, d); this.a.splice(0, d); this.b.splice(0, d); }
   }
+  // The server's history: the min and the max of each bucket. Both are drawn, as a zig-zag
+  // (min at the bucket's start, max at its end), so no peak is lost to the decimation.
+  setBuckets(s, aMin, aMax, bMin, bMax) {
+    this.clear();
+    for (let k = 0; k < s.buckets; k++) {
+      this.t.push(s.t_min[k], s.t_max[k] > s.t_min[k] ? s.t_max[k] : s.t_min[k] + 1e-9);
+      this.a.push(aMin[k], aMax[k]); this.b.push(bMin[k], bMax[k]);
+    }
+  }
   redraw() { this.u.setData([this.t, this.a, this.b]); }
 }
 
-// A blue-to-yellow scale (viridis endpoints, interpolated through three stops).
-function colour(v) {
-  const stops = [[68, 1, 84], [33, 145, 140], [253, 231, 37]];
-  const x = Math.min(1, Math.max(0, v)) * 2, k = Math.min(1, Math.floor(x)), f = x - k;
-  const c = stops[k].map((s, i) => Math.round(s + (stops[k + 1][i] - s) * f));
+// Viridis through five stops: readable in grey too.
+const VIRIDIS = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
+export function colour(v) {
+  const x = Math.min(1, Math.max(0, v)) * (VIRIDIS.length - 1), k = Math.min(VIRIDIS.length - 2, Math.floor(x)), f = x - k;
+  const c = VIRIDIS[k].map((s, i) => Math.round(s + (VIRIDIS[k + 1][i] - s) * f));
   return `rgb(${c[0]},${c[1]},${c[2]})`;
+}
+// The next "round" number at or above v (1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k).
+function niceUp(v) {
+  if (!(v > 0)) return 1;
+  const p = 10 ** Math.floor(Math.log10(v));
+  for (const m of [1, 1.5, 2, 2.5, 3, 4, 5, 6, 8, 10]) if (m * p >= v * (1 - 1e-9)) return m * p;
+  return 10 * p;
 }
 
 // The Preisach triangle: one square per node (δ_j, δ_i), j ≤ i, coloured by F(δ_i, δ_j);
 // nodes not yet identified are grey with a cross. α up, β across (the paper's Fig. 13).
+// The colour limits are fixed by the first nodes and only ever extend (to a round number), so
+// the colours of the nodes already drawn do not shift as each new node arrives.
 export class TriangleHeatmap {
   constructor(el) {
-    this.grid = null;      // {n, lo_mm, hi_mm}
+    this.grid = null;        // {n, lo_mm, hi_mm}
     this.values = new Map(); // "i,j" -> F
+    this.lim = null;         // [lo, hi] of the colour scale (N)
+    this.el = el;
+    const plotEl = document.createElement('div');
+    this.scaleEl = document.createElement('div'); this.scaleEl.className = 'colour-scale';
+    this.readout = document.createElement('div'); this.readout.className = 'readout';
+    this.readout.textContent = 'hover over a cell for its α, β and F';
+    el.append(plotEl, this.scaleEl, this.readout);
     const self = this;
     this.u = new uPlot({
-      width: W, height: H, legend: { show: false }, cursor: { show: false },
+      ...this.size(), legend: { show: false },
+      cursor: { x: false, y: false, points: { show: false }, drag: { x: false, y: false, setScale: false } },
       scales: { x: { time: false, auto: false }, y: { auto: false } },
       axes: [{ label: 'β (mm)' }, { label: 'α (mm)' }],
       series: [{}, { stroke: 'transparent' }],
-      hooks: { draw: [u => self.draw(u)] },
-    }, [[0, 1], [null, null]], el);
+      hooks: { draw: [u => self.draw(u)], setCursor: [u => self.hover(u)] },
+    }, [[0, 1], [null, null]], plotEl);
+    onWidth(el, w => this.u.setSize(this.size(w)));
+    this.drawScale();
   }
+  size(w = this.el.clientWidth) { const width = Math.max(200, w); return { width, height: Math.round(Math.min(560, Math.max(240, width * 0.75))) }; }
   range() {
     if (!this.grid) return [0, 1];
     const h = (this.grid.hi_mm - this.grid.lo_mm) / this.grid.n;
@@ -117,7 +188,9 @@ export class TriangleHeatmap {
   setGrid(grid) {
     this.grid = grid;
     this.values.clear();
+    this.lim = null;
     this.u.setData([[grid ? grid.lo_mm : 0, grid ? grid.hi_mm : 1], [null, null]]);
+    this.drawScale();
   }
   node(i) { return this.grid.lo_mm + (this.grid.hi_mm - this.grid.lo_mm) * i / this.grid.n; }
   // A measured node: its (α, β) snapped to the grid.
@@ -127,19 +200,52 @@ export class TriangleHeatmap {
     const i = Math.round((alpha - this.grid.lo_mm) / h), j = Math.round((beta - this.grid.lo_mm) / h);
     if (i < 1 || i > this.grid.n || j < 0 || j >= i) return;
     this.values.set(`${i},${j}`, F);
+    this.extend(F);
+  }
+  extend(F) {
+    if (!Number.isFinite(F)) return;
+    if (!this.lim) {
+      // The first node sets the scale, with head room: F grows with α − β.
+      this.lim = [F < 0 ? -niceUp(-F * 1.25) : 0, F > 0 ? niceUp(F * 1.25) : 1];
+    } else if (F > this.lim[1]) this.lim[1] = niceUp(F * 1.25);
+    else if (F < this.lim[0]) this.lim[0] = -niceUp(-F * 1.25);
+    else return;
+    this.drawScale();
   }
   identified() { return this.values.size; }
   required() { return this.grid ? this.grid.n * (this.grid.n + 1) / 2 : 0; }
+  limits() { return this.lim ? this.lim.slice() : null; }
   redraw() {
     const [lo, hi] = this.range();
     this.u.batch(() => { this.u.setScale('x', { min: lo, max: hi }); this.u.setScale('y', { min: lo, max: hi }); });
     this.u.redraw();
   }
+  // The legend bar under the plot: the gradient with its limits in N, and what grey means.
+  drawScale() {
+    const lim = this.lim || [0, 1];
+    const bar = document.createElement('span'); bar.className = 'bar';
+    bar.style.background = `linear-gradient(to right, ${[0, 0.25, 0.5, 0.75, 1].map(colour).join(', ')})`;
+    const lo = document.createElement('span'); lo.textContent = this.lim ? `${round2(lim[0])} N` : '';
+    const hi = document.createElement('span'); hi.textContent = this.lim ? `${round2(lim[1])} N` : '';
+    const label = document.createElement('span'); label.textContent = 'F';
+    const none = document.createElement('span'); none.className = 'untouched'; none.textContent = 'not measured yet';
+    this.scaleEl.replaceChildren(label, lo, bar, hi, none);
+  }
+  // The cell under the pointer, read out below the plot.
+  hover(u) {
+    if (!this.grid || u.cursor.left == null || u.cursor.left < 0) return;
+    const b = u.posToVal(u.cursor.left, 'x'), a = u.posToVal(u.cursor.top, 'y');
+    const h = (this.grid.hi_mm - this.grid.lo_mm) / this.grid.n;
+    const i = Math.round((a - this.grid.lo_mm) / h), j = Math.round((b - this.grid.lo_mm) / h);
+    if (i < 0 || i > this.grid.n || j < 0 || j > i) { this.readout.textContent = 'hover over a cell for its α, β and F'; return; }
+    const where = `α = ${num(this.node(i))} mm, β = ${num(this.node(j))} mm`;
+    const F = i === j ? 0 : this.values.get(`${i},${j}`);
+    this.readout.textContent = F === undefined ? `${where}: not measured yet` : `${where}: F = ${round2(F)} N${i === j ? ' (zero on the diagonal)' : ''}`;
+  }
   draw(u) {
     if (!this.grid) return;
     const ctx = u.ctx, n = this.grid.n, h = (this.grid.hi_mm - this.grid.lo_mm) / n;
-    let fmax = 0;
-    for (const v of this.values.values()) fmax = Math.max(fmax, Math.abs(v));
+    const [flo, fhi] = this.lim || [0, 1];
     ctx.save();
     for (let i = 0; i <= n; i++) {
       for (let j = 0; j <= i; j++) {
@@ -148,7 +254,8 @@ export class TriangleHeatmap {
         const y0 = u.valToPos(a + h / 2, 'y', true), y1 = u.valToPos(a - h / 2, 'y', true);
         const key = `${i},${j}`;
         const known = i === j || this.values.has(key);  // F(δ_i, δ_i) = 0 by definition
-        ctx.fillStyle = known ? colour(i === j ? 0 : this.values.get(key) / (fmax || 1)) : '#cfd8dc';
+        const F = i === j ? 0 : this.values.get(key);
+        ctx.fillStyle = known ? colour((F - flo) / (fhi - flo || 1)) : '#cfd8dc';
         ctx.fillRect(x0, y0, x1 - x0 - 1, y1 - y0 - 1);
         if (!known) {
           ctx.strokeStyle = '#90a4ae';

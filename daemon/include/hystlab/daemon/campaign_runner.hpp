@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "hystlab/daemon/clock.hpp"
+#include "hystlab/db/campaign_enums.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/supervisor.hpp"
@@ -29,6 +30,8 @@ enum class Control { pause, resume, abort, estop };  // estop: the rig's e-stop,
 // What a campaign ends as: text only at the JSON/database edges.
 enum class CampaignEnd { none, completed, failed, aborted, interrupted };
 [[nodiscard]] const char* to_string(CampaignEnd e) noexcept;
+// The campaign's (and its run's) state for an end; running for none.
+[[nodiscard]] db::CampaignState state_of(CampaignEnd e) noexcept;
 
 struct RunSeries {  // the measured loop, kept for the fits (about 16 bytes per sample)
   std::vector<double> x, f;

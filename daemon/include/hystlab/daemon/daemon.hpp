@@ -11,13 +11,19 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <string_view>
+#include <utility>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "hystlab/control/values.hpp"
+#include "hystlab/control/http_config.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/live_feed.hpp"
+#include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/drivers/io_health.hpp"
@@ -47,18 +53,7 @@ struct RigEntry {
   SupervisionSettings supervision;  // "supervision": dead band, lag, settle, mode, heartbeat, ...
 };
 
-// The HTTP/JSON API and the page (web/). Binding anywhere but loopback needs a token, which every
-// request that changes state must carry; the daemon refuses to start otherwise.
-struct HttpConfig {
-  bool enabled = true;
-  std::string bind = "127.0.0.1";
-  int port = 8080;
-  std::string token;           // from the config, or $HYSTLAB_TOKEN
-  std::string web_root;        // the page; empty: the one built in (web/static of the source tree, or installed)
-  std::string vendor_root;     // the plotting library's files (npm's uplot/dist)
-  int max_stream_clients = 64; // SSE subscribers; each holds one pool thread
-  std::size_t max_body_bytes = 8U << 20;
-};
+using control::HttpConfig;
 
 struct DaemonConfig {
   std::string db_path = "hystlab.db";
@@ -75,28 +70,12 @@ struct DaemonConfig {
 // beyond loopback without a token.
 void check_http_security(HttpConfig& http, const char* env_token);
 
-struct RigInfo {
-  std::int64_t id = 0;
-  std::string name, kind, description;  // kind: "load_frame" or "shaker"
-  bool simulated = false;
-};
-
-// Operator commands for a rig itself, whatever campaign runs (or none).
-enum class RigCommand { reset, estop };
-
-// The rig's supervision as other threads see it (a copy, taken under a lock).
-struct RigSupervision {
-  std::string state = "disconnected";  // RigState, as text at this edge
-  bool latched = false, resetting = false, have_sample = false;
-  std::string latch_reason, reset_refusal;
-  std::uint16_t latched_fault_code = 0;  // the code that latched (0: an e-stop or none)
-  std::uint16_t status_word = 0, fault_code = 0;  // the last sample's
-  std::string fault_text;                          // the map's text for fault_code
-  double position_mm = 0, force_N = 0;
-  std::uint64_t link_losses = 0, transitions = 0;
-  std::vector<nlohmann::json> recent;  // the last transitions: at, t, from, to, reason
-  nlohmann::json envelope, supervision;
-};
+using control::CampaignCommand;
+using control::RigCommand;
+using control::RigInfo;
+using control::RigSupervision;
+using control::campaign_command_from;
+using control::to_string;
 
 // The daemon's owners: one acquisition thread per rig, the db writer thread, and the main loop
 // (run) that carries out commands and keeps the snapshots. Other threads (HTTP) read the
@@ -125,9 +104,11 @@ class Daemon {
   // Queues a campaign on a rig (empty name: the only rig). Throws std::invalid_argument naming
   // what is wrong (the plan's field, an unknown rig, a plan the rig cannot run).
   std::int64_t submit(const std::string& rig_name, const nlohmann::json& plan);
-  // pause, resume, abort, estop. A running campaign's goes straight to its rig's thread (never
-  // through the database, which may be busy); a queued or held one's through the main loop.
-  void command(std::int64_t campaign_id, const std::string& verb);
+  // What submit checks, without queuing: the plan parsed, for the rig (its index) it would run on.
+  [[nodiscard]] std::pair<Plan, std::size_t> check_plan(const std::string& rig_name, const nlohmann::json& plan) const;
+  // A running campaign's command goes straight to its rig's thread (never through the database,
+  // which may be busy); a queued or held one's through the main loop.
+  void command(std::int64_t campaign_id, CampaignCommand c);
   // reset or estop a rig: straight to its thread, from any state.
   void rig_command(std::size_t rig, RigCommand c);
 

@@ -7,14 +7,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "hystlab/control/values.hpp"
+
 namespace hystlab::daemon {
 
-struct LiveSample {
-  double mono_s = 0;  // host steady clock when acquired (the same clock in every process here)
-  double t = 0, cmd = 0, disp = 0, force = 0;  // shakers: base displacement, mass displacement, mass acceleration
-  std::int64_t run = 0;                        // 0: the rig is idle (a sample read between campaigns)
-  std::uint32_t status = 0;
-};
+using LiveSample = control::LiveSample;
 
 class LiveSampleRing {
  public:

@@ -12,11 +12,18 @@
 #include <string>
 #include <vector>
 
+#include "hystlab/control/values.hpp"
+#include "hystlab/db/campaign_enums.hpp"
+
 namespace hystlab::daemon {
 
-struct PlanError : std::invalid_argument {
-  using std::invalid_argument::invalid_argument;
-};
+// A refused plan: what() is the whole sentence ("plan: ramp_rate_mm_s must be between 0.0001 and
+// 20"), field the plan's field alone ("ramp_rate_mm_s", "limits.force_N"), so that a form can
+// mark the input it came from.
+using control::PlanError;
+
+// A number as people write it: 0.0001, 20, 1e+06 (not std::to_string's 0.000100).
+[[nodiscard]] std::string plan_number(double v);
 
 struct Limits {
   double displacement_min_mm = -1.0, displacement_max_mm = 10.0;
@@ -26,7 +33,7 @@ struct Limits {
 };
 
 struct Plan {
-  std::string kind;  // "fot", "waveform" or "sine"
+  db::CampaignKind kind = db::CampaignKind::fot;
   // fot
   double lo_mm = 0, hi_mm = 0;
   int subdivisions = 0, repeats = 1, training_cycles = 0;

@@ -9,6 +9,8 @@
 #include <tuple>
 #include <vector>
 
+#include "hystlab/db/campaign_enums.hpp"
+#include "hystlab/db/reads.hpp"
 #include "hystlab/db/sqlite.hpp"
 
 namespace hystlab::db {
@@ -28,7 +30,10 @@ struct Bucket {  // min/max of one stretch of a run: no peak is lost by decimati
 
 struct CampaignRow {
   std::int64_t id = 0, rig_id = 0;
-  std::string kind, plan, state, created_at, updated_at;
+  CampaignKind kind = CampaignKind::fot;
+  std::string plan;
+  CampaignState state = CampaignState::queued;
+  std::string created_at, updated_at;
 };
 
 struct EventRow {
@@ -47,12 +52,12 @@ class Store {
   [[nodiscard]] Database& database() noexcept { return db_; }
 
   std::int64_t upsert_rig(const std::string& name, const std::string& config_json, const std::string& now);
-  std::int64_t create_campaign(std::int64_t rig_id, const std::string& kind, const std::string& plan_json,
+  std::int64_t create_campaign(std::int64_t rig_id, CampaignKind kind, const std::string& plan_json,
                                const std::string& now);
   // Updates the state and records the transition as an event, in one transaction.
-  void transition(std::int64_t campaign_id, const std::string& to, const std::string& reason, const std::string& now);
+  void transition(std::int64_t campaign_id, CampaignState to, const std::string& reason, const std::string& now);
   std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s);
-  void end_run(std::int64_t run_id, const std::string& state, const std::string& now);
+  void end_run(std::int64_t run_id, CampaignState state, const std::string& now);
   std::int64_t add_event(std::int64_t campaign_id, const std::string& kind, const std::string& detail, const std::string& now);
   std::int64_t add_transmissibility(std::int64_t run_id, double f_hz, double base_mm, double mass_mm, double ratio, double phase);
   std::int64_t add_fot_node(std::int64_t run_id, double alpha, double beta, double f_alpha, double f_alpha_beta, double t);
@@ -74,26 +79,12 @@ class Store {
   // state with its transition event. When the campaign already has tables (finishing again after
   // a crash), none are added. Returns the new tables' ids.
   std::vector<std::int64_t> finish_run(std::int64_t campaign_id, std::int64_t run_id, const std::vector<TableRecord>& tables,
-                                       const std::string& state, const std::string& reason, const std::string& now);
+                                       CampaignState state, const std::string& reason, const std::string& now);
   [[nodiscard]] std::int64_t table_count(std::int64_t campaign_id);
   [[nodiscard]] std::vector<std::int64_t> runs_of_campaign(std::int64_t campaign_id);
-  // Operator commands for a rig (reset, estop), written by the CLI, taken by the daemon.
-  std::int64_t add_rig_command(const std::string& rig_name, const std::string& command, const std::string& now);
-  struct RigCommand {
-    std::int64_t id;
-    std::string rig, command;
-  };
-  [[nodiscard]] std::vector<RigCommand> take_rig_commands(const std::string& now);
   [[nodiscard]] std::vector<std::string> rig_names();
   void add_io_stats(std::int64_t rig_id, const std::string& stats_json, const std::string& now);
 
-  // Operator commands (pause, resume, abort) queued for the daemon.
-  std::int64_t add_command(std::int64_t campaign_id, const std::string& command, const std::string& now);
-  struct Command {
-    std::int64_t id, campaign_id;
-    std::string command;
-  };
-  [[nodiscard]] std::vector<Command> take_commands(const std::string& now);  // marks them handled
   [[nodiscard]] std::vector<std::int64_t> queued_campaigns(std::int64_t rig_id);
   [[nodiscard]] std::vector<std::tuple<double, double, double, double>> fot_nodes_of_campaign(std::int64_t campaign_id);
 
@@ -112,8 +103,35 @@ class Store {
                        const std::function<void(const SampleRow&)>& f);
   [[nodiscard]] std::string integrity_check();
 
+  // ---- reads for the API and the CLI (store_reads.cpp) ----
+  [[nodiscard]] std::string rig_name(std::int64_t rig_id);
+  [[nodiscard]] std::vector<std::pair<std::int64_t, std::string>> rigs();  // id, name
+  [[nodiscard]] std::vector<std::pair<CampaignState, std::int64_t>> campaign_counts();  // by state
+  [[nodiscard]] std::optional<RunInfo> run(std::int64_t id);
+  [[nodiscard]] std::vector<RunInfo> runs(std::int64_t campaign_id);
+  [[nodiscard]] std::optional<std::pair<double, double>> time_span(std::int64_t run_id);  // rig seconds
+  [[nodiscard]] std::vector<TableInfo> tables(std::optional<std::int64_t> campaign_id = std::nullopt);
+  [[nodiscard]] std::optional<TableInfo> table(std::int64_t id);
+  [[nodiscard]] std::optional<std::string> table_document(std::int64_t id);
+  // The newest table of this method from a campaign of this rig (or of this campaign).
+  [[nodiscard]] std::optional<TableInfo> newest_table_of_rig(std::int64_t rig_id, const std::string& method);
+  [[nodiscard]] std::optional<TableInfo> newest_table_of_campaign(std::int64_t campaign_id, const std::string& method);
+  [[nodiscard]] std::vector<NodeInfo> nodes(std::int64_t campaign_id);
+  [[nodiscard]] std::vector<TransmissibilityInfo> transmissibility(std::int64_t campaign_id);
+  // Details of a campaign's events of one kind, oldest first.
+  [[nodiscard]] std::vector<std::string> event_details(std::int64_t campaign_id, const std::string& kind);
+  // Records since an id, across campaigns, oldest first, at most limit (the event stream).
+  [[nodiscard]] std::vector<EventInfo> events_after(std::int64_t id, int limit);
+  [[nodiscard]] std::vector<NodeInfo> nodes_after(std::int64_t id, int limit);
+  [[nodiscard]] std::vector<TableInfo> tables_after(std::int64_t id, int limit);
+  [[nodiscard]] std::int64_t newest_id(const std::string& table);  // events, fot_nodes or tables
+  // Appends two columns of a run's samples from seq0 on, in order, as floats (plots):
+  // displacement and force, or (base_mass) the command (base) and displacement (mass).
+  // Returns the next seq to read.
+  std::int64_t read_xy(std::int64_t run_id, std::int64_t seq0, bool base_mass, std::vector<float>& x, std::vector<float>& y);
+
  private:
-  void transition_in(std::int64_t campaign_id, const std::string& to, const std::string& reason, const std::string& now);
+  void transition_in(std::int64_t campaign_id, CampaignState to, const std::string& reason, const std::string& now);
   Database db_;
   Statement insert_sample_, upsert_block_;
 };

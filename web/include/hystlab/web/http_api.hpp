@@ -1,10 +1,12 @@
 #pragma once
 // hystlabd's HTTP/JSON API, its Server-Sent Events stream, /metrics and the page (docs/API.md).
-// The HTTP threads read snapshots, live feeds and their own SQLite connections, and send commands
-// to the daemon's queue: they never touch a rig and never write a sample.
+// The HTTP threads reach the daemon only through its interface (snapshots, live samples, plans and
+// commands) and read the database through their own connections: they never touch a rig and
+// never write a sample.
 #include <memory>
 
-#include "hystlab/daemon/daemon.hpp"
+#include "hystlab/control/daemon_interface.hpp"
+#include "hystlab/control/http_config.hpp"
 
 namespace hystlab::web {
 
@@ -12,7 +14,7 @@ class HttpApi {
  public:
   // Binds http.bind:http.port (port 0: a free one) and starts serving on its own threads.
   // Throws std::runtime_error when the address cannot be bound.
-  HttpApi(daemon::Daemon& daemon, const daemon::HttpConfig& config);
+  HttpApi(control::DaemonInterface& daemon, const control::HttpConfig& config);
   ~HttpApi();  // stop()
   HttpApi(const HttpApi&) = delete;
   HttpApi& operator=(const HttpApi&) = delete;

@@ -1,6 +1,7 @@
 #pragma once
-// hystlabd as a separate process for the HTTP benchmarks: started with a config in a temporary
-// folder, its port read from its log, stopped with SIGTERM.
+// hystlabd as a separate process, for the HTTP benchmarks and the CLI's test: started with a
+// config in a temporary folder (HYSTLABD names the binary), its port read from its log, stopped
+// with SIGTERM.
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -10,6 +11,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
@@ -19,13 +21,15 @@
 
 extern char** environ;
 
-namespace hystlab::bench {
+namespace hystlab::test_support {
 
 class DaemonProcess {
  public:
-  explicit DaemonProcess(const std::string& config_json) {
+  // prepare: fills the database before the daemon opens it (a stored run to read back).
+  explicit DaemonProcess(const std::string& config_json, const std::function<void(const std::string& db_path)>& prepare = {}) {
     char tmpl[] = "/tmp/hystlab-bench-XXXXXX";
     dir_ = mkdtemp(tmpl);
+    if (prepare) prepare((dir_ / "bench.db").string());
     std::ofstream(dir_ / "hystlab.json") << config_json;
     const std::string log = (dir_ / "daemon.log").string();
     posix_spawn_file_actions_t fa;
@@ -39,7 +43,7 @@ class DaemonProcess {
     if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ) != 0) throw std::runtime_error("cannot start hystlabd");
     posix_spawn_file_actions_destroy(&fa);
     const std::regex re("serving the API and the page on http://127\\.0\\.0\\.1:(\\d+)/");
-    for (int k = 0; k < 200 && port_ == 0; ++k) {
+    for (int k = 0; k < 600 && port_ == 0; ++k) {  // 60 s: a sanitized daemon on a loaded 2-core VM
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
       std::stringstream s;
       s << std::ifstream(log).rdbuf();
@@ -47,20 +51,37 @@ class DaemonProcess {
       const std::string text = s.str();
       if (std::regex_search(text, m, re)) port_ = std::stoi(m[1]);
     }
-    if (port_ == 0) throw std::runtime_error("hystlabd did not start; see " + log);
+    if (port_ == 0) {
+      const std::string text = this->log();
+      stop();
+      throw std::runtime_error("hystlabd did not start within 60 s; it printed:\n" + text);
+    }
   }
-  ~DaemonProcess() {
-    kill(pid_, SIGTERM);
-    int st = 0;
-    waitpid(pid_, &st, 0);
-    std::filesystem::remove_all(dir_);
-  }
+  ~DaemonProcess() { stop(); }
   [[nodiscard]] int port() const noexcept { return port_; }
+  [[nodiscard]] std::string db_path() const { return (dir_ / "bench.db").string(); }
+  [[nodiscard]] std::string log() const {
+    std::stringstream s;
+    s << std::ifstream(dir_ / "daemon.log").rdbuf();
+    return s.str();
+  }
 
  private:
+  // SIGTERM; SIGKILL when it has not exited after 30 s (a hung daemon never hangs the test).
+  void stop() {
+    kill(pid_, SIGTERM);
+    int st = 0;
+    for (int k = 0; k < 300 && waitpid(pid_, &st, WNOHANG) == 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (waitpid(pid_, &st, WNOHANG) == 0) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, &st, 0);
+    }
+    std::filesystem::remove_all(dir_);
+  }
+
   std::filesystem::path dir_;
   pid_t pid_ = -1;
   int port_ = 0;
 };
 
-}  // namespace hystlab::bench
+}  // namespace hystlab::test_support

@@ -1,0 +1,105 @@
+#pragma once
+// The values the daemon's interface hands out: copies, owned by the caller, safe to keep. Text
+// appears only where it is shown as is (names, reasons); states and commands are enums.
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "hystlab/db/campaign_enums.hpp"
+
+namespace hystlab::control {
+
+// A plan the daemon refuses: what (in the form's words: "ramp rate must be between 0.0001 and
+// 20 mm/s"), and the plan's field alone ("ramp_rate_mm_s", "limits.force_N") so that a form
+// can mark the input it came from.
+struct PlanError : std::invalid_argument {
+  explicit PlanError(const std::string& what) : std::invalid_argument(what) {}
+  PlanError(std::string field_name, const std::string& what) : std::invalid_argument(what), field(std::move(field_name)) {}
+  std::string field;
+};
+
+struct RigInfo {
+  std::int64_t id = 0;
+  std::string name, kind, description;  // kind: "load_frame" or "shaker"
+  bool simulated = false;
+};
+
+// Operator commands for a rig itself, whatever campaign runs (or none).
+enum class RigCommand { reset, estop };
+
+// Operator commands for a campaign. Text only at the edges (JSON, the database's commands).
+enum class CampaignCommand { pause, resume, abort, estop };
+[[nodiscard]] const char* to_string(CampaignCommand c) noexcept;
+// nullopt for anything else: an unknown command is refused, never taken for an abort.
+[[nodiscard]] std::optional<CampaignCommand> campaign_command_from(std::string_view text) noexcept;
+// The commands that do something to a campaign in this state, as the daemon carries them out:
+// what a page offers (pause a running one; resume a paused, interrupted or held one; abort or
+// e-stop any that is not over).
+[[nodiscard]] std::vector<CampaignCommand> commands_for(db::CampaignState s);
+
+// The rig's supervision (a copy, taken under a lock).
+struct RigSupervision {
+  std::string state = "disconnected";  // the supervisor's RigState, as text at this edge
+  bool latched = false, resetting = false, have_sample = false;
+  std::string latch_reason, reset_refusal;
+  std::uint16_t latched_fault_code = 0;  // the code that latched (0: an e-stop or none)
+  std::uint16_t status_word = 0, fault_code = 0;  // the last sample's
+  std::string fault_text;                          // the map's text for fault_code
+  double position_mm = 0, force_N = 0;
+  std::uint64_t link_losses = 0, transitions = 0;
+  std::vector<nlohmann::json> recent;  // the last transitions: at, t, from, to, reason
+  nlohmann::json envelope, supervision;
+};
+
+// One live sample of a rig, as its acquisition thread saw it.
+struct LiveSample {
+  double mono_s = 0;  // host steady clock when acquired (the same clock in every process here)
+  double t = 0, cmd = 0, disp = 0, force = 0;  // shakers: base displacement, mass displacement, mass acceleration
+  std::int64_t run = 0;                        // 0: the rig is idle (a sample read between campaigns)
+  std::uint32_t status = 0;
+};
+
+// The rig link's I/O health.
+struct LinkHealth {
+  std::uint64_t reads = 0, writes = 0, reconnects = 0;
+  std::uint64_t lost_samples = 0;  // gaps in a controller's sample counter that no block read filled
+  std::vector<std::pair<std::string, std::uint64_t>> errors;  // by kind: "timeout", "crc_error", ...
+  double last_transaction_us = 0, max_transaction_us = 0, total_transaction_us = 0;
+  std::vector<std::uint64_t> latency_histogram_us;  // bucket k: [2^k, 2^(k+1)) µs; the last is open
+};
+
+// The rig's acquisition counters.
+struct AcquisitionCounters {
+  std::uint64_t samples = 0, missed_deadlines = 0, late_wakeups = 0;
+  std::int64_t campaign = 0, run = 0;  // 0: none running
+  double sample_rate_hz = 0;           // the running campaign's
+};
+
+struct WriterCounters {
+  std::uint64_t written = 0, depth = 0, dropped = 0, commits = 0;
+};
+
+// What a plan will do, before it is submitted.
+struct PlanPreview {
+  db::CampaignKind kind = db::CampaignKind::fot;
+  double duration_s = 0;       // rig seconds, from the rig at the range's bottom
+  std::size_t nodes = 0;       // FOT nodes measured (fot), frequencies (sine)
+  double peak_speed_mm_s = 0;  // commanded
+  double peak_force_N = 0;     // predicted by the model on the plan's input (load frames)
+  double peak_accel_m_s2 = 0;  // of the base (shakers)
+  double samples = 0;          // duration × sample rate
+  double sample_rate_hz = 0, force_limit_N = 0;  // the plan's
+};
+
+// A FOT plan's grid: its nodes are on n = subdivisions steps of [lo_mm, hi_mm].
+struct FotGrid {
+  double lo_mm = 0, hi_mm = 0;
+  int subdivisions = 0;
+};
+
+}  // namespace hystlab::control

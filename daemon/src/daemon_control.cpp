@@ -1,0 +1,78 @@
+#include "hystlab/daemon/daemon_control.hpp"
+
+#include "hystlab/daemon/plan_preview.hpp"
+
+namespace hystlab::daemon {
+namespace {
+
+// drivers::RigError's values, as the API and /metrics name them (index = the enum's value).
+constexpr const char* kErrorNames[] = {"", "timeout", "exception_response", "connection_lost", "crc_error",
+                                       "out_of_range", "protocol_error", "not_connected", "stale_data", "unsupported"};
+static_assert(sizeof kErrorNames / sizeof kErrorNames[0] == drivers::kRigErrorCount);
+
+control::LinkHealth link_health(const drivers::IoHealthSnapshot& h) {
+  control::LinkHealth out;
+  out.reads = h.reads;
+  out.writes = h.writes;
+  out.reconnects = h.reconnects;
+  out.lost_samples = h.lost_samples;
+  for (std::size_t k = 1; k < drivers::kRigErrorCount; ++k) out.errors.emplace_back(kErrorNames[k], h.errors[k]);
+  out.last_transaction_us = h.last_transaction_us;
+  out.max_transaction_us = h.max_transaction_us;
+  out.total_transaction_us = h.total_transaction_us;
+  out.latency_histogram_us.assign(h.latency_histogram.begin(), h.latency_histogram.end());
+  return out;
+}
+
+class DaemonControl final : public control::DaemonInterface {
+ public:
+  explicit DaemonControl(Daemon& d) : d_(d) {}
+
+  std::size_t rig_count() const noexcept override { return d_.rig_count(); }
+  control::RigInfo rig_info(std::size_t k) const override { return d_.rig_info(k); }
+  control::RigSupervision rig_supervision(std::size_t k) const override { return d_.rig_supervision(k); }
+  control::LinkHealth rig_health(std::size_t k) const override { return link_health(d_.rig_health(k)); }
+  control::AcquisitionCounters rig_counters(std::size_t k) const override {
+    const RigLive& live = d_.rig_live(k);
+    return {live.samples.load(), live.missed_deadlines.load(), live.late_wakeups.load(),
+            live.campaign.load(), live.run.load(), live.sample_rate_hz.load()};
+  }
+  std::size_t rig_index(const std::string& name) const override { return d_.rig_index(name); }
+  void rig_command(std::size_t k, control::RigCommand c) override { d_.rig_command(k, c); }
+
+  std::uint64_t live_head(std::size_t k) const noexcept override { return k < d_.rig_count() ? d_.rig_live(k).ring.head() : 0; }
+  std::uint64_t read_live(std::size_t k, std::uint64_t from, std::size_t stride, std::vector<control::LiveSample>& out,
+                          std::uint64_t* lost) const override {
+    return d_.rig_live(k).ring.read(from, stride, out, lost);
+  }
+
+  std::int64_t submit(const std::string& rig, const nlohmann::json& plan) override { return d_.submit(rig, plan); }
+  control::PlanPreview preview(const std::string& rig, const nlohmann::json& plan, models::HysteresisModel* model) const override {
+    return preview_plan(d_.check_plan(rig, plan).first, model);
+  }
+  std::optional<control::FotGrid> fot_grid(const nlohmann::json& stored_plan) const override {
+    const Plan p = parse_plan(stored_plan);
+    if (p.kind != db::CampaignKind::fot) return std::nullopt;
+    return control::FotGrid{p.lo_mm, p.hi_mm, p.subdivisions};
+  }
+  void command(std::int64_t campaign, control::CampaignCommand c) override { d_.command(campaign, c); }
+
+  control::WriterCounters writer() const override {
+    const db::WriterStats w = d_.writer_stats();
+    return {w.written, w.depth, w.dropped_full, w.commits};
+  }
+  double uptime_s() const noexcept override { return d_.uptime_s(); }
+  std::string db_path() const override { return d_.config().db_path; }
+  void keep_off_acquisition_cpu(bool off) const noexcept override {
+    (void)avoid_cpu(off ? resolve_cpu(d_.config().acquisition.cpu) : -1);
+  }
+
+ private:
+  Daemon& d_;
+};
+
+}  // namespace
+
+std::unique_ptr<control::DaemonInterface> make_control(Daemon& d) { return std::make_unique<DaemonControl>(d); }
+
+}  // namespace hystlab::daemon

@@ -1,0 +1,28 @@
+#pragma once
+// A campaign's state and kind: enums inside the program, text only at its edges (the database's
+// columns, JSON, the CLI's lines). The text is the stored form: changing it needs a migration.
+#include <array>
+#include <optional>
+#include <string_view>
+
+namespace hystlab::db {
+
+enum class CampaignState { queued, held, arming, running, paused, completed, aborted, failed, interrupted };
+inline constexpr std::array<CampaignState, 9> kCampaignStates{CampaignState::queued,    CampaignState::held,      CampaignState::arming,
+                                                              CampaignState::running,   CampaignState::paused,    CampaignState::completed,
+                                                              CampaignState::aborted,   CampaignState::failed,    CampaignState::interrupted};
+[[nodiscard]] const char* to_string(CampaignState s) noexcept;
+// nullopt for any other text.
+[[nodiscard]] std::optional<CampaignState> campaign_state_from(std::string_view text) noexcept;
+// completed, aborted or failed: nothing more happens to it (interrupted and held can resume).
+[[nodiscard]] bool is_final(CampaignState s) noexcept;
+// arming, running or paused: the campaign holds its rig.
+[[nodiscard]] bool is_active(CampaignState s) noexcept;
+
+// fot: the first-order-transition input (load frames); waveform: a list of points (load frames);
+// sine: base excitation at steady frequencies (shakers).
+enum class CampaignKind { fot, waveform, sine };
+[[nodiscard]] const char* to_string(CampaignKind k) noexcept;
+[[nodiscard]] std::optional<CampaignKind> campaign_kind_from(std::string_view text) noexcept;
+
+}  // namespace hystlab::db

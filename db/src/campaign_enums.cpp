@@ -1,0 +1,49 @@
+#include "hystlab/db/campaign_enums.hpp"
+
+namespace hystlab::db {
+
+const char* to_string(CampaignState s) noexcept {
+  switch (s) {
+    case CampaignState::queued: return "queued";
+    case CampaignState::held: return "held";
+    case CampaignState::arming: return "arming";
+    case CampaignState::running: return "running";
+    case CampaignState::paused: return "paused";
+    case CampaignState::completed: return "completed";
+    case CampaignState::aborted: return "aborted";
+    case CampaignState::failed: return "failed";
+    case CampaignState::interrupted: return "interrupted";
+  }
+  return "?";
+}
+
+std::optional<CampaignState> campaign_state_from(std::string_view text) noexcept {
+  for (const CampaignState s : kCampaignStates)
+    if (text == to_string(s)) return s;
+  return std::nullopt;
+}
+
+bool is_final(CampaignState s) noexcept {
+  return s == CampaignState::completed || s == CampaignState::aborted || s == CampaignState::failed;
+}
+
+bool is_active(CampaignState s) noexcept {
+  return s == CampaignState::arming || s == CampaignState::running || s == CampaignState::paused;
+}
+
+const char* to_string(CampaignKind k) noexcept {
+  switch (k) {
+    case CampaignKind::fot: return "fot";
+    case CampaignKind::waveform: return "waveform";
+    case CampaignKind::sine: return "sine";
+  }
+  return "?";
+}
+
+std::optional<CampaignKind> campaign_kind_from(std::string_view text) noexcept {
+  for (const CampaignKind k : {CampaignKind::fot, CampaignKind::waveform, CampaignKind::sine})
+    if (text == to_string(k)) return k;
+  return std::nullopt;
+}
+
+}  // namespace hystlab::db

@@ -1,0 +1,238 @@
+// The new-campaign form: its fields (with units), checks in the page before anything is sent
+// (in the form's words, beside the input at fault), the server's own plan errors mapped back to
+// the input its `field` names, and a preview of the plan (duration, nodes, peak speed and force)
+// from POST /api/plans/preview as the form changes.
+import { post } from './api.js';
+import { el, num, round2, count, duration } from './fmt.js';
+
+// Each input: where it goes in the plan, its words and units, and what it accepts (the plan
+// parser's limits, daemon/src/plan.cpp). `optional` fields may be left blank (the rig decides).
+const FIELDS = [
+  { name: 'lo', group: 'fot', label: 'δmin', unit: 'mm', value: '0', min: -1e4, max: 1e4, plan: 'range_mm' },
+  { name: 'hi', group: 'fot', label: 'δmax', unit: 'mm', value: '4', min: -1e4, max: 1e4, plan: 'range_mm' },
+  { name: 'n', group: 'fot', label: 'subdivisions n', value: '8', int: true, min: 1, max: 200, plan: 'subdivisions' },
+  { name: 'rate', group: 'fot', label: 'ramp rate', unit: 'mm/s', value: '0.5', min: 1e-4, max: 1e3, plan: 'ramp_rate_mm_s' },
+  { name: 'dwell', group: 'fot', label: 'dwell', unit: 's', value: '0.2', min: 0, max: 3600, plan: 'dwell_s' },
+  { name: 'training', group: 'fot', label: 'training cycles', value: '0', int: true, min: 0, max: 1000, plan: 'training_cycles' },
+  { name: 'repeats', group: 'fot', label: 'repeats', value: '1', int: true, min: 1, max: 100, plan: 'repeats' },
+  { name: 'freqs', group: 'sine', label: 'frequencies', unit: 'Hz', value: '2, 4, 6, 8, 10, 12', list: true, min: 1e-3, max: 1000, plan: 'frequencies_hz', type: 'text' },
+  { name: 'amp', group: 'sine', label: 'amplitude', unit: 'mm', value: '0.5', min: 1e-4, max: 100, plan: 'amplitude_mm' },
+  { name: 'settle', group: 'sine', label: 'settle cycles', value: '10', int: true, min: 0, max: 100000, plan: 'settle_cycles' },
+  { name: 'measured', group: 'sine', label: 'measured cycles', value: '5', int: true, min: 1, max: 100000, plan: 'measured_cycles' },
+  { name: 'hz', group: 'common', label: 'sample rate', unit: 'Hz', value: '1000', min: 1, max: 10000, plan: 'sample_rate_hz' },
+  { name: 'dlo', group: 'limits', label: 'lower displacement limit', unit: 'mm', value: '', optional: true, placeholder: 'δmin − 0.5', min: -1e4, max: 1e4, plan: 'limits.displacement_mm' },
+  { name: 'dhi', group: 'limits', label: 'upper displacement limit', unit: 'mm', value: '', optional: true, placeholder: 'δmax + 0.5', min: -1e4, max: 1e4, plan: 'limits.displacement_mm' },
+  { name: 'force', group: 'limits', label: 'force limit', unit: 'N', value: '400', optional: true, placeholder: "rig's", min: 1e-6, max: 1e7, plan: 'limits.force_N' },
+  { name: 'ratelim', group: 'limits', label: 'rate limit', unit: 'mm/s', value: '', optional: true, placeholder: "rig's", min: 1e-6, max: 1e4, plan: 'limits.rate_mm_s' },
+];
+const GROUP_TITLES = { fot: null, sine: null, common: null, limits: 'Limits (blank: the rig’s own)' };
+// The server's field names, as the form says them (for its messages).
+const WORDS = [['limits.displacement_mm', 'displacement limits'], ['limits.safe_position_mm', 'safe position'],
+  ['limits.force_N', 'force limit'], ['limits.rate_mm_s', 'rate limit'], ['range_mm', 'δmin … δmax'],
+  ...FIELDS.filter(f => !f.plan.includes('.') && f.plan !== 'range_mm').map(f => [f.plan, f.label])];
+
+export function humanize(text) {
+  let s = String(text || '').replace(/^plan: /, '');
+  for (const [key, words] of WORDS) s = s.split(key).join(words);
+  return s;
+}
+
+export class PlanForm {
+  constructor(form, { rigPanel, onSubmitted }) {
+    this.form = form; this.rigPanel = rigPanel; this.onSubmitted = onSubmitted;
+    this.previewSeq = 0; this.previewTimer = null;
+    this.build();
+    this.error = form.querySelector('#form-error');
+    this.preview = form.querySelector('#preview');
+    this.why = form.querySelector('#submit-why');
+    this.submit = form.querySelector('#submit');
+    form.kind.addEventListener('change', () => { this.showKind(); this.pickRigFor(form.kind.value); });
+    form.rig.addEventListener('change', () => this.updateLatch());
+    form.addEventListener('input', e => { this.clearField(e.target.name); this.error.textContent = ''; this.schedulePreview(); });
+    form.addEventListener('change', () => this.schedulePreview());
+    form.addEventListener('submit', e => { e.preventDefault(); this.send(); });
+    this.showKind();
+  }
+  // The inputs, from FIELDS: label with unit, input, and the message slot beside it.
+  build() {
+    for (const g of Object.keys(GROUP_TITLES)) {
+      const box = this.form.querySelector(`fieldset.${g}`);
+      if (GROUP_TITLES[g]) box.append(el('legend', { text: GROUP_TITLES[g] }));
+      for (const f of FIELDS.filter(x => x.group === g)) {
+        const id = 'f-' + f.name;
+        const input = el('input', { id, name: f.name, type: f.type || 'text', inputmode: f.type ? null : 'decimal',
+                                    value: f.value, placeholder: f.placeholder || null, 'aria-describedby': id + '-msg', autocomplete: 'off' });
+        box.append(el('div', { class: 'field' },
+          el('label', { for: id, text: f.label + (f.unit ? ` (${f.unit})` : '') }), input,
+          el('span', { class: 'msg', id: id + '-msg', 'aria-live': 'polite' })));
+      }
+    }
+  }
+  showKind() {
+    const sine = this.form.kind.value === 'sine';
+    this.form.querySelector('fieldset.fot').hidden = sine;
+    this.form.querySelector('fieldset.limits').hidden = sine;
+    this.form.querySelector('fieldset.sine').hidden = !sine;
+    this.clearAll();
+  }
+  // The first rig that can run this kind of plan (a sine sweep needs a shaker).
+  pickRigFor(kind) {
+    const want = kind === 'sine' ? 'shaker' : 'load_frame';
+    const o = [...this.form.rig.options].find(x => x.dataset.kind === want);
+    if (o) this.form.rig.value = o.value;
+    this.updateLatch();
+  }
+  setRigs(rigs) {
+    const chosen = this.form.rig.value;
+    const names = rigs.map(r => r.name).join('\n');
+    if (names !== this.rigNames) {
+      this.rigNames = names;
+      this.form.rig.replaceChildren(...rigs.map(r => el('option', { value: r.name, 'data-kind': r.kind, text: `${r.name} (${r.kind === 'shaker' ? 'shaker' : 'load frame'})` })));
+      if (chosen && rigs.some(r => r.name === chosen)) this.form.rig.value = chosen; else this.pickRigFor(this.form.kind.value);
+      this.schedulePreview();
+    }
+    this.updateLatch();
+  }
+  // No campaign on a latched rig: Submit is off, and says why.
+  updateLatch() {
+    const r = this.rigPanel.rig(this.form.rig.value);
+    const latched = !!(r && r.latched);
+    this.submit.disabled = latched;
+    this.why.textContent = latched ? `${r.name} is latched (${r.latch_reason || 'e-stop or fault'}): reset it first` : '';
+  }
+
+  // ---- messages beside the inputs ----
+  inputsFor(field) {
+    const key = String(field || '').replace(/^plan\./, '').replace(/\[\d+\]$/, '');
+    if (key === 'range_mm') return ['lo', 'hi'];
+    if (key === 'limits.displacement_mm' || key === 'limits.safe_position_mm') return ['dlo', 'dhi'];
+    if (key === 'sweep' || key.startsWith('sweep.')) return ['freqs'];
+    if (key === 'limits') return ['force'];
+    const f = FIELDS.find(x => x.plan === key && !this.inputOf(x.name).closest('fieldset').hidden);
+    return f ? [f.name] : [];
+  }
+  inputOf(name) { return this.form.querySelector(`#f-${name}`); }
+  mark(name, message) {
+    const input = this.inputOf(name);
+    if (!input) return;
+    input.setAttribute('aria-invalid', 'true');
+    const msg = this.form.querySelector(`#f-${name}-msg`);
+    if (message) msg.textContent = message;
+  }
+  clearField(name) {
+    const input = name && this.inputOf(name);
+    if (!input || input.getAttribute('aria-invalid') !== 'true') return;
+    // A message shared by a pair (δmin … δmax, the displacement limits) goes with either.
+    const pair = [['lo', 'hi'], ['dlo', 'dhi'], ['rate', 'ratelim']].find(p => p.includes(name)) || [name];
+    for (const n of pair) { this.inputOf(n).removeAttribute('aria-invalid'); this.form.querySelector(`#f-${n}-msg`).textContent = ''; }
+  }
+  clearAll() {
+    for (const f of FIELDS) { this.inputOf(f.name).removeAttribute('aria-invalid'); this.form.querySelector(`#f-${f.name}-msg`).textContent = ''; }
+    if (this.error) this.error.textContent = '';
+  }
+  // A 400 from the server: its `field` (or the "plan: FIELD ..." of its detail) marks the input.
+  showServerError(err) {
+    const b = err.body || {};
+    const field = b.field || (/^plan: ([a-z_.]+(?:\[\d+\])?) /.exec(b.detail || '') || [])[1];
+    const names = field ? this.inputsFor(field) : [];
+    const message = humanize(b.detail || err.message);
+    if (!names.length) { this.error.textContent = message; return; }
+    names.forEach((n, k) => this.mark(n, k === 0 ? message : ''));
+  }
+
+  // ---- the plan ----
+  // Reads and checks every visible field; returns {plan} or {errors: [[name, message]]}.
+  read() {
+    const form = this.form;
+    if (form.json.value.trim()) {
+      try { return { plan: JSON.parse(form.json.value) }; } catch (e) { return { errors: [['', `the pasted plan is not valid JSON (${e.message})`]] }; }
+    }
+    const sine = form.kind.value === 'sine';
+    const groups = sine ? ['sine', 'common'] : ['fot', 'common', 'limits'];
+    const errors = [], v = {};
+    for (const f of FIELDS.filter(x => groups.includes(x.group))) {
+      const raw = this.inputOf(f.name).value.trim();
+      const what = f.label;
+      if (raw === '') { if (!f.optional) errors.push([f.name, `${what} is required`]); continue; }
+      const parts = f.list ? raw.split(/[,;\s]+/).filter(Boolean) : [raw];
+      const vals = parts.map(p => Number(p.replace(',', '.')));
+      const unit = f.unit ? ' ' + f.unit : '';
+      if (vals.some(x => !Number.isFinite(x))) errors.push([f.name, f.list ? `${what}: each must be a number (separate them with commas)` : `${what} must be a number`]);
+      else if (f.int && vals.some(x => !Number.isInteger(x))) errors.push([f.name, `${what} must be a whole number`]);
+      else if (vals.some(x => x < f.min || x > f.max)) errors.push([f.name, `${what} must be from ${num(f.min)} to ${num(f.max)}${unit}`]);
+      else v[f.name] = f.list ? vals : vals[0];
+    }
+    if (!sine) {
+      if (v.lo != null && v.hi != null && !(v.hi > v.lo)) errors.push(['hi', 'δmax must be above δmin']);
+      if (v.rate != null && v.ratelim != null && v.rate > v.ratelim) errors.push(['rate', `ramp rate must not be above the rate limit (${num(v.ratelim)} mm/s)`]);
+      if (v.dlo != null && v.lo != null && v.dlo > v.lo) errors.push(['dlo', 'the lower displacement limit must be at or below δmin']);
+      if (v.dhi != null && v.hi != null && v.dhi < v.hi) errors.push(['dhi', 'the upper displacement limit must be at or above δmax']);
+      if ((v.dlo == null) !== (v.dhi == null)) errors.push([v.dlo == null ? 'dlo' : 'dhi', 'give both displacement limits, or neither']);
+    }
+    if (errors.length) return { errors };
+    if (sine) {
+      return { plan: { kind: 'sine', frequencies_hz: v.freqs, amplitude_mm: v.amp, settle_cycles: v.settle, measured_cycles: v.measured, sample_rate_hz: v.hz } };
+    }
+    const limits = {};
+    if (v.dlo != null) limits.displacement_mm = [v.dlo, v.dhi];
+    if (v.force != null) limits.force_N = v.force;
+    if (v.ratelim != null) limits.rate_mm_s = v.ratelim;
+    const plan = { kind: 'fot', range_mm: [v.lo, v.hi], subdivisions: v.n, ramp_rate_mm_s: v.rate, dwell_s: v.dwell, sample_rate_hz: v.hz };
+    if (v.training) plan.training_cycles = v.training;
+    if (v.repeats !== 1) plan.repeats = v.repeats;
+    if (Object.keys(limits).length) plan.limits = limits;
+    return { plan };
+  }
+  body(plan) { const b = { plan }; if (this.form.rig.value) b.rig = this.form.rig.value; return b; }
+  showErrors(errors) {
+    for (const [name, message] of errors) { if (name) this.mark(name, message); else this.error.textContent = message; }
+    const first = errors.find(e => e[0]);
+    return first ? this.inputOf(first[0]) : null;
+  }
+
+  async send() {
+    this.clearAll();
+    const r = this.read();
+    if (r.errors) { const input = this.showErrors(r.errors); if (input) input.focus(); return; }
+    this.submit.disabled = true;
+    try {
+      const c = await post('/api/campaigns', this.body(r.plan));
+      await this.onSubmitted(c);
+    } catch (err) {
+      if (err.status === 400) this.showServerError(err); else this.error.textContent = humanize(err.message);
+    } finally { this.updateLatch(); }
+  }
+
+  // ---- the preview, ~300 ms after the last change ----
+  schedulePreview() {
+    clearTimeout(this.previewTimer);
+    ++this.previewSeq;  // an answer for the form as it was before this change is stale already
+    this.previewTimer = setTimeout(() => this.runPreview(), 300);
+  }
+  async runPreview() {
+    const seq = ++this.previewSeq;
+    const r = this.read();
+    if (r.errors || this.previewMissing) { this.preview.hidden = true; return; }
+    try {
+      const p = await post('/api/plans/preview', this.body(r.plan));
+      if (seq !== this.previewSeq) return;  // an older answer must not replace a newer one
+      this.preview.textContent = previewText(p);
+      this.preview.hidden = false;
+    } catch (err) {
+      if (seq !== this.previewSeq) return;
+      this.preview.hidden = true;
+      if (err.status === 404 || err.status === 405) this.previewMissing = true;  // an older daemon: no preview, say nothing
+      else if (err.status === 400) this.showServerError(err);
+    }
+  }
+}
+
+// "about 2 min 10 s · 45 nodes · peak speed 0.5 mm/s · peak force ≈ 380 N (from table #3)"
+export function previewText(p) {
+  const parts = [`about ${duration(p.duration_s)}`];
+  if (p.nodes != null) parts.push(`${count(p.nodes)} nodes`);
+  if (p.samples != null) parts.push(`${count(p.samples)} samples`);
+  if (p.peak_speed_mm_s != null) parts.push(`peak speed ${num(p.peak_speed_mm_s, 2)} mm/s`);
+  if (p.peak_force_N != null) parts.push(`peak force ≈ ${round2(p.peak_force_N)} N${p.force_source ? ` (from ${p.force_source})` : ''}`);
+  return parts.join(' · ');
+}

@@ -1,0 +1,41 @@
+// Data quality in view: per run, what the acquisition lost (missed deadlines, lost samples,
+// I/O errors, holes in the samples) and the rate actually stored in rig time against the one
+// the plan asked for; and a warning box with every warning of the campaign's runs and tables.
+// An older daemon sends no `quality`: the run line then says only what it knows.
+import { el, count, num, plural } from './fmt.js';
+
+function rateText(q) {
+  if (!Number.isFinite(q.rate_hz)) return null;
+  const asked = q.requested_rate_hz;
+  // Within 5 %: the plan's rate was kept; say so only when it was not.
+  if (Number.isFinite(asked) && Math.abs(q.rate_hz - asked) > 0.05 * asked)
+    return el('span', { class: 'bad', text: `stored ${num(q.rate_hz)} Hz of rig time (plan asked ${num(asked)} Hz)` });
+  return `${num(q.rate_hz)} Hz`;
+}
+const figure = (n, one, many) => el('span', { class: n ? 'bad' : '', text: plural(n || 0, one, many) });
+
+function runLine(r) {
+  const q = r.quality;
+  const li = el('li', {}, `run #${r.id}: `);
+  if (!q) { li.append(`${plural(r.samples || 0, 'sample')} (this daemon gives no quality figures)`); return li; }
+  const parts = [plural(q.samples ?? r.samples ?? 0, 'sample'), rateText(q),
+    figure(q.missed_deadlines, 'missed deadline'), figure(q.lost_samples, 'lost sample'), figure(q.io_errors, 'I/O error')];
+  const gaps = q.gaps || 0;
+  parts.push(gaps ? el('span', { class: 'bad', text: `${plural(gaps, 'gap')} (${num(q.gap_total_s, 2)} s in all, longest ${num(q.longest_gap_s, 2)} s)` }) : 'no gaps');
+  if (q.late_wakeups) parts.push(plural(q.late_wakeups, 'late wake-up'));
+  parts.filter(p => p != null).forEach((p, k) => { if (k) li.append(' · '); li.append(p); });
+  return li;
+}
+
+// Fills the quality list and the warning box; returns the warnings shown.
+export function showQuality(d, listEl, boxEl) {
+  const runs = (d && d.runs) || [], tables = (d && d.tables) || [];
+  listEl.replaceChildren(...runs.map(runLine));
+  const warnings = [];
+  for (const r of runs) for (const w of (r.quality && r.quality.warnings) || []) warnings.push(`run #${r.id}: ${w}`);
+  for (const t of tables) for (const w of t.warnings || []) warnings.push(`table #${t.id}: ${w}`);
+  boxEl.replaceChildren(...(warnings.length ? [el('strong', { text: `Check before trusting this campaign (${plural(warnings.length, 'warning')}):` }),
+    el('ul', {}, ...warnings.map(w => el('li', { text: w })))] : []));
+  boxEl.hidden = warnings.length === 0;
+  return warnings;
+}
