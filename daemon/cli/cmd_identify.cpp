@@ -6,7 +6,7 @@
 #include "commands.hpp"
 #include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
-#include "hystlab/models/lsq_fit.hpp"
+#include "hystlab/models/fit_report.hpp"
 #include "hystlab/models/sma_calibration.hpp"
 
 namespace hystlab::cli {
@@ -22,12 +22,16 @@ are averaged; the spread of repeated f_α is the drift figure; cells whose Preis
 negative beyond noise (--noise, default: the drift figure) are reported.
 )";
 
-const char* kFitHelp = R"(usage: hystlab fit --data X.csv --subdivisions N [--range A,B] [--lambda L] -o T.json
+const char* kFitHelp = R"(usage: hystlab fit --data X.csv --subdivisions N [--prior auto|signed|monotone] [--range A,B]
+                  [--lambda L] [--folds K] -o T.json
 
-Constrained least-squares Preisach table from any displacement/force record (columns
-displacement_mm, force_N): every cell weight >= 0, F(α,α) = 0, smoothing weight chosen by
-generalized cross-validation unless --lambda is given. N at most 48. The range defaults to the
-data's displacement range. The record is assumed to start from rest at the bottom of the range.
+Least-squares Preisach table from any displacement/force record (columns displacement_mm,
+force_N), F(α,α) = 0. The prior is the model class: `signed` lets cell masses take either sign
+(a superelastic specimen needs it), `monotone` holds every mass >= 0 (the classical Preisach
+measure), `auto` (the default) fits both and keeps the one with the lower error on held-out
+blocks of the record. The smoothing weight is chosen by K-fold cross-validation on contiguous
+blocks (default 4) unless --lambda is given. N at most 200. The range defaults to the data's
+displacement range. The record is assumed to start from rest at the bottom of the range.
 )";
 
 const char* kCalibrateHelp = R"(usage: hystlab calibrate --data loop.csv (--initial P.json | --temperature T --clausius C) -o P.json
@@ -98,32 +102,37 @@ int run_identify(const Args& args) {
 
 int run_fit(const Args& args) {
   if (print_help_if_asked(args, kFitHelp)) return 0;
-  const Options opt(args, {"data", "subdivisions", "range", "lambda", "output"}, {});
+  const Options opt(args, {"data", "subdivisions", "range", "lambda", "output", "prior", "folds"}, {});
   const std::string out = opt.require("output"), path = opt.require("data");
   const Csv csv = Csv::load(path);
   const auto x = csv.column("displacement_mm"), y = csv.column("force_N");
   if (!opt.has("subdivisions")) throw CliError("missing required option --subdivisions");
-  const int n = opt.integer("subdivisions", 0, 1, 48);
+  models::PreisachFitOptions fo;
+  const int n = opt.integer("subdivisions", 0, 1, fo.max_subdivisions);
   double lo = *std::min_element(x.begin(), x.end()), hi = *std::max_element(x.begin(), x.end());
   if (opt.has("range")) std::tie(lo, hi) = opt.range("range");
   if (!(hi > lo)) throw CliError(path + ": the displacement never changes");
-  models::LsqFitOptions fo;
   fo.lambda = opt.number("lambda", -1.0);
   if (opt.has("lambda") && fo.lambda < 0) throw CliError("option --lambda: must be >= 0");
-  const models::LsqFitResult r = models::fit_preisach_lsq(x, y, models::Grid::make(lo, hi, n), fo);
-  models::TableProvenance prov{"displacement/force record", "lsq", now_iso8601(), path, {}};
-  prov.extra = {{"lambda", r.lambda},
-                {"rms_residual_N", r.rms_residual},
-                {"max_residual_N", r.max_residual},
-                {"effective_parameters", r.effective_parameters},
-                {"cells_at_bound", r.cells_at_bound},
-                {"cell_sigma_N", r.cell_sigma}};
-  write_file(out, models::table_to_json(r.table, prov).dump(2) + "\n");
-  std::cout << "fitted " << grid_text(r.table.grid()) << " to " << x.size() << " samples\n"
-            << "smoothing lambda " << format_number(r.lambda) << (opt.has("lambda") ? " (given)" : " (GCV)")
-            << ", effective parameters " << format_number(r.effective_parameters) << "\n"
-            << "residual: rms " << format_number(r.rms_residual) << " N, max " << format_number(r.max_residual)
-            << " N; cells held at zero weight: " << r.cells_at_bound << " of " << r.cell_weight.size() << "\n"
+  fo.folds = opt.integer("folds", 4, 2, 20);
+  try {
+    fo.prior = models::fit_prior_from_string(opt.get("prior", "auto"));
+  } catch (const std::invalid_argument& e) {
+    throw CliError(std::string("option --") + e.what());
+  }
+  const models::PreisachFitResult r = models::fit_preisach(x, y, models::Grid::make(lo, hi, n), fo);
+  const models::PriorFit& c = r.chosen;
+  models::TableProvenance prov{"displacement/force record", "lsq", now_iso8601(), path, models::fit_provenance(r)};
+  write_file(out, models::table_to_json(c.table, prov).dump(2) + "\n");
+  std::cout << "fitted " << grid_text(c.table.grid()) << " to " << x.size() << " samples in "
+            << format_number(r.seconds) << " s (" << format_number(static_cast<double>(r.peak_bytes) / 1048576.0)
+            << " MiB)\n"
+            << "prior " << models::to_string(c.prior) << ": " << r.reason << "\n"
+            << "smoothing lambda " << format_number(c.lambda)
+            << (opt.has("lambda") ? " (given)" : " (" + std::to_string(fo.folds) + "-fold cross-validation)") << "\n"
+            << "residual: rms " << format_number(c.rms_residual) << " N, max " << format_number(c.max_residual)
+            << " N; cells of negative mass: " << c.negative_cells << ", held at zero: " << c.cells_at_bound << " of "
+            << c.cell_weight.size() << "\n"
             << "wrote " << out << "\n";
   return 0;
 }

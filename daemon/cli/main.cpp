@@ -24,7 +24,7 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
 
   eval       run a table or the simplified model on a displacement series
   identify   a table from a model (virtual FOT campaign) or from measured FOT nodes
-  fit        a table from any displacement/force record (constrained least squares)
+  fit        a table from any displacement/force record (least squares, prior decided by held-out data)
   calibrate  simplified-model parameters from one measured loop
   invert     displacements that produce requested forces (force control)
   check      wiping-out and congruency of a record, as numbers

@@ -175,12 +175,27 @@ TEST_CASE("cli: fit, calibrate, invert, check and compare on generated data") {
   sma.evaluate(kPath, f);
   w.write("X.csv", series_csv(kPath, f));
 
+  // auto: both priors, each scored on held-out blocks; the SMA specimen needs negative masses.
   const Result fit = w.run("fit --data X.csv --subdivisions 10 -o F.json");
   REQUIRE(fit.code == 0);
-  CHECK(fit.out.find("(GCV)") != std::string::npos);
+  CAPTURE(fit.out);
+  CHECK(fit.out.find("(4-fold cross-validation)") != std::string::npos);
+  CHECK(fit.out.find("prior signed: signed: held-out RMS") != std::string::npos);
   const TableDocument fitted = table_from_json(slurp(w / "F.json"));
   CHECK(fitted.provenance.method == "lsq");
-  for (const CellWeight& c : cell_weights(fitted.table)) CHECK(c.weight >= -1e-9);
+  CHECK(fitted.provenance.extra.at("prior") == "signed");
+  CHECK(fitted.provenance.extra.at("candidates").size() == 2);
+  CHECK(fitted.provenance.extra.at("heldout_rms_N").get<double>() <
+        fitted.provenance.extra.at("candidates").at(1).at("heldout_rms_N").get<double>());
+  bool negative = false;
+  for (const CellWeight& c : cell_weights(fitted.table)) negative = negative || c.weight < 0.0;
+  CHECK(negative);
+  const Result mono = w.run("fit --data X.csv --subdivisions 10 --prior monotone --folds 3 -o M.json");
+  REQUIRE(mono.code == 0);
+  CHECK(mono.out.find("(3-fold cross-validation)") != std::string::npos);
+  for (const CellWeight& c : cell_weights(table_from_json(slurp(w / "M.json")).table)) CHECK(c.weight >= -1e-9);
+  check_error(w.run("fit --data X.csv --subdivisions 10 --prior positive -o F.json"), "signed, monotone or auto");
+  check_error(w.run("fit --data X.csv --subdivisions 201 -o F.json"), "subdivisions");
 
   const auto loop = ramp_through({0.0, 4.0, 0.0}, 0.005);
   std::vector<double> lf(loop.size());

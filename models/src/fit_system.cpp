@@ -1,0 +1,287 @@
+#include "fit_system.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+namespace hystlab::models::fit {
+namespace {
+
+double dot(std::span<const double> a, std::span<const double> b) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) s += a[k] * b[k];
+  return s;
+}
+
+double norm_on(std::span<const double> a, std::span<const std::uint8_t> free) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (free.empty() || free[k] != 0) s += a[k] * a[k];
+  return std::sqrt(s);
+}
+
+}  // namespace
+
+void cells_to_nodes(const Grid& g, std::span<const double> w, std::span<double> nodes) {
+  for (int i = 0; i <= g.n; ++i) nodes[Grid::index(i, i)] = 0.0;
+  for (int i = 1; i <= g.n; ++i) {
+    double row = 0.0;  // Σ_{q=j+1..i} w(i, q)
+    for (int j = i - 1; j >= 0; --j) {
+      row += w[Grid::cell_index(i, j + 1)];
+      nodes[Grid::index(i, j)] = nodes[Grid::index(i - 1, j)] + row;
+    }
+  }
+}
+
+void nodes_to_cells_transpose(const Grid& g, std::span<const double> nodes, std::span<double> w) {
+  // w(p, q) = Σ_{i >= p} Σ_{j < q} nodes(i, j): prefix sums along each row, accumulated upwards.
+  std::vector<double> column(static_cast<std::size_t>(g.n) + 1, 0.0);
+  for (int i = g.n; i >= 1; --i) {
+    double prefix = 0.0;
+    for (int q = 1; q <= i; ++q) {
+      prefix += nodes[Grid::index(i, q - 1)];
+      column[static_cast<std::size_t>(q)] += prefix;
+      w[Grid::cell_index(i, q)] = column[static_cast<std::size_t>(q)];
+    }
+  }
+}
+
+void smoothing_apply(const Grid& g, std::span<const double> w, std::span<double> out) {
+  std::fill(out.begin(), out.end(), 0.0);
+  auto couple = [&](std::size_t a, std::size_t b) {
+    const double d = w[a] - w[b];
+    out[a] += d;
+    out[b] -= d;
+  };
+  for (int p = 1; p <= g.n; ++p)
+    for (int q = 1; q <= p; ++q) {
+      if (p < g.n) couple(Grid::cell_index(p, q), Grid::cell_index(p + 1, q));
+      if (q < p) couple(Grid::cell_index(p, q), Grid::cell_index(p, q + 1));
+    }
+}
+
+std::vector<double> smoothing_diagonal(const Grid& g) {
+  std::vector<double> d(g.cell_count(), 0.0);
+  for (int p = 1; p <= g.n; ++p)
+    for (int q = 1; q <= p; ++q) {
+      if (p < g.n) {
+        d[Grid::cell_index(p, q)] += 1.0;
+        d[Grid::cell_index(p + 1, q)] += 1.0;
+      }
+      if (q < p) {
+        d[Grid::cell_index(p, q)] += 1.0;
+        d[Grid::cell_index(p, q + 1)] += 1.0;
+      }
+    }
+  return d;
+}
+
+NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> force, std::vector<double> mask)
+    : op_(op), mask_(std::move(mask)), cells_(op.grid().cell_count()) {
+  if (mask_.size() != op.samples() || force.size() != op.samples())
+    throw std::invalid_argument("fit: the force record and the mask must have one value per sample");
+  nodes_.assign(op.nodes(), 0.0);
+  node_grad_.assign(op.nodes(), 0.0);
+  samples_.assign(op.samples(), 0.0);
+  cell_tmp_.assign(cells_, 0.0);
+  rhs_.assign(size(), 0.0);
+  data_gradient(force, rhs_);
+  // Jacobi preconditioner: E[(Jᵀ M z)_c²] = Σ_k M_k J_kc² for z of random signs, from 8 probes
+  // (the diagonal of the data term cannot be read off without forming it; ±50 % is plenty here).
+  constexpr int kProbes = 8;
+  std::mt19937_64 rng(0x5eed);
+  std::vector<double> z(op.samples()), t(size());
+  data_diag_.assign(size(), 0.0);
+  for (int probe = 0; probe < kProbes; ++probe) {
+    for (double& v : z) v = (rng() & 1U) != 0U ? 1.0 : -1.0;
+    data_gradient(z, t);
+    for (std::size_t c = 0; c < cells_; ++c) data_diag_[c] += t[c] * t[c] / kProbes;
+  }
+  double trained = 0.0;
+  for (double m : mask_) trained += m;
+  data_diag_[cells_] = trained;
+  smooth_diag_ = smoothing_diagonal(op.grid());
+  smooth_diag_.push_back(0.0);
+  double data_trace = 0.0, smooth_trace = 0.0;
+  for (std::size_t c = 0; c < cells_; ++c) {
+    data_trace += data_diag_[c];
+    smooth_trace += smooth_diag_[c];
+  }
+  trace_ratio_ = smooth_trace > 0.0 ? std::max(data_trace, 1e-300) / smooth_trace : 1.0;
+  set_lambda(0.0);
+}
+
+void NormalSystem::set_lambda(double lambda) {
+  lambda_scaled_ = lambda * trace_ratio_;
+  inv_diag_.assign(size(), 1.0);
+  double largest = 0.0;
+  for (std::size_t c = 0; c < size(); ++c) largest = std::max(largest, data_diag_[c] + lambda_scaled_ * smooth_diag_[c]);
+  for (std::size_t c = 0; c < size(); ++c)
+    inv_diag_[c] = 1.0 / std::max(data_diag_[c] + lambda_scaled_ * smooth_diag_[c], 1e-12 * largest + 1e-300);
+}
+
+void NormalSystem::predict(std::span<const double> u, std::span<double> out) const {
+  cells_to_nodes(op_.grid(), u.first(cells_), nodes_);
+  op_.apply(nodes_, out);
+  for (double& v : out) v += u[cells_];
+}
+
+void NormalSystem::data_gradient(std::span<const double> r, std::span<double> out) const {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    samples_[k] = mask_[k] * r[k];
+    sum += samples_[k];
+  }
+  op_.apply_transpose(samples_, node_grad_);
+  nodes_to_cells_transpose(op_.grid(), node_grad_, out.first(cells_));
+  out[cells_] = sum;
+}
+
+void NormalSystem::apply(std::span<const double> u, std::span<double> out) const {
+  predict(u, samples_);
+  std::vector<double>& pred = samples_;
+  for (std::size_t k = 0; k < pred.size(); ++k) pred[k] *= mask_[k];
+  op_.apply_transpose(pred, node_grad_);
+  nodes_to_cells_transpose(op_.grid(), node_grad_, out.first(cells_));
+  double sum = 0.0;
+  for (double v : pred) sum += v;
+  out[cells_] = sum;
+  if (lambda_scaled_ > 0.0) {
+    smoothing_apply(op_.grid(), u.first(cells_), cell_tmp_);
+    for (std::size_t c = 0; c < cells_; ++c) out[c] += lambda_scaled_ * cell_tmp_[c];
+  }
+}
+
+std::size_t NormalSystem::scratch_bytes() const noexcept {
+  return (mask_.capacity() + samples_.capacity() + nodes_.capacity() + node_grad_.capacity() + cell_tmp_.capacity() +
+          rhs_.capacity() + data_diag_.capacity() + smooth_diag_.capacity() + inv_diag_.capacity()) *
+         sizeof(double);
+}
+
+SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::vector<double>& u,
+                         std::span<const std::uint8_t> free, double tol, int max_iterations, bool stop_at_bound) {
+  const std::size_t m = s.size(), cells = s.cells();
+  const auto inv = s.preconditioner();
+  auto on = [&](std::size_t c) { return free.empty() || free[c] != 0; };
+  std::vector<double> r(m), z(m), p(m), q(m);
+  s.apply(u, q);
+  for (std::size_t c = 0; c < m; ++c) r[c] = on(c) ? b[c] - q[c] : 0.0;
+  double bnorm = norm_on(b, free);
+  if (bnorm == 0.0) bnorm = 1.0;
+  for (std::size_t c = 0; c < m; ++c) p[c] = z[c] = inv[c] * r[c];
+  double rz = dot(r, z);
+  SolveStats st;
+  for (; st.iterations < max_iterations; ++st.iterations) {
+    if (norm_on(r, {}) <= tol * bnorm) {
+      st.converged = true;
+      return st;
+    }
+    s.apply(p, q);
+    for (std::size_t c = 0; c < m; ++c)
+      if (!on(c)) q[c] = 0.0;
+    const double pq = dot(p, q);
+    if (!(pq > 0.0)) return st;  // no curvature left along p (converged to rounding)
+    const double alpha = rz / pq;
+    if (stop_at_bound) {
+      double to_bound = std::numeric_limits<double>::infinity();
+      std::size_t hit = m;
+      for (std::size_t c = 0; c < cells; ++c)
+        if (on(c) && p[c] < 0.0 && u[c] / -p[c] < to_bound) {
+          to_bound = u[c] / -p[c];
+          hit = c;
+        }
+      if (to_bound < alpha) {
+        for (std::size_t c = 0; c < m; ++c) u[c] += to_bound * p[c];
+        for (std::size_t c = 0; c < cells; ++c) u[c] = std::max(0.0, u[c]);
+        u[hit] = 0.0;
+        ++st.iterations;
+        return st;
+      }
+    }
+    for (std::size_t c = 0; c < m; ++c) {
+      u[c] += alpha * p[c];
+      r[c] -= alpha * q[c];
+      z[c] = inv[c] * r[c];
+    }
+    const double rz_next = dot(r, z), beta = rz_next / rz;
+    rz = rz_next;
+    for (std::size_t c = 0; c < m; ++c) p[c] = z[c] + beta * p[c];
+  }
+  return st;
+}
+
+SolveStats solve_signed(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol,
+                        int max_iterations) {
+  return solve_on_face(s, b, u, {}, tol, max_iterations, false);
+}
+
+namespace {
+
+// One projected-gradient step with backtracking (Armijo along the projection arc). Returns false
+// when the projected gradient is already below the tolerance (u is a KKT point).
+bool gradient_projection_step(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol_abs) {
+  const std::size_t m = s.size(), cells = s.cells();
+  std::vector<double> g(m), d(m), qd(m), trial(m), step(m);
+  s.apply(u, g);
+  double pg2 = 0.0;
+  for (std::size_t c = 0; c < m; ++c) {
+    g[c] -= b[c];
+    const bool blocked = c < cells && u[c] <= 0.0 && g[c] > 0.0;
+    d[c] = blocked ? 0.0 : -g[c];
+    pg2 += d[c] * d[c];
+  }
+  if (std::sqrt(pg2) <= tol_abs) return false;
+  s.apply(d, qd);
+  const double curvature = dot(d, qd);
+  double alpha = curvature > 0.0 ? pg2 / curvature : 1.0;
+  for (int backtrack = 0; backtrack < 40; ++backtrack, alpha *= 0.5) {
+    for (std::size_t c = 0; c < m; ++c) {
+      trial[c] = u[c] + alpha * d[c];
+      if (c < cells) trial[c] = std::max(0.0, trial[c]);
+      step[c] = trial[c] - u[c];
+    }
+    s.apply(step, qd);
+    const double slope = dot(g, step);
+    if (slope + 0.5 * dot(step, qd) <= 1e-4 * slope) break;
+  }
+  u = trial;
+  return true;
+}
+
+}  // namespace
+
+SolveStats solve_monotone(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol,
+                          int max_iterations, std::vector<std::uint8_t>& free_out) {
+  const std::size_t m = s.size(), cells = s.cells();
+  for (std::size_t c = 0; c < cells; ++c) u[c] = std::max(0.0, u[c]);
+  double bnorm = norm_on(b, {});
+  if (bnorm == 0.0) bnorm = 1.0;
+  SolveStats st;
+  free_out.assign(m, 1);
+  while (st.iterations < max_iterations) {
+    // Gradient projection until the set of cells at the bound settles (or 5 steps).
+    std::size_t at_bound = cells + 1;
+    bool moved = true;
+    for (int k = 0; k < 5 && moved; ++k) {
+      moved = gradient_projection_step(s, b, u, tol * bnorm);
+      st.iterations += moved ? 1 : 0;
+      std::size_t now = 0;
+      for (std::size_t c = 0; c < cells; ++c) now += u[c] <= 0.0 ? 1U : 0U;
+      if (now == at_bound) break;
+      at_bound = now;
+    }
+    if (!moved) {
+      st.converged = true;
+      break;
+    }
+    for (std::size_t c = 0; c < m; ++c) free_out[c] = (c == cells || u[c] > 0.0) ? 1 : 0;
+    const SolveStats face = solve_on_face(s, b, u, free_out, tol, max_iterations - st.iterations, true);
+    st.iterations += face.iterations;
+  }
+  for (std::size_t c = 0; c < m; ++c) free_out[c] = (c == cells || u[c] > 0.0) ? 1 : 0;
+  return st;
+}
+
+}  // namespace hystlab::models::fit

@@ -1,0 +1,72 @@
+#pragma once
+// The regularised normal equations of the least-squares Preisach fit on one training mask, applied
+// matrix-free, and the two solvers (private to hystlab::models; preisach_fit.hpp is the interface).
+//
+// Unknowns u = [w_1 .. w_C, offset]: the cell masses in Grid::cell_index order and a force offset.
+// Model: pred = A P w + offset, with A the record's PreisachOperator (node values -> output) and
+// P the cumulative map from masses to node values. Q u = Pᵀ Aᵀ M (A P w + offset) + λ' L w, where
+// M masks the training samples and L = DᵀD smooths neighbouring cells; λ' = λ tr(data)/tr(L).
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "hystlab/models/preisach_operator.hpp"
+
+namespace hystlab::models::fit {
+
+// F(δ_i, δ_j) = Σ_{p=j+1..i} Σ_{q=j+1..p} w(p, q), diagonal nodes 0; and its transpose.
+void cells_to_nodes(const Grid& g, std::span<const double> w, std::span<double> nodes);
+void nodes_to_cells_transpose(const Grid& g, std::span<const double> nodes, std::span<double> w);
+// L w: for each pair of neighbouring cells (p,q)-(p+1,q) and (p,q)-(p,q+1), (w_a - w_b) on both.
+void smoothing_apply(const Grid& g, std::span<const double> w, std::span<double> out);
+[[nodiscard]] std::vector<double> smoothing_diagonal(const Grid& g);
+
+class NormalSystem {
+ public:
+  // mask[k] is 1 for a training sample, 0 for a held-out one. Not thread-safe (scratch buffers).
+  NormalSystem(const PreisachOperator& op, std::span<const double> force, std::vector<double> mask);
+
+  [[nodiscard]] std::size_t size() const noexcept { return cells_ + 1; }
+  [[nodiscard]] std::size_t cells() const noexcept { return cells_; }
+  void set_lambda(double lambda);  // relative weight; see the header comment
+  [[nodiscard]] double lambda_scaled() const noexcept { return lambda_scaled_; }
+
+  void apply(std::span<const double> u, std::span<double> out) const;        // Q u
+  void predict(std::span<const double> u, std::span<double> out) const;      // A P w + offset, all samples
+  void data_gradient(std::span<const double> r, std::span<double> out) const;  // [Pᵀ Aᵀ M r; Σ M r]
+  [[nodiscard]] const std::vector<double>& rhs() const noexcept { return rhs_; }
+  [[nodiscard]] std::span<const double> preconditioner() const noexcept { return inv_diag_; }
+  [[nodiscard]] std::size_t scratch_bytes() const noexcept;
+
+ private:
+  const PreisachOperator& op_;
+  std::vector<double> mask_;
+  std::size_t cells_ = 0;
+  std::vector<double> rhs_;
+  std::vector<double> data_diag_;    // estimated diagonal of the data term
+  std::vector<double> smooth_diag_;
+  std::vector<double> inv_diag_;
+  double trace_ratio_ = 1.0;         // tr(data) / tr(L)
+  double lambda_scaled_ = 0.0;
+  mutable std::vector<double> nodes_, samples_, node_grad_, cell_tmp_;
+};
+
+struct SolveStats {
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Preconditioned conjugate gradients on Q u = b from u (a warm start), all unknowns free.
+SolveStats solve_signed(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol,
+                        int max_iterations);
+// The same with w >= 0 (the offset free): gradient projection steps, then conjugate gradients on
+// the face of free cells until a bound is hit (Moré and Toraldo's GPCG, without its safeguards on
+// the face's progress). `free_out` gets which unknowns ended off the bound.
+SolveStats solve_monotone(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol,
+                          int max_iterations, std::vector<std::uint8_t>& free_out);
+// Conjugate gradients restricted to the unknowns with free[c] != 0 (others held at 0): used for
+// the uncertainty of a monotone fit on its free face, and by solve_monotone.
+SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::vector<double>& u,
+                         std::span<const std::uint8_t> free, double tol, int max_iterations, bool stop_at_bound);
+
+}  // namespace hystlab::models::fit

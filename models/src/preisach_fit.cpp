@@ -1,0 +1,222 @@
+#include "hystlab/models/preisach_fit.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include "fit_system.hpp"
+#include "hystlab/models/preisach_model.hpp"
+
+namespace hystlab::models {
+namespace {
+
+using fit::NormalSystem;
+
+// λ tried by the cross-validation, largest first: each solve starts from the smoother solution of
+// the λ before it, which is close (warm start).
+constexpr double kLambdas[] = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
+constexpr double kCvTolerance = 1e-5;
+constexpr int kMaxIterations = 4000;
+
+void validate(std::span<const double> x, std::span<const double> y, const Grid& grid, const PreisachFitOptions& o) {
+  if (x.size() != y.size()) throw std::invalid_argument("fit: displacement and force differ in length");
+  if (grid.n > o.max_subdivisions)
+    throw std::invalid_argument("fit: subdivisions must be at most " + std::to_string(o.max_subdivisions) + ", got " +
+                                std::to_string(grid.n));
+  if (o.folds < 2 || o.folds > 20) throw std::invalid_argument("fit: folds must be from 2 to 20");
+  const std::size_t unknowns = grid.cell_count() + 1;
+  if (x.size() < 2 * unknowns)
+    throw std::invalid_argument("fit: " + std::to_string(x.size()) + " samples are too few for " +
+                                std::to_string(unknowns) + " unknowns (need at least twice as many)");
+  for (std::size_t k = 0; k < x.size(); ++k)
+    if (!std::isfinite(x[k]) || !std::isfinite(y[k]))
+      throw std::invalid_argument("fit: sample " + std::to_string(k) + " is not a finite number");
+}
+
+struct Solved {
+  std::vector<double> u;
+  std::vector<std::uint8_t> free;
+  int iterations = 0;
+};
+
+void solve(const NormalSystem& s, FitPrior prior, double tol, Solved& out) {
+  if (prior == FitPrior::monotone) {
+    out.iterations += fit::solve_monotone(s, s.rhs(), out.u, tol, kMaxIterations, out.free).iterations;
+  } else {
+    out.iterations += fit::solve_signed(s, s.rhs(), out.u, tol, kMaxIterations).iterations;
+    out.free.assign(s.size(), 1);
+  }
+}
+
+// Held-out RMS for every λ of kLambdas: fold f trains on all samples but block f and is scored on
+// block f, whose memory state comes from the whole record before it.
+std::vector<double> cross_validate(const PreisachOperator& op, std::span<const double> y, FitPrior prior, int folds,
+                                   int& iterations) {
+  const std::size_t N = op.samples();
+  std::vector<double> sse(std::size(kLambdas), 0.0), pred(N);
+  for (int f = 0; f < folds; ++f) {
+    const std::size_t begin = N * static_cast<std::size_t>(f) / static_cast<std::size_t>(folds);
+    const std::size_t end = N * static_cast<std::size_t>(f + 1) / static_cast<std::size_t>(folds);
+    std::vector<double> mask(N, 1.0);
+    std::fill(mask.begin() + static_cast<std::ptrdiff_t>(begin), mask.begin() + static_cast<std::ptrdiff_t>(end), 0.0);
+    NormalSystem s(op, y, std::move(mask));
+    Solved sol{std::vector<double>(s.size(), 0.0), {}, 0};
+    for (std::size_t l = 0; l < std::size(kLambdas); ++l) {
+      s.set_lambda(kLambdas[l]);
+      solve(s, prior, kCvTolerance, sol);
+      s.predict(sol.u, pred);
+      for (std::size_t k = begin; k < end; ++k) sse[l] += (pred[k] - y[k]) * (pred[k] - y[k]);
+    }
+    iterations += sol.iterations;
+  }
+  for (double& v : sse) v = std::sqrt(v / static_cast<double>(N));
+  return sse;
+}
+
+// Per-cell σ and the effective number of parameters from random probes z of the samples:
+// v = Q_F⁻¹ (Jᵀ z)_F has E[v∘v] = diag(Q_F⁻¹ H_F Q_F⁻¹) and E[(Jᵀz)·v] = tr(Q_F⁻¹ H_F) on the
+// free set F, with the exact sandwich covariance σ² Q⁻¹ H Q⁻¹ of the dense fit as its mean.
+void uncertainty(const NormalSystem& s, const Solved& sol, double rss, std::size_t samples, int probes, PriorFit& r,
+                 int& iterations) {
+  const std::size_t m = s.size(), cells = s.cells();
+  std::vector<double> var(m, 0.0), z(samples), jz(m);
+  double edf = 0.0;
+  std::mt19937_64 rng(0xc0ffee);
+  for (int p = 0; p < probes; ++p) {
+    for (double& v : z) v = (rng() & 1U) != 0U ? 1.0 : -1.0;
+    s.data_gradient(z, jz);
+    for (std::size_t c = 0; c < m; ++c)
+      if (sol.free[c] == 0) jz[c] = 0.0;
+    std::vector<double> v(m, 0.0);
+    iterations += fit::solve_on_face(s, jz, v, sol.free, 1e-6, kMaxIterations, false).iterations;
+    for (std::size_t c = 0; c < m; ++c) {
+      var[c] += v[c] * v[c] / probes;
+      edf += jz[c] * v[c] / probes;
+    }
+  }
+  const double sigma2 = probes > 0 ? rss / std::max(1.0, static_cast<double>(samples) - edf) : 0.0;
+  r.cell_sigma.assign(cells, 0.0);
+  for (std::size_t c = 0; c < cells; ++c) r.cell_sigma[c] = std::sqrt(sigma2 * var[c]);
+}
+
+PriorFit final_fit(const PreisachOperator& op, std::span<const double> x, std::span<const double> y, FitPrior prior,
+                   double lambda, const PreisachFitOptions& o, bool with_sigma) {
+  const Grid& g = op.grid();
+  NormalSystem s(op, y, std::vector<double>(op.samples(), 1.0));
+  s.set_lambda(lambda);
+  Solved sol{std::vector<double>(s.size(), 0.0), {}, 0};
+  solve(s, prior, o.tolerance, sol);
+  PriorFit r;
+  r.prior = prior;
+  r.lambda = lambda;
+  r.iterations = sol.iterations;
+  const std::size_t cells = g.cell_count();
+  r.cell_weight.assign(sol.u.begin(), sol.u.begin() + static_cast<std::ptrdiff_t>(cells));
+  r.force_offset = sol.u[cells];
+  std::vector<double> values(g.node_count());
+  fit::cells_to_nodes(g, r.cell_weight, values);
+  r.table = EverettTable(g, std::move(values), r.force_offset);
+  for (std::size_t c = 0; c < cells; ++c) {
+    r.cells_at_bound += prior == FitPrior::monotone && sol.free[c] == 0 ? 1U : 0U;
+    r.negative_cells += r.cell_weight[c] < 0.0 ? 1U : 0U;
+  }
+  // Residuals from the fitted table run through the model itself, not through the operator.
+  PreisachModel model(r.table);
+  double ss = 0.0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const double e = model.step(x[k]) - y[k];
+    ss += e * e;
+    r.max_residual = std::max(r.max_residual, std::fabs(e));
+  }
+  r.rms_residual = std::sqrt(ss / static_cast<double>(x.size()));
+  if (with_sigma && o.uncertainty_probes > 0) uncertainty(s, sol, ss, x.size(), o.uncertainty_probes, r, r.iterations);
+  else r.cell_sigma.assign(cells, 0.0);
+  return r;
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+std::string describe(const PriorFit& f) {
+  return std::string(to_string(f.prior)) + ": held-out RMS " + number(f.heldout_rms) + " N (λ " + number(f.lambda) + ")";
+}
+
+}  // namespace
+
+std::string_view to_string(FitPrior p) noexcept {
+  switch (p) {
+    case FitPrior::signed_masses: return "signed";
+    case FitPrior::monotone: return "monotone";
+    case FitPrior::automatic: return "auto";
+  }
+  return "?";
+}
+
+FitPrior fit_prior_from_string(std::string_view s) {
+  if (s == "signed") return FitPrior::signed_masses;
+  if (s == "monotone") return FitPrior::monotone;
+  if (s == "auto") return FitPrior::automatic;
+  throw std::invalid_argument("prior: must be signed, monotone or auto, got '" + std::string(s) + "'");
+}
+
+PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double> y, const Grid& grid,
+                               const PreisachFitOptions& o) {
+  validate(x, y, grid, o);
+  const auto t0 = std::chrono::steady_clock::now();
+  const PreisachOperator op(grid, x);
+  PreisachFitResult result;
+  result.operator_bytes = op.memory_bytes();
+  std::vector<FitPrior> priors;
+  if (o.prior == FitPrior::automatic) priors = {FitPrior::signed_masses, FitPrior::monotone};
+  else priors = {o.prior};
+  for (const FitPrior prior : priors) {
+    double lambda = o.lambda, heldout = 0.0;
+    std::vector<double> tried, rms;
+    int cv_iterations = 0;
+    if (lambda < 0.0) {
+      rms = cross_validate(op, y, prior, o.folds, cv_iterations);
+      tried.assign(std::begin(kLambdas), std::end(kLambdas));
+      const auto best = static_cast<std::size_t>(std::min_element(rms.begin(), rms.end()) - rms.begin());
+      lambda = kLambdas[best];
+      heldout = rms[best];
+    }
+    const bool chosen_alone = priors.size() == 1;
+    PriorFit f = final_fit(op, x, y, prior, lambda, o, chosen_alone);
+    f.heldout_rms = heldout;
+    f.cv_lambda = std::move(tried);
+    f.cv_rms = std::move(rms);
+    f.iterations += cv_iterations;
+    result.candidates.push_back(std::move(f));
+  }
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < result.candidates.size(); ++k)
+    if (result.candidates[k].heldout_rms < result.candidates[best].heldout_rms) best = k;
+  if (result.candidates.size() > 1) {
+    const PriorFit& w = result.candidates[best];
+    const PriorFit& l = result.candidates[1 - best];
+    result.reason = describe(w) + " against " + describe(l) + ": " + std::string(to_string(w.prior)) +
+                    " has the lower error on held-out blocks of the record";
+    // σ for the winner only (its probes are the costly part after the cross-validation).
+    PriorFit sigma = final_fit(op, x, y, w.prior, w.lambda, o, true);
+    result.candidates[best].cell_sigma = std::move(sigma.cell_sigma);
+  } else if (o.lambda < 0.0) {
+    result.reason = describe(result.candidates[0]) + " (prior " + std::string(to_string(o.prior)) + " as asked)";
+  } else {
+    result.reason = std::string(to_string(o.prior)) + " with the given λ " + number(o.lambda);
+  }
+  result.chosen = result.candidates[best];
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The operator, one system's scratch and a few solver vectors of the cells are alive at once.
+  result.peak_bytes = op.memory_bytes() + (7 * op.samples() + 12 * (grid.cell_count() + 1) + 3 * grid.node_count()) *
+                                              sizeof(double);
+  return result;
+}
+
+}  // namespace hystlab::models
