@@ -48,6 +48,52 @@ void nodes_to_cells_transpose(const Grid& g, std::span<const double> nodes, std:
   }
 }
 
+void nodes_to_cells(const Grid& g, std::span<const double> nodes, std::span<double> w) {
+  auto F = [&](int i, int j) { return j >= i ? 0.0 : nodes[Grid::index(i, j)]; };
+  for (int p = 1; p <= g.n; ++p)
+    for (int q = 1; q <= p; ++q) w[Grid::cell_index(p, q)] = F(p, q - 1) - F(p - 1, q - 1) - F(p, q) + F(p - 1, q);
+}
+
+void cells_to_nodes_inverse_transpose(const Grid& g, std::span<const double> w, std::span<double> nodes) {
+  std::fill(nodes.begin(), nodes.end(), 0.0);
+  auto add = [&](int i, int j, double v) {
+    if (j < i) nodes[Grid::index(i, j)] += v;
+  };
+  for (int p = 1; p <= g.n; ++p)
+    for (int q = 1; q <= p; ++q) {
+      const double v = w[Grid::cell_index(p, q)];
+      add(p, q - 1, v);
+      add(p - 1, q - 1, -v);
+      add(p, q, -v);
+      add(p - 1, q, v);
+    }
+}
+
+namespace {
+
+// The diagonal of R = P⁻ᵀ L P⁻¹ (smoothing in node space), exactly: a node's footprint through
+// P⁻¹, L and P⁻ᵀ reaches nodes at most 2 away in i and in j, so probing every 5th node in each
+// direction at once (25 probes) reads each diagonal entry unmixed.
+std::vector<double> node_smoothing_diagonal(const Grid& g) {
+  constexpr int kSpacing = 5;
+  std::vector<double> diag(g.node_count(), 0.0), e(g.node_count()), w(g.cell_count()), lw(g.cell_count()),
+      back(g.node_count());
+  for (int ci = 0; ci < kSpacing; ++ci)
+    for (int cj = 0; cj < kSpacing; ++cj) {
+      std::fill(e.begin(), e.end(), 0.0);
+      for (int i = ci; i <= g.n; i += kSpacing)
+        for (int j = cj; j < i; j += kSpacing) e[Grid::index(i, j)] = 1.0;
+      nodes_to_cells(g, e, w);
+      smoothing_apply(g, w, lw);
+      cells_to_nodes_inverse_transpose(g, lw, back);
+      for (int i = ci; i <= g.n; i += kSpacing)
+        for (int j = cj; j < i; j += kSpacing) diag[Grid::index(i, j)] = back[Grid::index(i, j)];
+    }
+  return diag;
+}
+
+}  // namespace
+
 void smoothing_apply(const Grid& g, std::span<const double> w, std::span<double> out) {
   std::fill(out.begin(), out.end(), 0.0);
   auto couple = [&](std::size_t a, std::size_t b) {
@@ -87,27 +133,32 @@ NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> f
   samples_.assign(op.samples(), 0.0);
   cell_tmp_.assign(cells_, 0.0);
   rhs_.assign(size(), 0.0);
+  pre_nodes_.assign(op.nodes(), 0.0);
   data_gradient(force, rhs_);
-  // Jacobi preconditioner: E[(Jᵀ M z)_c²] = Σ_k M_k J_kc² for z of random signs, from 8 probes
-  // (the diagonal of the data term cannot be read off without forming it; ±50 % is plenty here).
+  // The data term's diagonal in node space, E[(Aᵀ M z)_a²] = Σ_k M_k A_ka² for z of random signs,
+  // from 8 probes (it cannot be read off without forming the Gram matrix; ±50 % is plenty for a
+  // preconditioner). The same probes mapped to cells give the trace that scales λ.
   constexpr int kProbes = 8;
   std::mt19937_64 rng(0x5eed);
-  std::vector<double> z(op.samples()), t(size());
-  data_diag_.assign(size(), 0.0);
+  std::vector<double> z(op.samples()), t(op.nodes()), tw(cells_);
+  data_diag_.assign(op.nodes(), 0.0);
+  cell_data_diag_.assign(cells_, 0.0);
   for (int probe = 0; probe < kProbes; ++probe) {
-    for (double& v : z) v = (rng() & 1U) != 0U ? 1.0 : -1.0;
-    data_gradient(z, t);
-    for (std::size_t c = 0; c < cells_; ++c) data_diag_[c] += t[c] * t[c] / kProbes;
+    for (std::size_t k = 0; k < z.size(); ++k) z[k] = mask_[k] * ((rng() & 1U) != 0U ? 1.0 : -1.0);
+    op.apply_transpose(z, t);
+    for (std::size_t a = 0; a < t.size(); ++a) data_diag_[a] += t[a] * t[a] / kProbes;
+    nodes_to_cells_transpose(op.grid(), t, tw);
+    for (std::size_t c = 0; c < cells_; ++c) cell_data_diag_[c] += tw[c] * tw[c] / kProbes;
   }
-  double trained = 0.0;
-  for (double m : mask_) trained += m;
-  data_diag_[cells_] = trained;
-  smooth_diag_ = smoothing_diagonal(op.grid());
-  smooth_diag_.push_back(0.0);
-  double data_trace = 0.0, smooth_trace = 0.0;
+  offset_diag_ = 0.0;
+  for (double m : mask_) offset_diag_ += m;
+  offset_diag_ = std::max(offset_diag_, 1.0);
+  smooth_diag_ = node_smoothing_diagonal(op.grid());
+  cell_smooth_diag_ = smoothing_diagonal(op.grid());
+  double smooth_trace = 0.0, data_trace = 0.0;
   for (std::size_t c = 0; c < cells_; ++c) {
-    data_trace += data_diag_[c];
-    smooth_trace += smooth_diag_[c];
+    smooth_trace += cell_smooth_diag_[c];
+    data_trace += cell_data_diag_[c];
   }
   trace_ratio_ = smooth_trace > 0.0 ? std::max(data_trace, 1e-300) / smooth_trace : 1.0;
   set_lambda(0.0);
@@ -115,11 +166,34 @@ NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> f
 
 void NormalSystem::set_lambda(double lambda) {
   lambda_scaled_ = lambda * trace_ratio_;
-  inv_diag_.assign(size(), 1.0);
+  const Grid& g = op_.grid();
+  inv_diag_.assign(data_diag_.size(), 0.0);
   double largest = 0.0;
-  for (std::size_t c = 0; c < size(); ++c) largest = std::max(largest, data_diag_[c] + lambda_scaled_ * smooth_diag_[c]);
-  for (std::size_t c = 0; c < size(); ++c)
-    inv_diag_[c] = 1.0 / std::max(data_diag_[c] + lambda_scaled_ * smooth_diag_[c], 1e-12 * largest + 1e-300);
+  for (std::size_t a = 0; a < inv_diag_.size(); ++a)
+    largest = std::max(largest, data_diag_[a] + lambda_scaled_ * smooth_diag_[a]);
+  for (int i = 0; i <= g.n; ++i)
+    for (int j = 0; j < i; ++j) {
+      const std::size_t a = Grid::index(i, j);
+      inv_diag_[a] = 1.0 / std::max(data_diag_[a] + lambda_scaled_ * smooth_diag_[a], 1e-12 * largest + 1e-300);
+    }
+  inv_cell_diag_.assign(cells_, 0.0);
+  largest = 0.0;
+  for (std::size_t c = 0; c < cells_; ++c)
+    largest = std::max(largest, cell_data_diag_[c] + lambda_scaled_ * cell_smooth_diag_[c]);
+  for (std::size_t c = 0; c < cells_; ++c)
+    inv_cell_diag_[c] = 1.0 / std::max(cell_data_diag_[c] + lambda_scaled_ * cell_smooth_diag_[c], 1e-12 * largest + 1e-300);
+}
+
+void NormalSystem::precondition(std::span<const double> r, std::span<double> z, bool on_face) const {
+  const Grid& g = op_.grid();
+  z[cells_] = r[cells_] / offset_diag_;
+  if (on_face) {
+    for (std::size_t c = 0; c < cells_; ++c) z[c] = inv_cell_diag_[c] * r[c];
+    return;
+  }
+  cells_to_nodes_inverse_transpose(g, r.first(cells_), pre_nodes_);
+  for (std::size_t a = 0; a < pre_nodes_.size(); ++a) pre_nodes_[a] *= inv_diag_[a];
+  nodes_to_cells(g, pre_nodes_, z.first(cells_));
 }
 
 void NormalSystem::predict(std::span<const double> u, std::span<double> out) const {
@@ -156,21 +230,28 @@ void NormalSystem::apply(std::span<const double> u, std::span<double> out) const
 
 std::size_t NormalSystem::scratch_bytes() const noexcept {
   return (mask_.capacity() + samples_.capacity() + nodes_.capacity() + node_grad_.capacity() + cell_tmp_.capacity() +
-          rhs_.capacity() + data_diag_.capacity() + smooth_diag_.capacity() + inv_diag_.capacity()) *
+          rhs_.capacity() + data_diag_.capacity() + smooth_diag_.capacity() + inv_diag_.capacity() +
+          pre_nodes_.capacity() + cell_data_diag_.capacity() + cell_smooth_diag_.capacity() +
+          inv_cell_diag_.capacity()) *
          sizeof(double);
 }
 
 SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::vector<double>& u,
                          std::span<const std::uint8_t> free, double tol, int max_iterations, bool stop_at_bound) {
   const std::size_t m = s.size(), cells = s.cells();
-  const auto inv = s.preconditioner();
   auto on = [&](std::size_t c) { return free.empty() || free[c] != 0; };
   std::vector<double> r(m), z(m), p(m), q(m);
   s.apply(u, q);
   for (std::size_t c = 0; c < m; ++c) r[c] = on(c) ? b[c] - q[c] : 0.0;
   double bnorm = norm_on(b, free);
   if (bnorm == 0.0) bnorm = 1.0;
-  for (std::size_t c = 0; c < m; ++c) p[c] = z[c] = inv[c] * r[c];
+  auto precondition = [&] {
+    s.precondition(r, z, !free.empty());
+    for (std::size_t c = 0; c < m; ++c)
+      if (!on(c)) z[c] = 0.0;
+  };
+  precondition();
+  p = z;
   double rz = dot(r, z);
   SolveStats st;
   for (; st.iterations < max_iterations; ++st.iterations) {
@@ -203,8 +284,8 @@ SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::
     for (std::size_t c = 0; c < m; ++c) {
       u[c] += alpha * p[c];
       r[c] -= alpha * q[c];
-      z[c] = inv[c] * r[c];
     }
+    precondition();
     const double rz_next = dot(r, z), beta = rz_next / rz;
     rz = rz_next;
     for (std::size_t c = 0; c < m; ++c) p[c] = z[c] + beta * p[c];

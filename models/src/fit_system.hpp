@@ -17,6 +17,10 @@ namespace hystlab::models::fit {
 // F(δ_i, δ_j) = Σ_{p=j+1..i} Σ_{q=j+1..p} w(p, q), diagonal nodes 0; and its transpose.
 void cells_to_nodes(const Grid& g, std::span<const double> w, std::span<double> nodes);
 void nodes_to_cells_transpose(const Grid& g, std::span<const double> nodes, std::span<double> w);
+// The inverse map: w(p, q) = F(p, q-1) - F(p-1, q-1) - F(p, q) + F(p-1, q) (a mixed difference,
+// F on the diagonal 0), and its transpose (cells -> nodes; diagonal nodes get 0).
+void nodes_to_cells(const Grid& g, std::span<const double> nodes, std::span<double> w);
+void cells_to_nodes_inverse_transpose(const Grid& g, std::span<const double> w, std::span<double> nodes);
 // L w: for each pair of neighbouring cells (p,q)-(p+1,q) and (p,q)-(p,q+1), (w_a - w_b) on both.
 void smoothing_apply(const Grid& g, std::span<const double> w, std::span<double> out);
 [[nodiscard]] std::vector<double> smoothing_diagonal(const Grid& g);
@@ -35,7 +39,13 @@ class NormalSystem {
   void predict(std::span<const double> u, std::span<double> out) const;      // A P w + offset, all samples
   void data_gradient(std::span<const double> r, std::span<double> out) const;  // [Pᵀ Aᵀ M r; Σ M r]
   [[nodiscard]] const std::vector<double>& rhs() const noexcept { return rhs_; }
-  [[nodiscard]] std::span<const double> preconditioner() const noexcept { return inv_diag_; }
+  // z = M⁻¹ r with M = Pᵀ D P, D the diagonal of the system in node space (the data term's,
+  // estimated, plus the smoothing's, exact): node values are local features of the record where
+  // cell masses are cumulative ones, so the node-space diagonal is the better-conditioned scaling.
+  // On a face of the monotone problem (some cells held at 0) the node-space scaling mixes held and
+  // free cells, and the plain Jacobi scaling of the cells converges faster (measured: 1,445 against
+  // 4,961 steps for a cross-validated monotone fit at n = 24 on 2·10^5 samples).
+  void precondition(std::span<const double> r, std::span<double> z, bool on_face) const;
   [[nodiscard]] std::size_t scratch_bytes() const noexcept;
 
  private:
@@ -43,12 +53,14 @@ class NormalSystem {
   std::vector<double> mask_;
   std::size_t cells_ = 0;
   std::vector<double> rhs_;
-  std::vector<double> data_diag_;    // estimated diagonal of the data term
-  std::vector<double> smooth_diag_;
-  std::vector<double> inv_diag_;
+  std::vector<double> data_diag_;    // node space: estimated diagonal of the data term
+  std::vector<double> smooth_diag_;  // node space: exact diagonal of P⁻ᵀ L P⁻¹
+  std::vector<double> inv_diag_;     // node space
+  std::vector<double> cell_data_diag_, cell_smooth_diag_, inv_cell_diag_;  // cell space, for faces
+  double offset_diag_ = 1.0;
   double trace_ratio_ = 1.0;         // tr(data) / tr(L)
   double lambda_scaled_ = 0.0;
-  mutable std::vector<double> nodes_, samples_, node_grad_, cell_tmp_;
+  mutable std::vector<double> nodes_, samples_, node_grad_, cell_tmp_, pre_nodes_;
 };
 
 struct SolveStats {

@@ -19,7 +19,7 @@ using fit::NormalSystem;
 // λ tried by the cross-validation, largest first: each solve starts from the smoother solution of
 // the λ before it, which is close (warm start).
 constexpr double kLambdas[] = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
-constexpr double kCvTolerance = 1e-5;
+constexpr double kCvTolerance = 1e-6;
 constexpr int kMaxIterations = 4000;
 
 void validate(std::span<const double> x, std::span<const double> y, const Grid& grid, const PreisachFitOptions& o) {
