@@ -132,7 +132,7 @@ TEST_CASE("acceptance: on the simplified SMA model, auto's error on held-out dat
   // tables are run over the whole record (so the memory is the specimen's) and scored on the rest.
   std::mt19937_64 rng(2024);
   SimplifiedSmaModel sma(table1_parameters());
-  const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 900, 0.01);
+  const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 500, 0.01);
   const auto truth = drive(sma, x);
   std::normal_distribution<double> noise(0.0, 0.2);
   auto y = truth;
@@ -143,6 +143,7 @@ TEST_CASE("acceptance: on the simplified SMA model, auto's error on held-out dat
     const Grid g = Grid::make(0.0, 4.0, n);
     PreisachFitOptions o;
     o.uncertainty_probes = 0;
+    o.folds = 3;
     const PreisachFitResult r = fit_preisach(std::span(x).first(train), std::span(y).first(train), g, o);
     CAPTURE(r.reason);
     REQUIRE(r.candidates.size() == 2);
