@@ -17,6 +17,7 @@ nlohmann::json fit_provenance(const PreisachFitResult& r) {
           {"heldout_rms_N", c.heldout_rms},
           {"rms_residual_N", c.rms_residual},
           {"max_residual_N", c.max_residual},
+          {"converged", c.converged},
           {"negative_cells", c.negative_cells},
           {"cells_at_bound", c.cells_at_bound},
           {"cell_sigma_N", c.cell_sigma},

@@ -269,8 +269,8 @@ SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::
       double to_bound = std::numeric_limits<double>::infinity();
       std::size_t hit = m;
       for (std::size_t c = 0; c < cells; ++c)
-        if (on(c) && p[c] < 0.0 && u[c] / -p[c] < to_bound) {
-          to_bound = u[c] / -p[c];
+        if (on(c) && p[c] < 0.0 && std::max(0.0, u[c]) / -p[c] < to_bound) {
+          to_bound = std::max(0.0, u[c]) / -p[c];
           hit = c;
         }
       if (to_bound < alpha) {
@@ -361,6 +361,7 @@ SolveStats solve_monotone(const NormalSystem& s, std::span<const double> b, std:
     const SolveStats face = solve_on_face(s, b, u, free_out, tol, max_iterations - st.iterations, true);
     st.iterations += face.iterations;
   }
+  for (std::size_t c = 0; c < cells; ++c) u[c] = std::max(0.0, u[c]);  // no -1e-17 left by rounding
   for (std::size_t c = 0; c < m; ++c) free_out[c] = (c == cells || u[c] > 0.0) ? 1 : 0;
   return st;
 }

@@ -28,6 +28,12 @@ void validate(std::span<const double> x, std::span<const double> y, const Grid& 
     throw std::invalid_argument("fit: subdivisions must be at most " + std::to_string(o.max_subdivisions) + ", got " +
                                 std::to_string(grid.n));
   if (o.folds < 2 || o.folds > 20) throw std::invalid_argument("fit: folds must be from 2 to 20");
+  if (std::isnan(o.lambda) || o.lambda > 1e6)
+    throw std::invalid_argument("fit: lambda must be a number from 0 to 1e6 (or negative to choose it by cross-validation)");
+  if (!(o.tolerance > 0.0 && o.tolerance <= 0.1)) throw std::invalid_argument("fit: tolerance must be in (0, 0.1]");
+  if (o.uncertainty_probes < 0 || o.uncertainty_probes > 1000)
+    throw std::invalid_argument("fit: uncertainty_probes must be from 0 to 1000");
+  (void)Grid::make(grid.lo, grid.hi, grid.n);  // a grid not built by Grid::make is checked the same way
   const std::size_t unknowns = grid.cell_count() + 1;
   if (x.size() < 2 * unknowns)
     throw std::invalid_argument("fit: " + std::to_string(x.size()) + " samples are too few for " +
@@ -41,23 +47,27 @@ struct Solved {
   std::vector<double> u;
   std::vector<std::uint8_t> free;
   int iterations = 0;
+  bool converged = true;
 };
 
 void solve(const NormalSystem& s, FitPrior prior, double tol, Solved& out) {
+  fit::SolveStats st;
   if (prior == FitPrior::monotone) {
-    out.iterations += fit::solve_monotone(s, s.rhs(), out.u, tol, kMaxIterations, out.free).iterations;
+    st = fit::solve_monotone(s, s.rhs(), out.u, tol, kMaxIterations, out.free);
   } else {
-    out.iterations += fit::solve_signed(s, s.rhs(), out.u, tol, kMaxIterations).iterations;
+    st = fit::solve_signed(s, s.rhs(), out.u, tol, kMaxIterations);
     out.free.assign(s.size(), 1);
   }
+  out.iterations += st.iterations;
+  out.converged = st.converged;
 }
 
 // Held-out RMS for every λ of kLambdas: fold f trains on all samples but block f and is scored on
 // block f, whose memory state comes from the whole record before it.
 std::vector<double> cross_validate(const PreisachOperator& op, std::span<const double> y, FitPrior prior, int folds,
-                                   int& iterations) {
+                                   std::span<const double> lambdas, int& iterations) {
   const std::size_t N = op.samples();
-  std::vector<double> sse(std::size(kLambdas), 0.0), pred(N);
+  std::vector<double> sse(lambdas.size(), 0.0), pred(N);
   for (int f = 0; f < folds; ++f) {
     const std::size_t begin = N * static_cast<std::size_t>(f) / static_cast<std::size_t>(folds);
     const std::size_t end = N * static_cast<std::size_t>(f + 1) / static_cast<std::size_t>(folds);
@@ -65,15 +75,16 @@ std::vector<double> cross_validate(const PreisachOperator& op, std::span<const d
     std::fill(mask.begin() + static_cast<std::ptrdiff_t>(begin), mask.begin() + static_cast<std::ptrdiff_t>(end), 0.0);
     NormalSystem s(op, y, std::move(mask));
     Solved sol{std::vector<double>(s.size(), 0.0), {}, 0};
-    for (std::size_t l = 0; l < std::size(kLambdas); ++l) {
-      s.set_lambda(kLambdas[l]);
+    for (std::size_t l = 0; l < lambdas.size(); ++l) {
+      s.set_lambda(lambdas[l]);
       solve(s, prior, kCvTolerance, sol);
       s.predict(sol.u, pred);
       for (std::size_t k = begin; k < end; ++k) sse[l] += (pred[k] - y[k]) * (pred[k] - y[k]);
     }
     iterations += sol.iterations;
   }
-  for (double& v : sse) v = std::sqrt(v / static_cast<double>(N));
+  // A solve that went non-finite scores +∞: it can never be chosen.
+  for (double& v : sse) v = std::isfinite(v) ? std::sqrt(v / static_cast<double>(N)) : std::numeric_limits<double>::infinity();
   return sse;
 }
 
@@ -92,7 +103,10 @@ void uncertainty(const NormalSystem& s, const Solved& sol, double rss, std::size
     for (std::size_t c = 0; c < m; ++c)
       if (sol.free[c] == 0) jz[c] = 0.0;
     std::vector<double> v(m, 0.0);
-    iterations += fit::solve_on_face(s, jz, v, sol.free, 1e-6, kMaxIterations, false).iterations;
+    const bool all_free = std::all_of(sol.free.begin(), sol.free.end(), [](std::uint8_t f) { return f != 0; });
+    iterations +=
+        fit::solve_on_face(s, jz, v, all_free ? std::span<const std::uint8_t>{} : sol.free, 1e-6, kMaxIterations, false)
+            .iterations;
     for (std::size_t c = 0; c < m; ++c) {
       var[c] += v[c] * v[c] / probes;
       edf += jz[c] * v[c] / probes;
@@ -114,6 +128,7 @@ PriorFit final_fit(const PreisachOperator& op, std::span<const double> x, std::s
   r.prior = prior;
   r.lambda = lambda;
   r.iterations = sol.iterations;
+  r.converged = sol.converged;
   const std::size_t cells = g.cell_count();
   r.cell_weight.assign(sol.u.begin(), sol.u.begin() + static_cast<std::ptrdiff_t>(cells));
   r.force_offset = sol.u[cells];
@@ -177,16 +192,17 @@ PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double
   if (o.prior == FitPrior::automatic) priors = {FitPrior::signed_masses, FitPrior::monotone};
   else priors = {o.prior};
   for (const FitPrior prior : priors) {
-    double lambda = o.lambda, heldout = 0.0;
-    std::vector<double> tried, rms;
+    // λ by cross-validation, or the given λ scored on the same held-out blocks (so `auto` still
+    // compares the priors on data they were not fitted to).
+    const std::vector<double> lambdas =
+        o.lambda < 0.0 ? std::vector<double>(std::begin(kLambdas), std::end(kLambdas)) : std::vector<double>{o.lambda};
     int cv_iterations = 0;
-    if (lambda < 0.0) {
-      rms = cross_validate(op, y, prior, o.folds, cv_iterations);
-      tried.assign(std::begin(kLambdas), std::end(kLambdas));
-      const auto best = static_cast<std::size_t>(std::min_element(rms.begin(), rms.end()) - rms.begin());
-      lambda = kLambdas[best];
-      heldout = rms[best];
-    }
+    std::vector<double> rms = cross_validate(op, y, prior, o.folds, lambdas, cv_iterations);
+    const auto best_l = static_cast<std::size_t>(std::min_element(rms.begin(), rms.end()) - rms.begin());
+    if (!std::isfinite(rms[best_l]))
+      throw std::invalid_argument("fit: every smoothing weight gave a non-finite error: the record cannot be fitted");
+    const double lambda = lambdas[best_l], heldout = rms[best_l];
+    std::vector<double> tried = lambdas;
     const bool chosen_alone = priors.size() == 1;
     PriorFit f = final_fit(op, x, y, prior, lambda, o, chosen_alone);
     f.heldout_rms = heldout;
@@ -206,11 +222,12 @@ PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double
     // σ for the winner only (its probes are the costly part after the cross-validation).
     PriorFit sigma = final_fit(op, x, y, w.prior, w.lambda, o, true);
     result.candidates[best].cell_sigma = std::move(sigma.cell_sigma);
-  } else if (o.lambda < 0.0) {
-    result.reason = describe(result.candidates[0]) + " (prior " + std::string(to_string(o.prior)) + " as asked)";
   } else {
-    result.reason = std::string(to_string(o.prior)) + " with the given λ " + number(o.lambda);
+    result.reason = describe(result.candidates[0]) + " (prior " + std::string(to_string(o.prior)) + " as asked)";
   }
+  for (const PriorFit& f : result.candidates)
+    if (!f.converged)
+      result.reason += "; WARNING: the " + std::string(to_string(f.prior)) + " solve stopped at its step limit before converging";
   result.chosen = result.candidates[best];
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // The operator, one system's scratch and a few solver vectors of the cells are alive at once.

@@ -46,7 +46,9 @@ TEST_CASE("the operator is the model's linear map: it matches the row-by-row reg
     const Grid g = Grid::make(-1.0, 3.0, 3 + static_cast<int>(seed % 5) * 4);
     auto x = rough_walk(rng, g, 30);
     x.push_back(g.hi + 1.0);  // clamped like the model
-    x.push_back(g.lo - 1.0);
+    // Odd seeds end at the bottom (every memory term wiped out before the end); even seeds end
+    // mid-range, so terms are still alive at the last sample (the difference array's open end).
+    x.push_back(seed % 2 == 1 ? g.lo - 1.0 : 0.5 * (g.lo + g.hi));
     const PreisachOperator op(g, x);
     REQUIRE(op.samples() == x.size());
     std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -208,7 +210,26 @@ TEST_CASE("the monotone solver reaches the constrained optimum: no feasible move
   o.uncertainty_probes = 0;
   o.tolerance = 1e-10;
   const PriorFit f = fit_preisach(x, y, g, o).chosen;
+  CHECK(f.converged);
   CHECK(f.cells_at_bound > 0);
+  // KKT at the returned point: with g = Q u - b, zero on the free cells and the offset, >= 0 on
+  // the cells held at the bound.
+  {
+    const PreisachOperator op(g, x);
+    fit::NormalSystem sys(op, y, std::vector<double>(x.size(), 1.0));
+    sys.set_lambda(f.lambda);
+    std::vector<double> u = f.cell_weight, grad(sys.size());
+    u.push_back(f.force_offset);
+    sys.apply(u, grad);
+    double bnorm = 0.0;
+    for (double b : sys.rhs()) bnorm = std::max(bnorm, std::fabs(b));
+    for (std::size_t c = 0; c < sys.size(); ++c) {
+      CAPTURE(c);
+      const double gc = grad[c] - sys.rhs()[c];
+      if (c < sys.cells() && u[c] == 0.0) CHECK(gc >= -1e-7 * bnorm);
+      else CHECK(std::fabs(gc) <= 1e-7 * bnorm);
+    }
+  }
   auto rms_of = [&](const std::vector<double>& w) {
     std::vector<double> F(g.node_count());
     fit::cells_to_nodes(g, w, F);
@@ -227,6 +248,26 @@ TEST_CASE("the monotone solver reaches the constrained optimum: no feasible move
   }
 }
 
+TEST_CASE("auto with a given λ still compares the priors on held-out blocks") {
+  std::mt19937_64 rng(8);
+  const Grid g = Grid::make(0.0, 4.0, 6);
+  SimplifiedSmaModel sma(table1_parameters());
+  const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 80, 0.02);
+  const auto y = drive(sma, x);
+  PreisachFitOptions o;
+  o.lambda = 1e-4;
+  o.uncertainty_probes = 0;
+  const PreisachFitResult r = fit_preisach(x, y, g, o);
+  REQUIRE(r.candidates.size() == 2);
+  for (const PriorFit& f : r.candidates) {
+    CHECK(f.heldout_rms > 0.0);
+    CHECK(f.lambda == 1e-4);
+    CHECK(f.cv_lambda.size() == 1);
+  }
+  CHECK(r.chosen.heldout_rms == std::min(r.candidates[0].heldout_rms, r.candidates[1].heldout_rms));
+  CHECK(r.reason.find("lower error on held-out blocks") != std::string::npos);
+}
+
 TEST_CASE("bad fit input is refused with the field named") {
   const Grid g = Grid::make(0.0, 4.0, 8);
   const std::vector<double> few(10, 1.0);
@@ -240,4 +281,13 @@ TEST_CASE("bad fit input is refused with the field named") {
   many[17] = std::nan("");
   CHECK_THROWS_WITH((void)fit_preisach(many, many, g), doctest::Contains("sample 17"));
   CHECK_THROWS_WITH((void)fit_prior_from_string("positive"), doctest::Contains("signed, monotone or auto"));
+  many[17] = 1.0;
+  PreisachFitOptions bad;
+  bad.lambda = std::nan("");
+  CHECK_THROWS_WITH((void)fit_preisach(many, many, g, bad), doctest::Contains("lambda"));
+  bad.lambda = 1e300;
+  CHECK_THROWS_WITH((void)fit_preisach(many, many, g, bad), doctest::Contains("lambda"));
+  bad.lambda = -1.0;
+  bad.tolerance = 0.0;
+  CHECK_THROWS_WITH((void)fit_preisach(many, many, g, bad), doctest::Contains("tolerance"));
 }

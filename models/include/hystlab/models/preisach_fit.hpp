@@ -47,7 +47,7 @@ struct PriorFit {
   FitPrior prior = FitPrior::signed_masses;
   EverettTable table;
   double lambda = 0.0;
-  double heldout_rms = 0.0;       // N, cross-validated error at the chosen λ (0 when λ was given)
+  double heldout_rms = 0.0;       // N, cross-validated error at the chosen (or given) λ
   std::vector<double> cv_lambda;  // the λ tried, and their held-out RMS (N)
   std::vector<double> cv_rms;
   double rms_residual = 0.0;      // N, on the whole record, by running the fitted table
@@ -58,6 +58,7 @@ struct PriorFit {
   std::size_t cells_at_bound = 0;
   std::size_t negative_cells = 0;
   int iterations = 0;               // conjugate-gradient steps of all its solves
+  bool converged = true;            // the final solve met its tolerance (else the reason warns)
 };
 
 struct PreisachFitResult {
