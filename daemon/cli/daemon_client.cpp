@@ -27,11 +27,15 @@ std::string api_reason(const httplib::Response& r) {
   return "HTTP " + std::to_string(r.status) + (excerpt.empty() ? "" : ": " + excerpt);
 }
 
+// One place for the two waits: the calls below and the messages that name them.
+constexpr int kConnectSeconds = 5;
+constexpr int kAnswerSeconds = 30;  // a submit waits for the daemon's main loop; a busy database can take seconds
+
 // httplib's names for a failed request ("Connection", "Read"), in the words of a lab user.
 std::string failure_words(httplib::Error e) {
   switch (e) {
     case httplib::Error::Connection: return "nothing accepts a connection there";
-    case httplib::Error::ConnectionTimeout: return "no connection within 5 s";
+    case httplib::Error::ConnectionTimeout: return "no connection within " + std::to_string(kConnectSeconds) + " s";
     case httplib::Error::SSLConnection:
     case httplib::Error::SSLServerVerification: return "no TLS connection (" + httplib::to_string(e) + ")";
     default: return httplib::to_string(e);
@@ -55,13 +59,13 @@ DaemonAddress daemon_address(const Options& opt) {
 
 nlohmann::json post_to_daemon(const DaemonAddress& to, const std::string& path, const std::string& body) {
   httplib::Client client(to.url);
-  client.set_connection_timeout(5, 0);
-  client.set_read_timeout(30, 0);  // a submit waits for the daemon's main loop; a busy database can take seconds
+  client.set_connection_timeout(kConnectSeconds, 0);
+  client.set_read_timeout(kAnswerSeconds, 0);
   httplib::Headers headers;
   if (!to.token.empty()) headers.emplace("Authorization", "Bearer " + to.token);
   const auto r = body.empty() ? client.Post(path.c_str(), headers) : client.Post(path.c_str(), headers, body, "application/json");
   if (!r && r.error() == httplib::Error::Read)  // it may have acted: a blind retry could queue a campaign twice
-    throw CliError("hystlabd at " + to.url + " did not answer within 30 s; it may still carry the request out: check with 'hystlab campaign list' before sending it again");
+    throw CliError("hystlabd at " + to.url + " did not answer within " + std::to_string(kAnswerSeconds) + " s; it may still carry the request out: check with 'hystlab campaign list' before sending it again");
   if (!r && r.error() == httplib::Error::Write)
     throw CliError("hystlabd at " + to.url + " closed the connection while the request was sent (a plan larger than its http.max_body_bytes?)");
   if (!r)

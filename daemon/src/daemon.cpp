@@ -3,12 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
-#include <thread>
 #include <condition_variable>
 #include <future>
 #include <limits>
 #include <mutex>
 #include <set>
+#include <thread>
 
 #include "finisher.hpp"
 #include "hystlab/daemon/plan.hpp"

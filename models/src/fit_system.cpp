@@ -145,7 +145,7 @@ NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> f
   cell_data_diag_.assign(cells_, 0.0);
   for (int probe = 0; probe < kProbes; ++probe) {
     for (std::size_t k = 0; k < z.size(); ++k) z[k] = mask_[k] * ((rng() & 1U) != 0U ? 1.0 : -1.0);
-    op.apply_transpose(z, t);
+    op.apply_transpose(z, t, prefix_);
     for (std::size_t a = 0; a < t.size(); ++a) data_diag_[a] += t[a] * t[a] / kProbes;
     nodes_to_cells_transpose(op.grid(), t, tw);
     for (std::size_t c = 0; c < cells_; ++c) cell_data_diag_[c] += tw[c] * tw[c] / kProbes;
@@ -208,7 +208,7 @@ void NormalSystem::data_gradient(std::span<const double> r, std::span<double> ou
     samples_[k] = mask_[k] * r[k];
     sum += samples_[k];
   }
-  op_.apply_transpose(samples_, node_grad_);
+  op_.apply_transpose(samples_, node_grad_, prefix_);
   nodes_to_cells_transpose(op_.grid(), node_grad_, out.first(cells_));
   out[cells_] = sum;
 }
@@ -217,7 +217,7 @@ void NormalSystem::apply(std::span<const double> u, std::span<double> out) const
   predict(u, samples_);
   std::vector<double>& pred = samples_;
   for (std::size_t k = 0; k < pred.size(); ++k) pred[k] *= mask_[k];
-  op_.apply_transpose(pred, node_grad_);
+  op_.apply_transpose(pred, node_grad_, prefix_);
   nodes_to_cells_transpose(op_.grid(), node_grad_, out.first(cells_));
   double sum = 0.0;
   for (double v : pred) sum += v;
@@ -232,7 +232,7 @@ std::size_t NormalSystem::scratch_bytes() const noexcept {
   return (mask_.capacity() + samples_.capacity() + nodes_.capacity() + node_grad_.capacity() + cell_tmp_.capacity() +
           rhs_.capacity() + data_diag_.capacity() + smooth_diag_.capacity() + inv_diag_.capacity() +
           pre_nodes_.capacity() + cell_data_diag_.capacity() + cell_smooth_diag_.capacity() +
-          inv_cell_diag_.capacity()) *
+          inv_cell_diag_.capacity() + prefix_.capacity()) *
          sizeof(double);
 }
 

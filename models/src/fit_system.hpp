@@ -60,7 +60,7 @@ class NormalSystem {
   double offset_diag_ = 1.0;
   double trace_ratio_ = 1.0;         // tr(data) / tr(L)
   double lambda_scaled_ = 0.0;
-  mutable std::vector<double> nodes_, samples_, node_grad_, cell_tmp_, pre_nodes_;
+  mutable std::vector<double> nodes_, samples_, node_grad_, cell_tmp_, pre_nodes_, prefix_;
 };
 
 struct SolveStats {

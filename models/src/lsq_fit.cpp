@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "fit_record.hpp"
 #include "hystlab/models/preisach_model.hpp"
 
 namespace hystlab::models {
@@ -113,23 +114,12 @@ ActiveSetResult solve_nonnegative(const MatrixXd& Q, const VectorXd& g, const Ve
   return r;
 }
 
-void validate_input(std::span<const double> x, std::span<const double> f, const Grid& grid) {
-  if (x.size() != f.size()) throw std::invalid_argument("fit: displacement and force differ in length");
-  if (grid.n > 48) throw std::invalid_argument("fit: subdivisions must be at most 48, got " + std::to_string(grid.n));
-  const std::size_t unknowns = grid.cell_count() + 1;
-  if (x.size() < 2 * unknowns)
-    throw std::invalid_argument("fit: " + std::to_string(x.size()) + " samples are too few for " +
-                                std::to_string(unknowns) + " unknowns (need at least twice as many)");
-  for (std::size_t k = 0; k < x.size(); ++k)
-    if (!std::isfinite(x[k]) || !std::isfinite(f[k]))
-      throw std::invalid_argument("fit: sample " + std::to_string(k) + " is not a finite number");
-}
 
 }  // namespace
 
 LsqFitResult fit_preisach_lsq(std::span<const double> x, std::span<const double> y, const Grid& grid,
                               const LsqFitOptions& opt) {
-  validate_input(x, y, grid);
+  check_fit_record(x, y, grid, 48);
   const std::size_t nodes = grid.node_count(), cells = grid.cell_count();
   const auto N = static_cast<double>(x.size());
   // Normal equations in node space, with the offset as the last unknown.

@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "fit_record.hpp"
 #include "fit_system.hpp"
 #include "hystlab/models/preisach_model.hpp"
 
@@ -23,10 +24,6 @@ constexpr double kCvTolerance = 1e-6;
 constexpr int kMaxIterations = 4000;
 
 void validate(std::span<const double> x, std::span<const double> y, const Grid& grid, const PreisachFitOptions& o) {
-  if (x.size() != y.size()) throw std::invalid_argument("fit: displacement and force differ in length");
-  if (grid.n > o.max_subdivisions)
-    throw std::invalid_argument("fit: subdivisions must be at most " + std::to_string(o.max_subdivisions) + ", got " +
-                                std::to_string(grid.n));
   if (o.folds < 2 || o.folds > 20) throw std::invalid_argument("fit: folds must be from 2 to 20");
   if (std::isnan(o.lambda) || o.lambda > 1e6)
     throw std::invalid_argument("fit: lambda must be a number from 0 to 1e6 (or negative to choose it by cross-validation)");
@@ -34,13 +31,7 @@ void validate(std::span<const double> x, std::span<const double> y, const Grid& 
   if (o.uncertainty_probes < 0 || o.uncertainty_probes > 1000)
     throw std::invalid_argument("fit: uncertainty_probes must be from 0 to 1000");
   (void)Grid::make(grid.lo, grid.hi, grid.n);  // a grid not built by Grid::make is checked the same way
-  const std::size_t unknowns = grid.cell_count() + 1;
-  if (x.size() < 2 * unknowns)
-    throw std::invalid_argument("fit: " + std::to_string(x.size()) + " samples are too few for " +
-                                std::to_string(unknowns) + " unknowns (need at least twice as many)");
-  for (std::size_t k = 0; k < x.size(); ++k)
-    if (!std::isfinite(x[k]) || !std::isfinite(y[k]))
-      throw std::invalid_argument("fit: sample " + std::to_string(k) + " is not a finite number");
+  check_fit_record(x, y, grid, o.max_subdivisions);
 }
 
 struct Solved {
@@ -117,14 +108,27 @@ void uncertainty(const NormalSystem& s, const Solved& sol, double rss, std::size
   for (std::size_t c = 0; c < cells; ++c) r.cell_sigma[c] = std::sqrt(sigma2 * var[c]);
 }
 
-PriorFit final_fit(const PreisachOperator& op, std::span<const double> x, std::span<const double> y, FitPrior prior,
-                   double lambda, const PreisachFitOptions& o, bool with_sigma) {
-  const Grid& g = op.grid();
+// A prior's fit on the whole record at its λ, with the solution kept for the σ probes.
+struct FinalFit {
+  PriorFit fit;
+  Solved solved;
+  double rss = 0.0;  // N², from the table run through the model
+};
+
+NormalSystem whole_record(const PreisachOperator& op, std::span<const double> y, double lambda) {
   NormalSystem s(op, y, std::vector<double>(op.samples(), 1.0));
   s.set_lambda(lambda);
-  Solved sol{std::vector<double>(s.size(), 0.0), {}, 0};
-  solve(s, prior, o.tolerance, sol);
-  PriorFit r;
+  return s;
+}
+
+FinalFit final_fit(const PreisachOperator& op, std::span<const double> x, std::span<const double> y, FitPrior prior,
+                   double lambda, double tolerance) {
+  const Grid& g = op.grid();
+  FinalFit out;
+  out.solved.u.assign(g.cell_count() + 1, 0.0);
+  solve(whole_record(op, y, lambda), prior, tolerance, out.solved);
+  const Solved& sol = out.solved;
+  PriorFit& r = out.fit;
   r.prior = prior;
   r.lambda = lambda;
   r.iterations = sol.iterations;
@@ -141,16 +145,33 @@ PriorFit final_fit(const PreisachOperator& op, std::span<const double> x, std::s
   }
   // Residuals from the fitted table run through the model itself, not through the operator.
   PreisachModel model(r.table);
-  double ss = 0.0;
   for (std::size_t k = 0; k < x.size(); ++k) {
     const double e = model.step(x[k]) - y[k];
-    ss += e * e;
+    out.rss += e * e;
     r.max_residual = std::max(r.max_residual, std::fabs(e));
   }
-  r.rms_residual = std::sqrt(ss / static_cast<double>(x.size()));
-  if (with_sigma && o.uncertainty_probes > 0) uncertainty(s, sol, ss, x.size(), o.uncertainty_probes, r, r.iterations);
-  else r.cell_sigma.assign(cells, 0.0);
-  return r;
+  r.rms_residual = std::sqrt(out.rss / static_cast<double>(x.size()));
+  r.cell_sigma.assign(cells, 0.0);
+  return out;
+}
+
+// One prior: λ by cross-validation, or the given λ scored on the same held-out blocks (so `auto`
+// still compares the priors on data they were not fitted to); then its fit on the whole record.
+FinalFit fit_prior(const PreisachOperator& op, std::span<const double> x, std::span<const double> y, FitPrior prior,
+                   const PreisachFitOptions& o) {
+  const std::vector<double> lambdas =
+      o.lambda < 0.0 ? std::vector<double>(std::begin(kLambdas), std::end(kLambdas)) : std::vector<double>{o.lambda};
+  int cv_iterations = 0;
+  std::vector<double> rms = cross_validate(op, y, prior, o.folds, lambdas, cv_iterations);
+  const auto best = static_cast<std::size_t>(std::min_element(rms.begin(), rms.end()) - rms.begin());
+  if (!std::isfinite(rms[best]))
+    throw std::invalid_argument("fit: every smoothing weight gave a non-finite error: the record cannot be fitted");
+  FinalFit f = final_fit(op, x, y, prior, lambdas[best], o.tolerance);
+  f.fit.heldout_rms = rms[best];
+  f.fit.cv_lambda = lambdas;
+  f.fit.cv_rms = std::move(rms);
+  f.fit.iterations += cv_iterations;
+  return f;
 }
 
 std::string number(double v) {
@@ -191,37 +212,22 @@ PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double
   std::vector<FitPrior> priors;
   if (o.prior == FitPrior::automatic) priors = {FitPrior::signed_masses, FitPrior::monotone};
   else priors = {o.prior};
-  for (const FitPrior prior : priors) {
-    // λ by cross-validation, or the given λ scored on the same held-out blocks (so `auto` still
-    // compares the priors on data they were not fitted to).
-    const std::vector<double> lambdas =
-        o.lambda < 0.0 ? std::vector<double>(std::begin(kLambdas), std::end(kLambdas)) : std::vector<double>{o.lambda};
-    int cv_iterations = 0;
-    std::vector<double> rms = cross_validate(op, y, prior, o.folds, lambdas, cv_iterations);
-    const auto best_l = static_cast<std::size_t>(std::min_element(rms.begin(), rms.end()) - rms.begin());
-    if (!std::isfinite(rms[best_l]))
-      throw std::invalid_argument("fit: every smoothing weight gave a non-finite error: the record cannot be fitted");
-    const double lambda = lambdas[best_l], heldout = rms[best_l];
-    std::vector<double> tried = lambdas;
-    const bool chosen_alone = priors.size() == 1;
-    PriorFit f = final_fit(op, x, y, prior, lambda, o, chosen_alone);
-    f.heldout_rms = heldout;
-    f.cv_lambda = std::move(tried);
-    f.cv_rms = std::move(rms);
-    f.iterations += cv_iterations;
-    result.candidates.push_back(std::move(f));
-  }
+  std::vector<FinalFit> finals;
+  for (const FitPrior prior : priors) finals.push_back(fit_prior(op, x, y, prior, o));
   std::size_t best = 0;
-  for (std::size_t k = 1; k < result.candidates.size(); ++k)
-    if (result.candidates[k].heldout_rms < result.candidates[best].heldout_rms) best = k;
+  for (std::size_t k = 1; k < finals.size(); ++k)
+    if (finals[k].fit.heldout_rms < finals[best].fit.heldout_rms) best = k;
+  // σ for the chosen prior only (its probes are the costly part after the cross-validation).
+  PriorFit& chosen = finals[best].fit;
+  if (o.uncertainty_probes > 0)
+    uncertainty(whole_record(op, y, chosen.lambda), finals[best].solved, finals[best].rss, x.size(),
+                o.uncertainty_probes, chosen, chosen.iterations);
+  for (FinalFit& f : finals) result.candidates.push_back(std::move(f.fit));
   if (result.candidates.size() > 1) {
     const PriorFit& w = result.candidates[best];
     const PriorFit& l = result.candidates[1 - best];
     result.reason = describe(w) + " against " + describe(l) + ": " + std::string(to_string(w.prior)) +
                     " has the lower error on held-out blocks of the record";
-    // σ for the winner only (its probes are the costly part after the cross-validation).
-    PriorFit sigma = final_fit(op, x, y, w.prior, w.lambda, o, true);
-    result.candidates[best].cell_sigma = std::move(sigma.cell_sigma);
   } else {
     result.reason = describe(result.candidates[0]) + " (prior " + std::string(to_string(o.prior)) + " as asked)";
   }

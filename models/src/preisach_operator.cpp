@@ -108,9 +108,16 @@ void PreisachOperator::apply(std::span<const double> v, std::span<double> out) c
 }
 
 void PreisachOperator::apply_transpose(std::span<const double> u, std::span<double> g) const {
+  std::vector<double> prefix;
+  apply_transpose(u, g, prefix);
+}
+
+void PreisachOperator::apply_transpose(std::span<const double> u, std::span<double> g,
+                                       std::vector<double>& prefix) const {
   if (u.size() != samples() || g.size() != nodes()) throw std::invalid_argument("PreisachOperator::apply_transpose: sizes");
   // prefix[k] = Σ_{j<k} u[j], so a held term's share is weight * (prefix[end] - prefix[start]).
-  std::vector<double> prefix(samples() + 1, 0.0);
+  prefix.resize(samples() + 1);
+  prefix[0] = 0.0;
   for (std::size_t k = 0; k < samples(); ++k) prefix[k + 1] = prefix[k] + u[k];
   std::fill(g.begin(), g.end(), 0.0);
   for (const HeldTerm& t : held_) g[t.node] += t.weight * (prefix[t.end] - prefix[t.start]);

@@ -30,31 +30,20 @@
 // usage: node bench_page.mjs HYSTLABD BENCH_LOOP OUT_DIR
 import { execFileSync } from 'node:child_process';
 import { startDaemon, stopDaemon } from '../browser/hystlabd.mjs';
-import { createRequire } from 'node:module';
+import { Checks, chromium, chromiumPath as findChromium, freshDir } from '../browser/harness.mjs';
 import fs from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const require = createRequire(path.resolve(here, '../../web/package.json'));
-const { chromium } = require('playwright-core');
 
 const [daemonPath, benchLoop, outDir] = process.argv.slice(2);
 if (!daemonPath || !benchLoop || !outDir) { console.error('usage: node bench_page.mjs HYSTLABD BENCH_LOOP OUT_DIR'); process.exit(2); }
-const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
-if (!fs.existsSync(chromiumPath)) { console.error(`no Chromium at ${chromiumPath} (apt install chromium)`); process.exit(1); }
+const chromiumPath = findChromium();
 const BIG = Number(process.env.BENCH_PAGE_SAMPLES || 1000000), SMALL = 1000, REPEATS = 5;
 const ROWS = 12, REVERSALS = 2 * ROWS - 1, CELLS = ROWS * (ROWS + 1) / 2;  // bench_loop's fill
 const TIMEOUT_MS = 300000;  // one render, on a starved VM
 
-fs.rmSync(outDir, { recursive: true, force: true });
-fs.mkdirSync(outDir, { recursive: true });
-let failures = 0;
-function check(cond, what) {
-  console.log(`${cond ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!cond) failures++;
-  return cond;
-}
+freshDir(outDir);
+const checks = new Checks(), check = checks.check;
 const median = v => { const s = v.slice().sort((a, b) => a - b); return s[Math.floor(s.length / 2)]; };
 const ms = v => `${Math.round(v).toLocaleString('en-US')} ms`;
 
@@ -228,7 +217,7 @@ try {
   check(errors.length === 0, 'no script errors on the page' + (errors.length ? ': ' + errors.join(' | ') : ''));
 } catch (e) {
   console.log('FAIL ' + (e.stack || e));
-  failures++;
+  checks.failures++;
 } finally {
   await browser.close();
   await stopDaemon(daemon);
@@ -250,6 +239,6 @@ if (tb.length === REPEATS && ts.length === REPEATS) {
   console.log(`page first render, ${label}-sample campaign: median ${ms(mb)} (baseline 1,000-sample campaign: ${ms(msm)}, ratio ${(mb / msm).toFixed(2)}) ` +
               `(target < 1.5 s: ${mb < 1500 ? 'met' : 'NOT met'})`);
 }
-if (failures) console.log('the daemon printed (last 3000 characters):\n' + log.slice(-3000));
-console.log(failures ? `${failures} check(s) failed (screenshots in ${outDir})` : `all checks passed (screenshots in ${outDir})`);
-process.exit(failures ? 1 : 0);
+if (checks.failures) console.log('the daemon printed (last 3000 characters):\n' + log.slice(-3000));
+console.log(checks.failures ? `${checks.failures} check(s) failed (screenshots in ${outDir})` : `all checks passed (screenshots in ${outDir})`);
+process.exit(checks.failures ? 1 : 0);

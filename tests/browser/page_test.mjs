@@ -9,31 +9,20 @@
 // Saves screenshots in OUT_DIR.
 // usage: [ONLY=outage] node page_test.mjs HYSTLABD OUT_DIR
 import { startDaemon as startHystlabd, stopDaemon as stopHystlabd } from './hystlabd.mjs';
-import { createRequire } from 'node:module';
+import { Checks, chromium, chromiumPath as findChromium, freshDir } from './harness.mjs';
 import fs from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const require = createRequire(path.resolve(here, '../../web/package.json'));
-const { chromium } = require('playwright-core');
 
 const [daemonPath, outDir] = process.argv.slice(2);
 if (!daemonPath || !outDir) { console.error('usage: node page_test.mjs HYSTLABD OUT_DIR'); process.exit(2); }
-const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
 // ONLY=outage runs the page's first checks and the injected outage alone (a quicker loop while
 // working on it); the test as a whole runs everything.
 const only = (process.env.ONLY || '').split(',').filter(Boolean);
-if (!fs.existsSync(chromiumPath)) { console.error(`no Chromium at ${chromiumPath} (apt install chromium)`); process.exit(1); }
-fs.rmSync(outDir, { recursive: true, force: true });
-fs.mkdirSync(outDir, { recursive: true });
+const chromiumPath = findChromium();
+freshDir(outDir);
 
-let failures = 0;
-function check(cond, what) {
-  console.log(`${cond ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!cond) failures++;
-  return cond;
-}
+const checks = new Checks(), check = checks.check;
 
 // The daemon: its own database and config (a fast simulated load frame), a free port.
 const FRAME_TIME_SCALE = 10;
@@ -498,12 +487,12 @@ try {
   }
 } catch (e) {
   console.log('FAIL ' + (e.stack || e));
-  failures++;
+  checks.failures++;
 } finally {
   await browser.close();
   await stopDaemon(daemon);
 }
-if (failures && pageWarnings.length) console.log('the page warned:\n' + pageWarnings.slice(-20).join('\n'));
-if (failures) console.log('the daemon printed (last 6000 characters):\n' + daemonLog.slice(-6000));
-console.log(failures ? `${failures} check(s) failed (screenshots in ${outDir})` : `all checks passed (screenshots in ${outDir})`);
-process.exit(failures ? 1 : 0);
+if (checks.failures && pageWarnings.length) console.log('the page warned:\n' + pageWarnings.slice(-20).join('\n'));
+if (checks.failures) console.log('the daemon printed (last 6000 characters):\n' + daemonLog.slice(-6000));
+console.log(checks.failures ? `${checks.failures} check(s) failed (screenshots in ${outDir})` : `all checks passed (screenshots in ${outDir})`);
+process.exit(checks.failures ? 1 : 0);

@@ -1,9 +1,7 @@
 // hystlabd as a user runs it: a real process with its supervised simulator, commanded through the
 // CLI over its HTTP API and observed in its db file; stopped by SIGTERM, killed with SIGKILL.
 #include <doctest/doctest.h>
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,15 +10,14 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <regex>
 #include <thread>
 
 #include "hystlab/db/store.hpp"
 #include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/simplified_sma.hpp"
+#include "../support/daemon_process.hpp"
 
-extern char** environ;
 namespace fs = std::filesystem;
 using namespace hystlab;
 
@@ -37,18 +34,7 @@ struct Dir {
 };
 
 pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  std::vector<std::string> a = args;
-  std::vector<char*> argv;
-  for (auto& s : a) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  pid_t pid = -1;
-  REQUIRE(posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ) == 0);
-  posix_spawn_file_actions_destroy(&fa);
-  return pid;
+  return test_support::spawn_logged(args, log.string());
 }
 
 // A daemon a failed REQUIRE left running is killed when the test case ends.
@@ -84,19 +70,13 @@ CliRun cli(const std::string& args) {
   return r;
 }
 
-std::string log_of(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+std::string log_of(const fs::path& p) { return test_support::read_log(p.string()); }
 
 // " --daemon http://127.0.0.1:PORT" of the daemon writing `log`, once it serves (started with --port 0).
 std::string daemon_at(const fs::path& log) {
-  static const std::regex re("serving the API and the page on (http://127\\.0\\.0\\.1:\\d+)/");
-  std::smatch m;
-  std::string text;
-  for (int k = 0; k < 1200 && !std::regex_search(text = log_of(log), m, re); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  REQUIRE_MESSAGE(std::regex_search(text, m, re), "hystlabd did not serve: " << text);
-  return " --daemon " + m[1].str();
+  const int port = test_support::served_port(log.string());
+  REQUIRE_MESSAGE(port != 0, "hystlabd did not serve: " << log_of(log));
+  return " --daemon http://127.0.0.1:" + std::to_string(port);
 }
 
 std::string state_of(const std::string& db, std::int64_t id) { return db::to_string(db::Store(db).campaign(id)->state); }

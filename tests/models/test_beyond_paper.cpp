@@ -16,24 +16,13 @@
 
 using namespace hystlab::models;
 
-namespace {
-std::vector<double> run(HysteresisModel& m, const std::vector<double>& in) {
-  std::vector<double> out(in.size());
-  m.evaluate(in, out);
-  return out;
-}
-}  // namespace
+using hystlab::test::run_model;
 
 TEST_CASE("5a: constrained least squares recovers a Preisach table from arbitrary noisy data") {
   std::mt19937_64 rng(31);
   const Grid g = Grid::make(0.0, 4.0, 8);
-  const EverettTable truth = RelayGrid(hystlab::test::random_relays(rng, g)).everett_table(g);
-  PreisachModel gen(truth);
-  const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 120, 0.02);
-  auto y = run(gen, x);
   const double sigma = 0.05;
-  std::normal_distribution<double> noise(0.0, sigma);
-  for (double& v : y) v += noise(rng);
+  const auto [truth, x, y] = hystlab::test::noisy_relay_record(rng, g, sigma);
 
   const LsqFitResult fit = fit_preisach_lsq(x, y, g);
   CHECK(fit.lambda > 0.0);
@@ -82,7 +71,7 @@ TEST_CASE("5a: on data no non-negative Preisach model fits, the constrained opti
   const Grid g = Grid::make(0.0, 4.0, 6);
   SimplifiedSmaModel sma(table1_parameters());
   const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 60, 0.02);
-  const auto y = run(sma, x);
+  const auto y = run_model(sma, x);
   const LsqFitResult fit = fit_preisach_lsq(x, y, g, LsqFitOptions{1e-12, 0});
   for (double w : fit.cell_weight) CHECK(w >= 0.0);
   CHECK(fit.cells_at_bound > 0);
@@ -116,7 +105,7 @@ TEST_CASE("5b: calibration recovers Table 1 within 2% from a loop with 1% force 
     std::mt19937_64 rng(seed);
     SimplifiedSmaModel m(table1_parameters());
     const auto x = ramp_through({0.0, 4.0, 0.0}, 0.004);
-    auto y = run(m, x);
+    auto y = run_model(m, x);
     const double sigma = 0.01 * 157.5;  // 1 % of the force range
     std::normal_distribution<double> noise(0.0, sigma);
     for (double& v : y) v += noise(rng);
@@ -137,7 +126,7 @@ TEST_CASE("5b: calibration recovers Table 1 within 2% from a loop with 1% force 
 TEST_CASE("5b: a loop that never transforms is refused with a reason") {
   SimplifiedSmaModel m(table1_parameters());
   const auto x = ramp_through({0.0, 0.8, 0.0}, 0.01);  // stays on the austenite line
-  const auto y = run(m, x);
+  const auto y = run_model(m, x);
   CHECK_THROWS_WITH((void)calibrate_simplified_sma(x, y), doctest::Contains("calibrate"));
 }
 
@@ -168,7 +157,7 @@ TEST_CASE("5d: wiping-out and congruency hold for a Preisach model and are measu
   const auto x = ramp_through(tp, 0.01);
   const Grid g = Grid::make(0.0, 4.0, 12);
   PreisachModel pm(RelayGrid(hystlab::test::random_relays(rng, g)).everett_table(g));
-  const auto yp = run(pm, x);
+  const auto yp = run_model(pm, x);
   const RepresentationReport rp = check_representation(x, yp);
   CHECK(rp.wiping_out.events >= 3);
   CHECK(rp.congruency.compared_pairs >= 1);
@@ -176,7 +165,7 @@ TEST_CASE("5d: wiping-out and congruency hold for a Preisach model and are measu
   CHECK(rp.congruency.max_deviation_norm < 1e-6);
 
   SimplifiedSmaModel sma(table1_parameters());
-  const auto ys = run(sma, x);
+  const auto ys = run_model(sma, x);
   const RepresentationReport rs = check_representation(x, ys);
   CHECK(rs.congruency.compared_pairs >= 1);
   CHECK(rs.congruency.max_deviation_norm > 1e-4);  // the simplified model's minor loops are not congruent

@@ -14,14 +14,9 @@
 #include "test_support.hpp"
 
 using namespace hystlab::models;
+using hystlab::test::run_model;
 
 namespace {
-
-std::vector<double> drive(HysteresisModel& m, const std::vector<double>& in) {
-  std::vector<double> out(in.size());
-  m.evaluate(in, out);
-  return out;
-}
 
 // Ramps between random turning points plus small random steps (nested minor loops of every size).
 std::vector<double> rough_walk(std::mt19937_64& rng, const Grid& g, int reversals) {
@@ -111,7 +106,7 @@ TEST_CASE("signed prior: a noiseless record of a table with masses of both signs
     const EverettTable truth(g, F, 2.0);
     PreisachModel gen(truth);
     const auto x = rough_walk(rng, g, 400);
-    const auto y = drive(gen, x);
+    const auto y = run_model(gen, x);
     const auto [lo, hi] = std::minmax_element(y.begin(), y.end());
     PreisachFitOptions o;
     o.prior = FitPrior::signed_masses;
@@ -125,7 +120,7 @@ TEST_CASE("signed prior: a noiseless record of a table with masses of both signs
     // major loop's branches.
     PreisachModel a(truth), b(r.chosen.table);
     const auto major = ramp_through({0.0, 4.0, 0.0}, 0.01);
-    CHECK(rms_between(drive(a, major), drive(b, major), 0) < 0.02 * (*hi - *lo));
+    CHECK(rms_between(run_model(a, major), run_model(b, major), 0) < 0.02 * (*hi - *lo));
   }
 }
 
@@ -135,7 +130,7 @@ TEST_CASE("acceptance: on the simplified SMA model, auto's error on held-out dat
   std::mt19937_64 rng(2024);
   SimplifiedSmaModel sma(table1_parameters());
   const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 500, 0.01);
-  const auto truth = drive(sma, x);
+  const auto truth = run_model(sma, x);
   std::normal_distribution<double> noise(0.0, 0.2);
   auto y = truth;
   for (double& v : y) v += noise(rng);
@@ -152,7 +147,7 @@ TEST_CASE("acceptance: on the simplified SMA model, auto's error on held-out dat
     PreisachModel fitted(r.chosen.table);
     SimplifiedSmaModel source(table1_parameters());
     PreisachModel fot(identify_virtual(source, g));
-    const double fit_rms = rms_between(drive(fitted, x), y, train), fot_rms = rms_between(drive(fot, x), y, train);
+    const double fit_rms = rms_between(run_model(fitted, x), y, train), fot_rms = rms_between(run_model(fot, x), y, train);
     CAPTURE(fit_rms);
     CAPTURE(fot_rms);
     CHECK(fit_rms <= fot_rms);
@@ -167,13 +162,8 @@ TEST_CASE("acceptance: on the simplified SMA model, auto's error on held-out dat
 TEST_CASE("monotone prior: a record from a table of non-negative masses is recovered within the noise") {
   std::mt19937_64 rng(31);
   const Grid g = Grid::make(0.0, 4.0, 8);
-  const EverettTable truth = RelayGrid(hystlab::test::random_relays(rng, g)).everett_table(g);
-  PreisachModel gen(truth);
-  const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 120, 0.02);
-  auto y = drive(gen, x);
   const double sigma = 0.05;
-  std::normal_distribution<double> noise(0.0, sigma);
-  for (double& v : y) v += noise(rng);
+  const auto [truth, x, y] = hystlab::test::noisy_relay_record(rng, g, sigma);
   PreisachFitOptions o;
   o.prior = FitPrior::monotone;
   const PreisachFitResult r = fit_preisach(x, y, g, o);
@@ -203,7 +193,7 @@ TEST_CASE("the monotone solver reaches the constrained optimum: no feasible move
   const Grid g = Grid::make(0.0, 4.0, 6);
   SimplifiedSmaModel sma(table1_parameters());
   const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 60, 0.02);
-  const auto y = drive(sma, x);
+  const auto y = run_model(sma, x);
   PreisachFitOptions o;
   o.prior = FitPrior::monotone;
   o.lambda = 1e-9;
@@ -234,7 +224,7 @@ TEST_CASE("the monotone solver reaches the constrained optimum: no feasible move
     std::vector<double> F(g.node_count());
     fit::cells_to_nodes(g, w, F);
     PreisachModel pm(EverettTable(g, F, f.force_offset));
-    return rms_between(drive(pm, x), y, 0);
+    return rms_between(run_model(pm, x), y, 0);
   };
   const double best = rms_of(f.cell_weight);
   std::uniform_int_distribution<std::size_t> cell(0, f.cell_weight.size() - 1);
@@ -253,7 +243,7 @@ TEST_CASE("auto with a given λ still compares the priors on held-out blocks") {
   const Grid g = Grid::make(0.0, 4.0, 6);
   SimplifiedSmaModel sma(table1_parameters());
   const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 80, 0.02);
-  const auto y = drive(sma, x);
+  const auto y = run_model(sma, x);
   PreisachFitOptions o;
   o.lambda = 1e-4;
   o.uncertainty_probes = 0;

@@ -4,6 +4,8 @@
 #include <vector>
 
 #include "hystlab/models/grid.hpp"
+#include "hystlab/models/hysteresis_model.hpp"
+#include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/relay_grid.hpp"
 
 namespace hystlab::test {
@@ -42,6 +44,29 @@ inline std::vector<models::Relay> random_relays(std::mt19937_64& rng, const mode
       relays.push_back(models::Relay{a, b, weight(rng)});
     }
   return relays;
+}
+
+// The model's output for an input record, from its present state.
+inline std::vector<double> run_model(models::HysteresisModel& m, const std::vector<double>& in) {
+  std::vector<double> out(in.size());
+  m.evaluate(in, out);
+  return out;
+}
+
+// A record of a table of random non-negative masses (random_relays) on random ramps over 0..4 mm
+// with Gaussian force noise: what a fit with the monotone prior must recover.
+struct RelayRecord {
+  models::EverettTable truth;
+  std::vector<double> x, y;
+};
+inline RelayRecord noisy_relay_record(std::mt19937_64& rng, const models::Grid& g, double sigma) {
+  RelayRecord r{models::RelayGrid(random_relays(rng, g)).everett_table(g), {}, {}};
+  models::PreisachModel gen(r.truth);
+  r.x = random_ramps(rng, 0.0, 4.0, 120, 0.02);
+  r.y = run_model(gen, r.x);
+  std::normal_distribution<double> noise(0.0, sigma);
+  for (double& v : r.y) v += noise(rng);
+  return r;
 }
 
 }  // namespace hystlab::test

@@ -23,6 +23,42 @@ extern char** environ;
 
 namespace hystlab::test_support {
 
+// Starts args[0] with args, its stdout and stderr into the file `log`.
+inline pid_t spawn_logged(const std::vector<std::string>& args, const std::string& log) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  std::vector<std::string> a = args;
+  std::vector<char*> argv;
+  for (auto& s : a) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) throw std::runtime_error("cannot start " + args.at(0));
+  return pid;
+}
+
+inline std::string read_log(const std::string& path) {
+  std::stringstream s;
+  s << std::ifstream(path).rdbuf();
+  return s.str();
+}
+
+// The port of the hystlabd writing `log` (started with --port 0), once it serves; 0 when it has
+// not said so within 60 s (a sanitized daemon on a loaded 2-core VM).
+inline int served_port(const std::string& log) {
+  static const std::regex re("serving the API and the page on http://127\\.0\\.0\\.1:(\\d+)/");
+  for (int k = 0; k < 600; ++k) {
+    std::smatch m;
+    const std::string text = read_log(log);
+    if (std::regex_search(text, m, re)) return std::stoi(m[1]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return 0;
+}
+
 class DaemonProcess {
  public:
   // prepare: fills the database before the daemon opens it (a stored run to read back).
@@ -32,25 +68,10 @@ class DaemonProcess {
     if (prepare) prepare((dir_ / "bench.db").string());
     std::ofstream(dir_ / "hystlab.json") << config_json;
     const std::string log = (dir_ / "daemon.log").string();
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    std::vector<std::string> args{HYSTLABD, "--config", (dir_ / "hystlab.json").string(), "--db", (dir_ / "bench.db").string(), "--port", "0"};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ) != 0) throw std::runtime_error("cannot start hystlabd");
-    posix_spawn_file_actions_destroy(&fa);
-    const std::regex re("serving the API and the page on http://127\\.0\\.0\\.1:(\\d+)/");
-    for (int k = 0; k < 600 && port_ == 0; ++k) {  // 60 s: a sanitized daemon on a loaded 2-core VM
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      std::stringstream s;
-      s << std::ifstream(log).rdbuf();
-      std::smatch m;
-      const std::string text = s.str();
-      if (std::regex_search(text, m, re)) port_ = std::stoi(m[1]);
-    }
+    pid_ = spawn_logged({HYSTLABD, "--config", (dir_ / "hystlab.json").string(), "--db", (dir_ / "bench.db").string(),
+                         "--port", "0"},
+                        log);
+    port_ = served_port(log);
     if (port_ == 0) {
       const std::string text = this->log();
       stop();
@@ -60,11 +81,7 @@ class DaemonProcess {
   ~DaemonProcess() { stop(); }
   [[nodiscard]] int port() const noexcept { return port_; }
   [[nodiscard]] std::string db_path() const { return (dir_ / "bench.db").string(); }
-  [[nodiscard]] std::string log() const {
-    std::stringstream s;
-    s << std::ifstream(dir_ / "daemon.log").rdbuf();
-    return s.str();
-  }
+  [[nodiscard]] std::string log() const { return read_log((dir_ / "daemon.log").string()); }
 
  private:
   // SIGTERM; SIGKILL when it has not exited after 30 s (a hung daemon never hangs the test).

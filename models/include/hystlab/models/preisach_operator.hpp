@@ -34,6 +34,9 @@ class PreisachOperator {
   void apply(std::span<const double> v, std::span<double> out) const;
   // g[node] = Σ_k A[k][node] u[k]; u.size() == samples(), g.size() == nodes().
   void apply_transpose(std::span<const double> u, std::span<double> g) const;
+  // The same with the caller's buffer for the prefix sums (resized to samples() + 1), so a solver
+  // calling it every step allocates nothing.
+  void apply_transpose(std::span<const double> u, std::span<double> g, std::vector<double>& prefix) const;
 
  private:
   struct HeldTerm {  // weight * F[node] is part of the output for samples start <= k < end
