@@ -84,6 +84,19 @@ int Options::integer(const std::string& name, int fallback, int lo, int hi) cons
   return static_cast<int>(v);
 }
 
+std::vector<double> Options::numbers(const std::string& name) const {
+  std::vector<double> out;
+  if (!has(name)) return out;
+  const std::string s = get(name);
+  std::size_t start = 0;
+  while (start <= s.size()) {
+    const std::size_t comma = std::min(s.find(',', start), s.size());
+    out.push_back(parse_double(s.substr(start, comma - start), "option --" + name));
+    start = comma + 1;
+  }
+  return out;
+}
+
 std::pair<double, double> Options::range(const std::string& name) const {
   const std::string s = require(name);
   const auto comma = s.find(',');

@@ -26,6 +26,8 @@ class Options {
   [[nodiscard]] std::string require(const std::string& name) const;
   [[nodiscard]] double number(const std::string& name, double fallback) const;
   [[nodiscard]] int integer(const std::string& name, int fallback, int lo, int hi) const;
+  // "a,b,c": numbers separated by commas; empty when the option is absent.
+  [[nodiscard]] std::vector<double> numbers(const std::string& name) const;
   // "a,b" with a < b.
   [[nodiscard]] std::pair<double, double> range(const std::string& name) const;
 

@@ -14,6 +14,7 @@ int run_calibrate(const Args& args);
 int run_invert(const Args& args);
 int run_check(const Args& args);
 int run_compare(const Args& args);
+int run_loops(const Args& args);
 int run_demo(const Args& args);
 int run_campaign_cmd(const Args& args);
 int run_rig_cmd(const Args& args);

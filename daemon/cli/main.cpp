@@ -29,6 +29,7 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
   invert     displacements that produce requested forces (force control)
   check      wiping-out and congruency of a record, as numbers
   compare    accuracy of a table or model against a record
+  loops      the material figures of every closed cycle of a record (energy, damping, plateaus, ...)
   demo       the paper's §3.3 study on Table 1, with a report and plots
   campaign   submit, preview, pause, resume, abort, estop campaigns of the running hystlabd
              (over its HTTP API); list and show them from its db file
@@ -47,6 +48,7 @@ int dispatch(const std::string& verb, const Args& args) {
   if (verb == "invert") return run_invert(args);
   if (verb == "check") return run_check(args);
   if (verb == "compare") return run_compare(args);
+  if (verb == "loops") return run_loops(args);
   if (verb == "demo") return run_demo(args);
   if (verb == "campaign") return run_campaign_cmd(args);
   if (verb == "rig") return run_rig_cmd(args);

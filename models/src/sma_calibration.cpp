@@ -1,5 +1,7 @@
 #include "hystlab/models/sma_calibration.hpp"
 
+#include "hystlab/models/branch_knees.hpp"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
@@ -41,63 +43,23 @@ bool residuals(const Vec7& v, const SmaCalibrationOptions& o, std::span<const do
   return true;
 }
 
-// Continuous three-segment line through a branch: f = a + b x + c (x-k1)+ + d (x-k2)+, best (k1, k2).
-struct Hinge {
-  double k1 = 0, k2 = 0;
-  Eigen::Vector4d coef = Eigen::Vector4d::Zero();
-  double at(double x) const {
-    return coef(0) + coef(1) * x + coef(2) * std::max(0.0, x - k1) + coef(3) * std::max(0.0, x - k2);
-  }
-};
-
-Hinge fit_hinge(const std::vector<double>& x, const std::vector<double>& y) {
-  const auto [mn, mx] = std::minmax_element(x.begin(), x.end());
-  const double lo = *mn, hi = *mx;
-  Hinge best;
-  double best_ss = std::numeric_limits<double>::infinity();
-  const int steps = 40;
-  MatrixXd A(static_cast<Eigen::Index>(x.size()), 4);
-  VectorXd Y = Eigen::Map<const VectorXd>(y.data(), static_cast<Eigen::Index>(y.size()));
-  for (int a = 1; a < steps; ++a)
-    for (int b = a + 1; b < steps; ++b) {
-      const double k1 = lo + (hi - lo) * a / steps, k2 = lo + (hi - lo) * b / steps;
-      for (std::size_t k = 0; k < x.size(); ++k) {
-        const auto r = static_cast<Eigen::Index>(k);
-        A(r, 0) = 1.0;
-        A(r, 1) = x[k];
-        A(r, 2) = std::max(0.0, x[k] - k1);
-        A(r, 3) = std::max(0.0, x[k] - k2);
-      }
-      const Eigen::Vector4d c = (A.transpose() * A).ldlt().solve(A.transpose() * Y);
-      const double ss = (A * c - Y).squaredNorm();
-      if (ss < best_ss) {
-        best_ss = ss;
-        best = Hinge{k1, k2, c};
-      }
-    }
-  return best;
-}
-
+// The starting point: each branch's three tangent lines (models::fit_branch_knees, the loop
+// figures' transformation points): loading gives KA, KM, Ms, Mf and so δtr_max; unloading Af, As.
 Vec7 initial_guess(std::span<const double> x, std::span<const double> y) {
   const std::size_t top = static_cast<std::size_t>(std::max_element(x.begin(), x.end()) - x.begin());
-  std::vector<double> ux, uy, dx, dy;
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    auto& bx = k <= top ? ux : dx;
-    auto& by = k <= top ? uy : dy;
-    bx.push_back(x[k]);
-    by.push_back(y[k]);
-  }
-  if (ux.size() < 10 || dx.size() < 10)
+  if (top + 1 < 10 || x.size() - top < 10)
     throw std::invalid_argument("calibrate: the loop needs at least 10 samples on loading and on unloading");
-  const Hinge up = fit_hinge(ux, uy), down = fit_hinge(dx, dy);
+  const auto up = fit_branch_knees(x.subspan(0, top + 1), y.subspan(0, top + 1));
+  const auto down = fit_branch_knees(x.subspan(top), y.subspan(top));
+  if (!up || !down) throw std::invalid_argument("calibrate: the loop's branches do not span a displacement range");
   Vec7 v{};
-  v[0] = up.coef(1);                                         // KA: first slope of loading
-  v[1] = up.coef(1) + up.coef(2) + up.coef(3);               // KM: last slope of loading
-  v[3] = up.at(up.k1);                                       // fMs
-  v[4] = up.at(up.k2);                                       // fMf
-  v[2] = up.k2 - v[4] / v[1];                                // δtr_max from δMf = fMf/KM + δtr_max
-  v[6] = down.at(down.k1);                                   // fAf (lower corner of unloading)
-  v[5] = down.at(down.k2);                                   // fAs (upper corner)
+  v[0] = up->slope_start;                 // KA: first slope of loading
+  v[1] = up->slope_end;                   // KM: last slope of loading
+  v[3] = up->lower_N;                     // fMs
+  v[4] = up->upper_N;                     // fMf
+  v[2] = up->upper_mm - v[4] / v[1];      // δtr_max from δMf = fMf/KM + δtr_max
+  v[6] = down->lower_N;                   // fAf (lower corner of unloading)
+  v[5] = down->upper_N;                   // fAs (upper corner)
   return v;
 }
 

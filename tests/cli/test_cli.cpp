@@ -26,6 +26,7 @@
 
 #include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/loop_figures.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/simplified_sma.hpp"
 
@@ -108,7 +109,7 @@ const std::vector<double> kPath = ramp_through({0.0, 3.5, 1.0, 3.0, 1.5, 4.0, 0.
 
 TEST_CASE("cli: --help on every verb") {
   Workdir w;
-  for (const char* verb : {"eval", "identify", "fit", "calibrate", "invert", "check", "compare", "demo"}) {
+  for (const char* verb : {"eval", "identify", "fit", "calibrate", "invert", "check", "compare", "loops", "demo"}) {
     CAPTURE(verb);
     const Result r = w.run(std::string(verb) + " --help");
     CHECK(r.code == 0);
@@ -226,6 +227,40 @@ TEST_CASE("cli: fit, calibrate, invert, check and compare on generated data") {
   CHECK(cmp.out.find("ascending") != std::string::npos);
   CHECK(cmp.out.find("descending") != std::string::npos);
   CHECK(cmp.out.find("loop energy: reference") != std::string::npos);
+}
+
+TEST_CASE("cli: loops prints every closed cycle's figures, as the library computes them") {
+  Workdir w;
+  SimplifiedSmaModel sma(table1_parameters());
+  const auto x = ramp_through({0.0, 4.0, 0.0, 4.0, 2.0, 3.5, 0.0}, 0.005);
+  std::vector<double> f(x.size());
+  sma.evaluate(x, f);
+  w.write("X.csv", series_csv(x, f));
+  const Result text = w.run("loops --data X.csv --plateaus 1,3");
+  REQUIRE(text.code == 0);
+  CAPTURE(text.out);
+  CHECK(text.out.find("3 closed cycle(s)") != std::string::npos);
+  CHECK(text.out.find("plateau at 1 mm: loading 40 N") != std::string::npos);
+  CHECK(text.out.find("Ms (1.012 mm, 40.47 N)") != std::string::npos);
+  const Result js = w.run("loops --data X.csv --json --plateaus 3");
+  REQUIRE(js.code == 0);
+  const auto j = nlohmann::json::parse(js.out);
+  LoopOptions o;
+  o.plateau_at_mm = {3.0};
+  // The CSV holds 17 digits: the same numbers as the library's on the same record.
+  const auto lib = find_loops(x, f, o);
+  REQUIRE(j.size() == lib.size());
+  for (std::size_t k = 0; k < lib.size(); ++k) {
+    CAPTURE(k);
+    CHECK(j[k].at("energy_Nmm").get<double>() == lib[k].energy_Nmm);
+    CHECK(j[k].at("damping_ratio").get<double>() == lib[k].damping_ratio);
+    CHECK(j[k].at("plateaus").at(0).at("unloading_N").get<double>() == lib[k].plateaus.at(0).unloading_N);
+  }
+  CHECK(j[1].at("min_mm").get<double>() == doctest::Approx(2.0));  // the inner loop closes before its host
+  CHECK(j[2].at("energy_Nmm").get<double>() == doctest::Approx(j[0].at("energy_Nmm").get<double>()).epsilon(1e-6));
+  w.write("bad.csv", "displacement_mm,force_N\n0,0\n1,nan\n");
+  check_error(w.run("loops --data bad.csv"), "bad.csv: line 3");
+  check_error(w.run("loops --data X.csv --plateaus 1,x"), "option --plateaus: 'x' is not a number");
 }
 
 TEST_CASE("cli: demo writes the report, plots and tables") {
