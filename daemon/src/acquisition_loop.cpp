@@ -400,14 +400,19 @@ void hand_off(Loop& L, Strategy& strategy) {
   if (L.ctx.on_state) L.ctx.on_state(to_string(L.result.end));
 }
 
+// The run, and the validation run beside it when the plan has one (created now, so that starting
+// it later is no database round trip on the acquisition thread).
 bool create_run(Loop& L) {
   const auto id = L.job.id;
   const std::string now = L.ctx.now_iso();
   const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(), mono = L.wall0;
-  const auto run = L.ctx.writer.call<std::int64_t>([id, now, wall, mono](db::Store& s) { return s.add_run(id, now, wall, mono); },
-                                                   L.ctx.db_timeout_s);
-  if (!run) return L.end(CampaignEnd::failed, "the database did not take the new run in time: the rig was not armed"), false;
-  L.result.run_id = *run;
+  const bool validation = L.plan.kind == db::CampaignKind::fot && L.plan.validation.enabled;
+  const auto runs = L.ctx.writer.call<std::pair<std::int64_t, std::int64_t>>(
+      [id, now, wall, mono, validation](db::Store& s) { return s.add_runs(id, now, wall, mono, validation); },
+      L.ctx.db_timeout_s);
+  if (!runs) return L.end(CampaignEnd::failed, "the database did not take the new run in time: the rig was not armed"), false;
+  L.result.run_id = runs->first;
+  L.result.validation_run_id = runs->second;
   return true;
 }
 }  // namespace

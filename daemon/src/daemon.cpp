@@ -124,7 +124,7 @@ struct Daemon::Impl {
     }
     for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) job.prior_nodes.push_back({a, b, fa, fab});
     if (job.plan.kind == db::CampaignKind::fot && !job.prior_nodes.empty())  // the fits after a resume use every run
-      for (const std::int64_t run : store.runs_of_campaign(id))
+      for (const std::int64_t run : store.runs_of_campaign(id, db::RunRole::campaign))  // never the validation runs
         store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(),
                               [&job](const db::SampleRow& r) { job.prior_series.add(r.disp, r.force); });
     return job;

@@ -151,6 +151,8 @@ Limits check_plan_against(const Plan& p, const RigEnvelope& e, const Supervision
   // A ramp must fit under the rate limit that trips it (with room for the servo's overshoot).
   if (p.ramp_rate_mm_s > l.rate_max_mm_s)
     refuse("ramp_rate_mm_s", num(p.ramp_rate_mm_s) + " exceeds the rate limit " + num(l.rate_max_mm_s) + " mm/s");
+  if (p.validation.enabled && p.validation.rate_mm_s > l.rate_max_mm_s)
+    refuse("validation.rate_mm_s", num(p.validation.rate_mm_s) + " exceeds the rate limit " + num(l.rate_max_mm_s) + " mm/s");
   return l;
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace hystlab::daemon {
 
@@ -49,6 +50,94 @@ Limits parse_limits(const json& j, double lo, double hi) {
     fail("limits.safe_position_mm", "must lie inside limits.displacement_mm");
   return l;
 }
+// A percentage: 0.5 or "0.5 %" or "0.5%".
+double percent(const json& j, const std::string& f, double def) {
+  if (!j.contains(f)) return def;
+  double v = NAN;
+  if (j[f].is_number()) {
+    v = j[f].get<double>();
+  } else if (j[f].is_string()) {
+    std::string t = j[f].get<std::string>();
+    while (!t.empty() && (t.back() == ' ' || t.back() == '%')) t.pop_back();
+    char* end = nullptr;
+    v = std::strtod(t.c_str(), &end);
+    if (t.empty() || end != t.c_str() + t.size()) v = NAN;
+  }
+  if (!std::isfinite(v) || !(v > 0) || v > 100) fail("training.until." + f, "must be a percentage above 0 and at most 100, e.g. 0.5 or \"0.5 %\"");
+  return v;
+}
+
+Training parse_training(const json& j) {
+  Training t;
+  if (!j.contains("training")) {
+    t.max_cycles = static_cast<int>(number(j, "training_cycles", 0, 0, 1000));
+    return t;
+  }
+  if (j.contains("training_cycles")) fail("training_cycles", "and training: give one of them");
+  const json& tr = j["training"];
+  if (!tr.is_object()) fail("training", "must be an object: {\"max_cycles\": 40, \"until\": {...}}");
+  for (const auto& [k, _] : tr.items())
+    if (k != "max_cycles" && k != "until") fail("training." + k, "is not a known field (max_cycles, until)");
+  if (!tr.contains("max_cycles") || !tr["max_cycles"].is_number_integer() || tr["max_cycles"] < 1 || tr["max_cycles"] > 1000)
+    fail("training.max_cycles", "must be an integer from 1 to 1000");
+  t.max_cycles = tr["max_cycles"].get<int>();
+  if (!tr.contains("until")) return t;
+  const json& u = tr["until"];
+  if (!u.is_object()) fail("training.until", "must be an object: {\"peak_force_change\": \"0.5 %\", \"energy_change\": \"2 %\", \"consecutive\": 3}");
+  for (const auto& [k, _] : u.items())
+    if (k != "peak_force_change" && k != "energy_change" && k != "consecutive")
+      fail("training.until." + k, "is not a known field (peak_force_change, energy_change, consecutive)");
+  t.until = true;
+  t.peak_force_change_pct = percent(u, "peak_force_change", t.peak_force_change_pct);
+  t.energy_change_pct = percent(u, "energy_change", t.energy_change_pct);
+  if (u.contains("consecutive") && (!u["consecutive"].is_number_integer() || u["consecutive"] < 1 || u["consecutive"] > 100))
+    fail("training.until.consecutive", "must be an integer from 1 to 100");
+  t.consecutive = u.value("consecutive", t.consecutive);
+  if (t.consecutive >= t.max_cycles) fail("training.until.consecutive", "must be below training.max_cycles");
+  return t;
+}
+
+Validation parse_validation(const json& j, const Plan& p) {
+  Validation v{true, 12, p.lo_mm, p.hi_mm, p.ramp_rate_mm_s, 1};
+  if (!j.contains("validation")) return v;
+  const json& b = j["validation"];
+  if (b.is_boolean()) {
+    v.enabled = b.get<bool>();
+    return v;
+  }
+  if (!b.is_object()) fail("validation", "must be an object ({\"reversals\": 12, ...}) or false");
+  for (const auto& [k, _] : b.items())
+    if (k != "reversals" && k != "range_mm" && k != "rate_mm_s" && k != "seed")
+      fail("validation." + k, "is not a known field (reversals, range_mm, rate_mm_s, seed)");
+  if (b.contains("reversals") && (!b["reversals"].is_number_integer() || b["reversals"] < 2 || b["reversals"] > 10000))
+    fail("validation.reversals", "must be an integer from 2 to 10000");
+  v.reversals = b.value("reversals", v.reversals);
+  if (b.contains("range_mm")) std::tie(v.lo_mm, v.hi_mm) = pair_of(b["range_mm"], "validation.range_mm");
+  if (v.lo_mm < p.lo_mm || v.hi_mm > p.hi_mm) fail("validation.range_mm", "must lie inside range_mm (the tables cover only it)");
+  if (b.contains("rate_mm_s")) {
+    const json& r = b["rate_mm_s"];
+    if (!r.is_number() || !(r.get<double>() >= 1e-4 && r.get<double>() <= 1e3)) fail("validation.rate_mm_s", "must be between 0.0001 and 1000");
+    v.rate_mm_s = r.get<double>();
+  }
+  if (b.contains("seed") && (!b["seed"].is_number_unsigned())) fail("validation.seed", "must be a non-negative integer");
+  v.seed = b.value("seed", v.seed);
+  return v;
+}
+
+std::vector<double> parse_plateaus(const json& j, const Plan& p) {
+  std::vector<double> out;
+  if (!j.contains("plateaus_mm")) return out;
+  if (!j["plateaus_mm"].is_array() || j["plateaus_mm"].size() > 20) fail("plateaus_mm", "must be an array of at most 20 displacements");
+  for (std::size_t k = 0; k < j["plateaus_mm"].size(); ++k) {
+    const json& v = j["plateaus_mm"][k];
+    const std::string f = "plateaus_mm[" + std::to_string(k) + "]";
+    if (!v.is_number() || !std::isfinite(v.get<double>())) fail(f, "must be a number");
+    if (v.get<double>() <= p.lo_mm || v.get<double>() >= p.hi_mm) fail(f, "must lie inside range_mm");
+    out.push_back(v.get<double>());
+  }
+  return out;
+}
+
 void parse_sine(const json& j, Plan& p) {
   if (j.contains("frequencies_hz") == j.contains("sweep")) fail("frequencies_hz", "or sweep: exactly one is required");
   if (j.contains("frequencies_hz")) {
@@ -102,17 +191,19 @@ Plan parse_plan(const json& j) {
   p.dwell_s = number(j, "dwell_s", 0.0, 0.0, 3600.0);
   p.sample_rate_hz = number(j, "sample_rate_hz", 1000.0, 1.0, 10000.0);
   if (p.kind == db::CampaignKind::fot) {
-    known({"range_mm", "subdivisions", "repeats", "training_cycles"});
+    known({"range_mm", "subdivisions", "repeats", "training_cycles", "training", "validation", "plateaus_mm"});
     if (!j.contains("range_mm")) fail("range_mm", "is required");
     std::tie(p.lo_mm, p.hi_mm) = pair_of(j["range_mm"], "range_mm");
     if (!j.contains("subdivisions") || !j["subdivisions"].is_number_integer() || j["subdivisions"] < 1 || j["subdivisions"] > 200)
       fail("subdivisions", "must be an integer from 1 to 200");
     p.subdivisions = j["subdivisions"].get<int>();
     p.repeats = static_cast<int>(number(j, "repeats", 1, 1, 100));
-    p.training_cycles = static_cast<int>(number(j, "training_cycles", 0, 0, 1000));
+    p.training = parse_training(j);
     p.limits = parse_limits(j.value("limits", json()), p.lo_mm, p.hi_mm);
     if (p.lo_mm < p.limits.displacement_min_mm || p.hi_mm > p.limits.displacement_max_mm)
       fail("range_mm", "must lie inside limits.displacement_mm");
+    p.validation = parse_validation(j, p);
+    p.plateaus_mm = parse_plateaus(j, p);
   } else if (p.kind == db::CampaignKind::waveform) {
     known({"points_mm"});
     if (!j.contains("points_mm") || !j["points_mm"].is_array() || j["points_mm"].size() < 2)
@@ -137,6 +228,8 @@ Plan parse_plan(const json& j) {
   // names its own maximum (check_plan_against), not a default the user never saw.
   const bool own_rate = j.contains("limits") && j["limits"].is_object() && j["limits"].contains("rate_mm_s");
   if (own_rate && p.ramp_rate_mm_s > p.limits.rate_max_mm_s) fail("ramp_rate_mm_s", "is above limits.rate_mm_s");
+  if (own_rate && p.validation.enabled && p.validation.rate_mm_s > p.limits.rate_max_mm_s)
+    fail("validation.rate_mm_s", "is above limits.rate_mm_s");
   return p;
 }
 

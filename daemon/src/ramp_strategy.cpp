@@ -9,6 +9,8 @@
 #include "acquisition_loop.hpp"
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/sequencer.hpp"
+#include "hystlab/daemon/shakedown.hpp"
+#include "hystlab/models/loop_figures.hpp"
 #include "hystlab/models/online_table_builder.hpp"
 #include "run_finish.hpp"
 
@@ -19,8 +21,9 @@ class RampStrategy final : public Strategy {
  public:
   explicit RampStrategy(Loop& L)
       : plan_(L.plan), seq_(schedule(L.plan), L.ctx.supervisor.settings().in_position_mm), settings_(L.ctx.supervisor.settings()),
-        time_scale_(L.ctx.time_scale) {
+        time_scale_(L.ctx.time_scale), shakedown_(L.plan.training) {
     series_ = L.job.prior_series;
+    rows_begin_ = series_.x.size();
     if (plan_.kind != db::CampaignKind::fot) return;
     const models::Grid g = models::Grid::make(plan_.lo_mm, plan_.hi_mm, plan_.subdivisions);
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
@@ -38,9 +41,11 @@ class RampStrategy final : public Strategy {
   [[nodiscard]] bool has_work() const override { return !(builder_ && builder_->complete()); }
 
   bool on_frame(Loop& L, const drivers::RigSample& s) override {
-    series_.add(s.displacement_mm, s.force_N);
+    (validating_ ? validation_ : series_).add(s.displacement_mm, s.force_N);
     const std::size_t before = seq_.index();
-    if (const auto cmd = seq_.step(s.time_s, s.displacement_mm)) {
+    std::optional<SetpointCommand> cmd = seq_.step(s.time_s, s.displacement_mm);
+    if (cmd) cmd = segment_changed(L, s, before, *cmd);
+    if (cmd) {
       if (auto ec = L.ctx.rig.command(cmd->target_mm, cmd->rate_mm_s)) return L.command_failed(s.time_s, ec, "command");
       L.command_taken();
       arm_deadline(s.time_s, s.displacement_mm, *cmd);
@@ -50,11 +55,11 @@ class RampStrategy final : public Strategy {
       // (a browser-test campaign reached 0.000 mm late after a host stall, then "missed" it while dwelling).
       return target_missed(L, s);
     }
-    if (fot_) {
+    if (fot_ && !validating_) {
       fot_->set_spacing(L.spacing);
       fot_->feed(s.time_s, s.displacement_mm, s.force_N, collecting());
       if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
-      if (seq_.done()) retake_rows(L);
+      if (seq_.done() && !validating_) retake_rows(L);
     }
     return true;
   }
@@ -78,28 +83,97 @@ class RampStrategy final : public Strategy {
   [[nodiscard]] bool done() const override { return seq_.done(); }
 
   void fill_finish(Loop& L, FinishJob& fj) override {
+    if (validating_) L.result.run_id = campaign_run_;  // the tables and the quality record belong to the campaign's run
+    fj.rows_begin = rows_begin_;
+    fj.validation = std::move(validation_);
+    if (shakedown_.cycles() > 0) fj.training_summary = shakedown_.summary();
     if (fot_) {
       fot_->finish();  // the last descent ends here: evaluate it like the others
       if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
     }
-    if (!builder_) return;
-    fj.builder = std::move(builder_);
     fj.series = std::move(series_);
+    if (builder_) fj.builder = std::move(builder_);
   }
 
  private:
   static std::vector<Segment> schedule(const Plan& p) { return p.kind == db::CampaignKind::fot ? fot_schedule(p) : waveform_schedule(p); }
 
-  void resume_rows_only(Loop& L) {  // a resumed campaign drives only the rows not yet complete
+  // A resumed campaign drives only the rows not yet complete (no training), then the validation.
+  void resume_rows_only(Loop& L) {
     const std::vector<Segment> all = schedule(L.plan);
     std::vector<Segment> rest{all.front()};
     for (const Segment& seg : all) {
+      if (seg.kind == SegmentKind::validation) rest.push_back(seg);
       if (seg.kind != SegmentKind::rise && seg.kind != SegmentKind::descent) continue;
       bool row_done = true;
       for (int j = 0; j < seg.row; ++j) row_done = row_done && builder_->identified(seg.row, j);
       if (!row_done) rest.push_back(seg);
     }
     seq_ = Sequencer(rest, settings_.in_position_mm);
+  }
+
+  // A new segment starts (cmd is its command). A training cycle ends: its figures go to the
+  // shakedown rule, which may end training early (the rows start now). The validation input
+  // starts: rows with a hole are taken again first, then the samples go to the validation run.
+  // Returns the command to give (another segment's, when the schedule changed).
+  std::optional<SetpointCommand> segment_changed(Loop& L, const drivers::RigSample& s, std::size_t before, SetpointCommand cmd) {
+    const Segment* cur = seq_.current();
+    if (before < seq_.size() && seq_.at(before).kind == SegmentKind::training && seq_.at(before).target_mm == plan_.lo_mm &&
+        cycle_start_ && end_training_cycle(L)) {
+      seq_.restart_at(seq_.find(SegmentKind::rise, seq_.index()));
+      return seq_.step(s.time_s, s.displacement_mm);
+    }
+    if (cur && cur->kind == SegmentKind::training && cur->target_mm == plan_.hi_mm) cycle_start_ = series_.x.size() - 1;
+    if (cur && cur->kind != SegmentKind::training && before < seq_.size() && seq_.at(before).kind == SegmentKind::training)
+      rows_begin_ = series_.x.size() - 1;
+    if (cur && cur->kind == SegmentKind::validation && !validating_) {
+      const std::size_t at = seq_.index();
+      if (builder_) retake_rows(L);
+      if (seq_.index() != at || seq_.current() != cur || seq_.current()->kind != SegmentKind::validation)
+        return seq_.step(s.time_s, s.displacement_mm);  // a retake was inserted before the validation
+      start_validation(L, s);
+    }
+    return cmd;
+  }
+
+  // The figures of the training cycle that just ended; true when training ends with it.
+  bool end_training_cycle(Loop& L) {
+    const std::size_t b = *cycle_start_, e = series_.x.size() - 1;
+    cycle_start_.reset();
+    const std::span<const double> x(series_.x), f(series_.f);
+    const std::size_t top = b + static_cast<std::size_t>(std::max_element(x.begin() + static_cast<std::ptrdiff_t>(b),
+                                                                          x.begin() + static_cast<std::ptrdiff_t>(e) + 1) -
+                                                         (x.begin() + static_cast<std::ptrdiff_t>(b)));
+    if (!(b < top && top < e)) return false;
+    const models::LoopFigures fig = models::loop_figures(x, f, b, top, e);
+    const ShakedownStep st = shakedown_.add(fig.peak_force_N, fig.energy_Nmm);
+    nlohmann::json ev{{"cycle", st.cycle}, {"peak_force_N", st.peak_force_N}, {"energy_Nmm", st.energy_Nmm}, {"consecutive", st.consecutive},
+                      {"stable", st.stable}, {"damping_ratio", fig.damping_ratio}, {"secant_stiffness_N_mm", fig.secant_stiffness_N_mm}};
+    if (st.peak_change_pct) ev["peak_change_pct"] = *st.peak_change_pct;
+    if (st.energy_change_pct) ev["energy_change_pct"] = *st.energy_change_pct;
+    L.event("shakedown", ev);
+    if (!st.last) return false;
+    L.event("training", {{"cycles", st.cycle}, {"stable", st.stable}, {"until", plan_.training.until}, {"why", shakedown_.summary()}});
+    rows_begin_ = e;
+    return st.cycle < plan_.training.max_cycles;  // cycles left to skip
+  }
+
+  void start_validation(Loop& L, const drivers::RigSample& s) {
+    if (fot_) {  // the rows are over with this sample: the last descent ends here (the validation input is no FOT row)
+      fot_->set_spacing(L.spacing);
+      fot_->feed(s.time_s, s.displacement_mm, s.force_N, false);
+      fot_->finish();
+      if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
+    }
+    validating_ = true;
+    campaign_run_ = L.result.run_id;
+    if (L.result.validation_run_id > 0) {
+      L.result.run_id = L.result.validation_run_id;
+      L.next_seq = 0;
+    }
+    L.event("validation", {{"run", L.result.run_id}, {"reversals", plan_.validation.reversals}, {"seed", plan_.validation.seed},
+                           {"points_mm", validation_points(plan_.validation)},
+                           {"why", "a seeded random input after the rows, not used to build any table: every table is scored on it"}});
   }
 
   // Motion is supervised: distance / rate, plus the rig's lag, a settle time and the dwell.
@@ -157,8 +231,13 @@ class RampStrategy final : public Strategy {
   SupervisionSettings settings_;
   std::shared_ptr<models::OnlineTableBuilder> builder_;
   std::unique_ptr<OnlineFot> fot_;
-  RunSeries series_;
+  RunSeries series_, validation_;
   double time_scale_ = 1.0;
+  ShakedownRule shakedown_;
+  std::optional<std::size_t> cycle_start_;  // the sample a training cycle began at
+  std::size_t rows_begin_ = 0;
+  bool validating_ = false;
+  std::int64_t campaign_run_ = 0;
   double target_ = 0, started_ = 0, deadline_ = 1e300;
   double stalled_at_arm_ = 0;
   int rounds_ = 0;

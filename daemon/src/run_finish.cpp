@@ -8,27 +8,16 @@
 #include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/fit_report.hpp"
-#include "hystlab/models/preisach_model.hpp"
+#include "hystlab/models/loop_figures.hpp"
+#include "hystlab/models/loop_report.hpp"
+#include "hystlab/models/table_score.hpp"
 
 namespace hystlab::daemon {
 namespace {
 using nlohmann::json;
 
-json accuracy_json(const models::AccuracyReport& r) {
-  auto branch = [](const models::ErrorStats& s) {
-    return json{{"samples", s.count}, {"rms_N", s.rms}, {"max_N", s.max_abs}, {"rms_norm", s.rms_norm}, {"max_norm", s.max_norm}};
-  };
-  json j{{"overall", branch(r.overall)}, {"ascending", branch(r.ascending)}, {"descending", branch(r.descending)},
-         {"reference_range_N", r.reference_range}};
-  if (r.energy_rel_error) j["loop_energy_rel_error"] = *r.energy_rel_error;
-  return j;
-}
-
-models::AccuracyReport evaluate(const models::EverettTable& table, const std::vector<double>& x, const std::vector<double>& f) {
-  models::PreisachModel m(table);
-  std::vector<double> y(x.size());
-  m.evaluate(x, y);
-  return models::compare(x, f, y);
+json evaluate(const models::EverettTable& table, const RunSeries& s) {
+  return models::accuracy_json(models::score_table(table, s.x, s.f));
 }
 }  // namespace
 
@@ -37,40 +26,97 @@ void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const mode
   auto table = builder.table();
   const std::size_t known = builder.identified_nodes(), needed = builder.required_nodes();
   writer.post([campaign, table = std::move(table), x = series.x, f = series.f, known, needed, now](db::Store& s) {
-    const json detail{{"nodes", known}, {"required", needed}, {"accuracy", accuracy_json(evaluate(table, x, f))}};
+    const json detail{{"nodes", known}, {"required", needed}, {"accuracy", models::accuracy_json(models::score_table(table, x, f))}};
     s.add_event(campaign, "fit", detail.dump(), now);
   });
 }
 
 namespace {
-// The fot tables of a finished campaign: the calibrated table from every node, with its accuracy
-// on every sample of every run, drift and provenance; and the constrained least-squares table.
-std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const std::string& now, std::string& note) {
-  std::vector<db::Store::TableRecord> out;
+// Every closed cycle of the campaign's run (those starting before rows_begin are training loops)
+// and of the validation run, with the plan's plateau displacements.
+std::vector<db::Store::LoopRecord> loop_records(const FinishJob& j, std::int64_t run, std::int64_t vrun) {
+  std::vector<db::Store::LoopRecord> out;
+  models::LoopOptions o;
+  o.plateau_at_mm = j.plan.plateaus_mm;
+  int k = 0;
+  for (const models::LoopFigures& L : models::find_loops(j.series.x, j.series.f, o))
+    out.push_back({run, k++, L.begin < j.rows_begin ? db::LoopPhase::training : db::LoopPhase::rows, models::loop_json(L).dump()});
+  if (vrun > 0 && !j.validation.x.empty()) {
+    k = 0;
+    for (const models::LoopFigures& L : models::find_loops(j.validation.x, j.validation.f, o))
+      out.push_back({vrun, k++, db::LoopPhase::validation, models::loop_json(L).dump()});
+  }
+  return out;
+}
+
+// A table of the campaign, with its accuracy on the campaign's own samples (training figures) and
+// on the validation run's (held-out figures, when there is one).
+struct Candidate {
+  std::string label;
+  db::Store::TableRecord record;
+  models::TableProvenance provenance;
+  models::EverettTable table;
+  json accuracy;
+  std::optional<double> heldout_rms;
+};
+
+Candidate candidate(const FinishJob& j, std::string label, std::string method, int n, const models::EverettTable& table,
+                    models::TableProvenance prov) {
+  Candidate c{std::move(label), {std::move(method), n, j.plan.lo_mm, j.plan.hi_mm, "", ""}, std::move(prov), table, evaluate(table, j.series), {}};
+  if (j.validation.x.size() >= 2) {
+    json held = evaluate(table, j.validation);
+    c.heldout_rms = held.at("overall").at("rms_N").get<double>();
+    c.accuracy["held_out"] = std::move(held);
+  }
+  return c;
+}
+
+// The recommended table: the lowest RMS error on the validation run; the reason lists them all.
+std::string recommend(std::vector<Candidate>& cs) {
+  std::optional<std::size_t> best;
+  for (std::size_t k = 0; k < cs.size(); ++k)
+    if (cs[k].heldout_rms && (!best || *cs[k].heldout_rms < *cs[*best].heldout_rms)) best = k;
+  if (!best) return "";
+  std::string why = cs[*best].label + " has the lowest error on the validation run (held-out RMS";
+  for (const Candidate& c : cs)
+    if (c.heldout_rms) why += (&c == &cs.front() ? " " : "; ") + c.label + ": " + plan_number(*c.heldout_rms) + " N";
+  why += ")";
+  for (std::size_t k = 0; k < cs.size(); ++k) {
+    cs[k].accuracy["recommended"] = k == *best;
+    if (k == *best) cs[k].accuracy["recommendation"] = why;
+  }
+  return why;
+}
+
+// The fot tables of a finished campaign: the calibrated table from every node, and the
+// least-squares table (prior decided by held-out blocks), each with its accuracy on every sample
+// of the campaign's runs, on the validation run, drift and provenance.
+std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const std::string& now, std::string& note, std::string& recommendation) {
   const Plan& plan = j.plan;
-  const models::EverettTable table = j.builder->table();
   const models::DriftReport drift = models::drift_report(*j.builder);
-  const json acc = accuracy_json(evaluate(table, j.series.x, j.series.f));
   const std::string source = "campaign " + std::to_string(j.campaign), run = "run " + std::to_string(j.result.run_id);
-  models::TableProvenance prov{source, "fot", now, run,
-                               {{"accuracy", acc}, {"drift_max_spread_N", drift.max_spread}, {"drift_pooled_std_N", drift.pooled_std}}};
-  out.push_back({"fot", plan.subdivisions, plan.lo_mm, plan.hi_mm, acc.dump(), models::table_to_json(table, prov).dump()});
-  // The least-squares table, its prior (signed or monotone masses) decided by its error on
-  // held-out blocks of the record (the CLI's `fit`, same code and figures). At most n = 24, as
-  // before: the campaign's end (and a shutdown) waits for it, the fit cannot be cancelled yet, and
-  // its cross-validation costs O(samples) per solver step (bench_fit: n = 48 on 10^5 samples 30 s).
+  const std::string fot_label = "fot n=" + std::to_string(plan.subdivisions);
+  std::vector<Candidate> cs;
+  cs.push_back(candidate(j, fot_label, "fot", plan.subdivisions, j.builder->table(),
+                         {source, "fot", now, run, {{"drift_max_spread_N", drift.max_spread}, {"drift_pooled_std_N", drift.pooled_std}}}));
+  // At most n = 24, as before: the campaign's end (and a shutdown) waits for it, the fit cannot
+  // be cancelled yet, and its cross-validation costs O(samples) per solver step (bench_fit: n = 48
+  // on 10^5 samples 30 s).
   const int n = std::min(plan.subdivisions, 24);
   try {
-    const models::PreisachFitResult fit =
-        models::fit_preisach(j.series.x, j.series.f, models::Grid::make(plan.lo_mm, plan.hi_mm, n));
-    const json lacc = accuracy_json(evaluate(fit.chosen.table, j.series.x, j.series.f));
-    json extra = models::fit_provenance(fit);
-    extra["accuracy"] = lacc;
-    models::TableProvenance lp{source, "lsq", now, run, std::move(extra)};
-    out.push_back({"lsq", n, plan.lo_mm, plan.hi_mm, lacc.dump(),
-                   models::table_to_json(fit.chosen.table, lp).dump()});
+    const models::PreisachFitResult fit = models::fit_preisach(j.series.x, j.series.f, models::Grid::make(plan.lo_mm, plan.hi_mm, n));
+    cs.push_back(candidate(j, "lsq " + std::string(models::to_string(fit.chosen.prior)) + " n=" + std::to_string(n), "lsq", n, fit.chosen.table,
+                           {source, "lsq", now, run, models::fit_provenance(fit)}));
   } catch (const std::exception& e) {  // optional: its failure never costs the campaign its fot table
     note = std::string("; least-squares table skipped: ") + e.what();
+  }
+  recommendation = recommend(cs);
+  std::vector<db::Store::TableRecord> out;
+  for (Candidate& c : cs) {
+    c.provenance.extra["accuracy"] = c.accuracy;
+    c.record.accuracy_json = c.accuracy.dump();
+    c.record.document_json = models::table_to_json(c.table, c.provenance).dump();
+    out.push_back(std::move(c.record));
   }
   return out;
 }
@@ -79,32 +125,44 @@ std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const std::string& 
 RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::function<std::string()>& now_iso) {
   RunnerResult r = j.result;
   const std::string now = now_iso();
-  std::vector<db::Store::TableRecord> tables;
-  std::string note;
+  db::Store::RunEnd end;
+  std::string note, recommendation;
   if (r.end == CampaignEnd::completed && j.builder) {
     if (!j.builder->complete()) {
       r.end = CampaignEnd::failed;
       r.reason = "the input ended with " + std::to_string(j.builder->identified_nodes()) + " of " +
                  std::to_string(j.builder->required_nodes()) + " FOT nodes measured";
     } else {
-      tables = fot_tables(j, now, note);
+      end.tables = fot_tables(j, now, note, recommendation);
+      for (std::size_t k = 0; k < end.tables.size(); ++k)
+        if (json::parse(end.tables[k].accuracy_json).value("recommended", false)) end.recommended = k;
+      end.recommendation = recommendation;
     }
   }
-  const db::CampaignState state = state_of(r.end);
-  const std::string reason = (r.reason.empty() ? std::string("finished") : r.reason) + note;
-  const auto campaign = j.campaign, run = r.run_id;
+  if (j.plan.kind != db::CampaignKind::sine) {
+    try {
+      end.loops = loop_records(j, r.run_id, r.validation_run_id);
+    } catch (const std::exception& e) {  // figures are extra: they never cost the campaign its end
+      note += std::string("; loop figures skipped: ") + e.what();
+    }
+  }
+  end.campaign = j.campaign;
+  end.run = r.run_id;
+  end.validation_run = r.validation_run_id;
+  end.state = state_of(r.end);
+  end.reason = (r.reason.empty() ? std::string("finished") : r.reason) + note;
+  end.now = now;
   // Retried: a busy database delays the end of a campaign, it never loses it.
   for (int attempt = 0; attempt < 30; ++attempt) {
-    auto ids = writer.call<std::vector<std::int64_t>>(
-        [campaign, run, tables, state, reason, now](db::Store& s) { return s.finish_run(campaign, run, tables, state, reason, now); }, 10.0);
+    auto ids = writer.call<std::vector<std::int64_t>>([&end](db::Store& s) { return s.finish_run(end); }, 10.0);
     if (ids) {
       if (ids->size() > 0) r.table_id = (*ids)[0];
       if (ids->size() > 1) r.lsq_table_id = (*ids)[1];
-      r.reason = reason == "finished" ? "" : reason;
+      r.reason = end.reason == "finished" ? "" : end.reason;
       return r;
     }
   }
-  r.reason = reason + "; the database did not take the end of the campaign";
+  r.reason = end.reason + "; the database did not take the end of the campaign";
   return r;
 }
 

@@ -1,13 +1,15 @@
 #include "hystlab/daemon/sequencer.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
 namespace hystlab::daemon {
 
 std::vector<Segment> fot_schedule(const Plan& p) {
   std::vector<Segment> s;
   s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::preamble, 0});
-  for (int c = 0; c < p.training_cycles; ++c) {  // stabilise the specimen on its major loop
+  for (int c = 0; c < p.training.max_cycles; ++c) {  // stabilise the specimen on its major loop
     s.push_back({p.hi_mm, p.ramp_rate_mm_s, 0.0, SegmentKind::training, 0});
     s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::training, 0});
   }
@@ -17,7 +19,26 @@ std::vector<Segment> fot_schedule(const Plan& p) {
       s.push_back({top, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::rise, i});
       s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::descent, i});
     }
+  if (p.validation.enabled)
+    for (const double x : validation_points(p.validation)) s.push_back({x, p.validation.rate_mm_s, 0.0, SegmentKind::validation, 0});
   return s;
+}
+
+std::vector<double> validation_points(const Validation& v) {
+  std::mt19937_64 rng(v.seed);
+  // From the generator's bits, not std::uniform_real_distribution (whose mapping the standard
+  // leaves to the library): the same plan gives the same input everywhere.
+  auto uniform = [&rng](double a, double b) { return a + (b - a) * static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  const double span = v.hi_mm - v.lo_mm, gap = 0.1 * span;
+  std::vector<double> out{v.lo_mm};
+  double x = v.lo_mm;
+  for (int r = 0; r < v.reversals; ++r) {
+    const bool up = r % 2 == 0;
+    x = up ? uniform(std::min(x + gap, v.hi_mm), v.hi_mm) : uniform(v.lo_mm, std::max(x - gap, v.lo_mm));
+    out.push_back(x);
+  }
+  out.push_back(v.lo_mm);
+  return out;
 }
 
 std::vector<Segment> waveform_schedule(const Plan& p) {
@@ -46,6 +67,11 @@ std::optional<SetpointCommand> Sequencer::step(double now, double x) {
     return step(now, x);
   }
   return std::nullopt;
+}
+
+std::size_t Sequencer::find(SegmentKind kind, std::size_t k) const noexcept {
+  while (k < segments_.size() && segments_[k].kind != kind) ++k;
+  return k;
 }
 
 void Sequencer::restart_at(std::size_t k) noexcept {

@@ -46,4 +46,21 @@ std::optional<CampaignKind> campaign_kind_from(std::string_view text) noexcept {
   return std::nullopt;
 }
 
+const char* to_string(RunRole r) noexcept { return r == RunRole::validation ? "validation" : "campaign"; }
+
+std::optional<RunRole> run_role_from(std::string_view text) noexcept {
+  for (const RunRole r : {RunRole::campaign, RunRole::validation})
+    if (text == to_string(r)) return r;
+  return std::nullopt;
+}
+
+const char* to_string(LoopPhase p) noexcept {
+  switch (p) {
+    case LoopPhase::training: return "training";
+    case LoopPhase::rows: return "rows";
+    case LoopPhase::validation: return "validation";
+  }
+  return "?";
+}
+
 }  // namespace hystlab::db

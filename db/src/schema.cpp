@@ -57,6 +57,14 @@ CREATE INDEX commands_pending ON commands(handled_at, id);
 CREATE TABLE rig_commands(
   id INTEGER PRIMARY KEY, rig TEXT NOT NULL, command TEXT NOT NULL, created_at TEXT NOT NULL, handled_at TEXT);
 )sql",
+    // 4: a run's role (its campaign's input, or the validation input the tables are scored on),
+    // and the figures of every closed cycle of every run (models/loop_figures), as JSON.
+    R"sql(
+ALTER TABLE runs ADD COLUMN role TEXT NOT NULL DEFAULT 'campaign';
+CREATE TABLE loops(
+  run_id INTEGER NOT NULL REFERENCES runs(id), k INTEGER NOT NULL, phase TEXT NOT NULL, figures TEXT NOT NULL,
+  PRIMARY KEY(run_id, k)) WITHOUT ROWID;
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof kMigrations / sizeof kMigrations[0]);
 static_assert(kMigrationCount == kSchemaVersion);

@@ -95,11 +95,19 @@ void Store::transition_in(std::int64_t id, CampaignState to, const std::string& 
   ev.step();
 }
 
-std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, double wall, double mono) {
-  Statement st(db_, "INSERT INTO runs(campaign_id, started_at, wall_anchor_unix, monotonic_anchor_s, state) VALUES(?,?,?,?,'running')");
-  st.bind(1, campaign).bind(2, now).bind(3, wall).bind(4, mono);
+std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, double wall, double mono, RunRole role) {
+  Statement st(db_, "INSERT INTO runs(campaign_id, started_at, wall_anchor_unix, monotonic_anchor_s, state, role) VALUES(?,?,?,?,'running',?)");
+  st.bind(1, campaign).bind(2, now).bind(3, wall).bind(4, mono).bind(5, std::string_view(to_string(role)));
   st.step();
   return db_.last_insert_rowid();
+}
+
+std::pair<std::int64_t, std::int64_t> Store::add_runs(std::int64_t campaign, const std::string& now, double wall, double mono, bool validation) {
+  Transaction tx(db_);
+  const std::int64_t run = add_run(campaign, now, wall, mono);
+  const std::int64_t vrun = validation ? add_run(campaign, now, wall, mono, RunRole::validation) : 0;
+  tx.commit();
+  return {run, vrun};
 }
 
 void Store::end_run(std::int64_t run, CampaignState state, const std::string& now) {

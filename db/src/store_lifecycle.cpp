@@ -22,22 +22,51 @@ std::int64_t Store::table_count(std::int64_t campaign) {
   return st.column_int(0);
 }
 
-std::vector<std::int64_t> Store::runs_of_campaign(std::int64_t campaign) {
+std::vector<std::int64_t> Store::runs_of_campaign(std::int64_t campaign, std::optional<RunRole> role) {
   std::vector<std::int64_t> out;
-  Statement st(db_, "SELECT id FROM runs WHERE campaign_id = ? ORDER BY id");
+  Statement st(db_, role ? "SELECT id FROM runs WHERE campaign_id = ? AND role = ? ORDER BY id" : "SELECT id FROM runs WHERE campaign_id = ? ORDER BY id");
   st.bind(1, campaign);
+  if (role) st.bind(2, std::string_view(to_string(*role)));
   while (st.step()) out.push_back(st.column_int(0));
   return out;
 }
 
-std::vector<std::int64_t> Store::finish_run(std::int64_t campaign, std::int64_t run, const std::vector<TableRecord>& tables,
-                                            CampaignState state, const std::string& reason, const std::string& now) {
+std::vector<std::int64_t> Store::finish_run(const RunEnd& e) {
   std::vector<std::int64_t> ids;
   Transaction tx(db_);
-  if (table_count(campaign) == 0)
-    for (const TableRecord& t : tables) ids.push_back(add_table(campaign, run, t.method, t.n, t.lo, t.hi, now, t.accuracy_json, t.document_json));
-  if (run > 0) end_run(run, state, now);
-  transition_in(campaign, state, reason, now);
+  if (table_count(e.campaign) == 0) {
+    for (const TableRecord& t : e.tables)
+      ids.push_back(add_table(e.campaign, e.run, t.method, t.n, t.lo, t.hi, e.now, t.accuracy_json, t.document_json));
+    if (e.recommended && *e.recommended < ids.size()) {
+      const TableRecord& t = e.tables[*e.recommended];
+      // JSON by hand: db/ has no JSON library; the reason is escaped for its quotes and backslashes.
+      std::string why;
+      for (const char ch : e.recommendation) {
+        if (ch == '"' || ch == '\\') why += '\\';
+        if (static_cast<unsigned char>(ch) >= 0x20) why += ch;
+      }
+      add_event(e.campaign, "recommendation",
+                "{\"table\":" + std::to_string(ids[*e.recommended]) + ",\"method\":\"" + t.method + "\",\"n\":" + std::to_string(t.n) +
+                    ",\"why\":\"" + why + "\"}",
+                e.now);
+    }
+  }
+  for (const LoopRecord& l : e.loops) {
+    Statement st(db_, "INSERT OR REPLACE INTO loops(run_id, k, phase, figures) VALUES(?,?,?,?)");
+    st.bind(1, l.run).bind(2, static_cast<std::int64_t>(l.k)).bind(3, std::string_view(to_string(l.phase))).bind(4, l.figures_json);
+    st.step();
+  }
+  if (e.run > 0) end_run(e.run, e.state, e.now);
+  if (e.validation_run > 0) {
+    if (sample_count(e.validation_run) > 0) {
+      end_run(e.validation_run, e.state, e.now);
+    } else {  // never started (the campaign ended before it): no empty run is left behind
+      Statement del(db_, "DELETE FROM runs WHERE id = ? AND NOT EXISTS (SELECT 1 FROM samples WHERE run_id = ?)");
+      del.bind(1, e.validation_run).bind(2, e.validation_run);
+      del.step();
+    }
+  }
+  transition_in(e.campaign, e.state, e.reason, e.now);
   tx.commit();
   records_changed();
   return ids;

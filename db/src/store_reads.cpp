@@ -7,13 +7,14 @@ namespace hystlab::db {
 namespace {
 constexpr const char* kRunSelect =
     "SELECT id, campaign_id, state, started_at, coalesce(ended_at, ''), wall_anchor_unix, "
-    "(SELECT coalesce(sum(n), 0) FROM sample_blocks WHERE run_id = runs.id), (SELECT count(*) FROM fot_nodes WHERE run_id = runs.id) FROM runs ";
+    "(SELECT coalesce(sum(n), 0) FROM sample_blocks WHERE run_id = runs.id), (SELECT count(*) FROM fot_nodes WHERE run_id = runs.id), role FROM runs ";
 constexpr const char* kTableSelect = "SELECT id, campaign_id, run_id, method, n, range_lo, range_hi, created_at, coalesce(accuracy, '') FROM tables ";
 constexpr const char* kNodeSelect =
     "SELECT f.id, r.campaign_id, f.run_id, alpha, beta, force_alpha, force_alpha_beta, coalesce(f.t, 0) FROM fot_nodes f JOIN runs r ON r.id = f.run_id ";
 
 RunInfo run_row(Statement& st) {
-  return {st.column_int(0), st.column_int(1), st.column_text(2), st.column_text(3), st.column_text(4), st.column_double(5), st.column_int(6), st.column_int(7)};
+  return {st.column_int(0), st.column_int(1), st.column_text(2), st.column_text(3), st.column_text(4), st.column_double(5), st.column_int(6), st.column_int(7),
+          st.column_text(8)};
 }
 TableInfo table_row(Statement& st) {
   TableInfo t;
@@ -183,6 +184,12 @@ std::int64_t Store::read_xy(std::int64_t run, std::int64_t seq0, bool base_mass,
     y.push_back(static_cast<float>(st.column_double(2)));
   }
   return next;
+}
+
+std::vector<LoopInfo> Store::loops(std::int64_t campaign) {
+  Statement st(db_, "SELECT l.run_id, l.k, l.phase, l.figures FROM loops l JOIN runs r ON r.id = l.run_id WHERE r.campaign_id = ? ORDER BY l.run_id, l.k");
+  st.bind(1, campaign);
+  return all<LoopInfo>(st, [](Statement& s) { return LoopInfo{s.column_int(0), s.column_int(1), s.column_text(2), s.column_text(3)}; });
 }
 
 }  // namespace hystlab::db

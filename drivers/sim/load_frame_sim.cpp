@@ -11,14 +11,27 @@ namespace st = protocols::status;
 SmoothedSpecimen::SmoothedSpecimen(std::unique_ptr<models::HysteresisModel> model, double width_mm)
     : model_(std::move(model)), width_(width_mm) {
   x_ = model_->input();
-  f_ = model_->output();
+  f_ = sharp_ = model_->output();
 }
 
 double SmoothedSpecimen::step(double x) noexcept {
   const double f = model_->step(x);
-  const double dx = std::fabs(x - x_);
+  const double dx = x - x_;
+  if (width_ <= 0 || dx == 0.0) {
+    x_ = x;
+    sharp_ = f;
+    f_ = width_ > 0 ? f_ : f;
+    return f_;
+  }
+  const int dir = dx > 0 ? 1 : -1;
+  const double k = (f - sharp_) / dx;
+  if (dir != dir_) slope_ = k;  // a reversal: the new branch's slope at once
+  else slope_ += (k - slope_) * (1.0 - std::exp(-std::fabs(dx) / width_));
+  f_ += slope_ * dx;
+  f_ += (f - f_) * (1.0 - std::exp(-std::fabs(dx) / (4 * width_)));
+  dir_ = dir;
   x_ = x;
-  f_ = width_ > 0 ? f_ + (f - f_) * (1.0 - std::exp(-dx / width_)) : f;
+  sharp_ = f;
   return f_;
 }
 

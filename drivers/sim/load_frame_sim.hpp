@@ -25,9 +25,14 @@ struct LoadFrameParams {
   ControllerParams controller;       // mode interlock and host watchdog (default: neither)
 };
 
-// The specimen's force with its corners rounded: a first-order filter in displacement (not in
-// time), f_s += (f - f_s)(1 - exp(-|Δδ|/w)), so the loop keeps its rate independence while the
-// sharp transitions of the simplified model become gradual, like the measured tube (paper Fig. 3).
+// The specimen's force with its corners rounded, in displacement (not in time, so the loop keeps
+// its rate independence), like the measured tube (paper Fig. 3): the force follows the sharp
+// model's slope through a first-order filter, k_s += (k - k_s)(1 - exp(-|Δδ|/w)), f_s += k_s Δδ,
+// and is pulled back to the sharp force over 4w. A straight line is followed exactly once k_s has
+// settled, and a reversal takes the new slope at once (elastic unloading is sharp in a real
+// spring). Filtering the force itself instead (until stop 23) lagged it by slope × w on every
+// straight part, in opposite directions on loading and unloading: an elastic loop on the
+// austenite line dissipated -3 N·mm, a spring giving energy back, which no material does.
 class SmoothedSpecimen {
  public:
   SmoothedSpecimen(std::unique_ptr<models::HysteresisModel> model, double width_mm);
@@ -36,6 +41,8 @@ class SmoothedSpecimen {
  private:
   std::unique_ptr<models::HysteresisModel> model_;
   double width_, x_ = 0, f_ = 0;
+  double sharp_ = 0, slope_ = 0;  // the sharp model's last force, and the filtered slope
+  int dir_ = 0;                   // the input's last direction of motion
 };
 
 struct LoadFrameCommands {

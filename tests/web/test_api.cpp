@@ -8,6 +8,7 @@
 
 #include "api_fixture.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/accuracy.hpp"
 #include "hystlab/models/preisach_model.hpp"
 
 using namespace hystlab;
@@ -50,7 +51,9 @@ TEST_CASE("a campaign through the API: submit, follow, nodes, tables and their e
   const json camp = json::parse(c.Get(("/api/campaigns/" + std::to_string(id)).c_str())->body);
   CHECK(camp["progress"]["nodes"] == 6);
   CHECK(camp["progress"]["required"] == 6);
-  REQUIRE(camp["runs"].size() == 1);
+  REQUIRE(camp["runs"].size() == 2);  // the campaign's run, and the validation run after the rows
+  CHECK(camp["runs"][0]["role"] == "campaign");
+  CHECK(camp["runs"][1]["role"] == "validation");
   REQUIRE(camp["tables"].size() == 2);
   const std::int64_t run = camp["runs"][0]["id"], samples = camp["runs"][0]["samples"];
   CHECK(samples > 100);
@@ -130,6 +133,62 @@ TEST_CASE("a campaign through the API: submit, follow, nodes, tables and their e
   r = post(c, "/api/evaluate", {{"params", {{"model", "simplified-sma"}}}, {"displacement_mm", {0.0, 1.0, 2.0}}});
   CAPTURE(r->body);
   CHECK((r->status == 200 || r->status == 400));  // the parameter format's own rules decide; never a crash
+
+  // Held-out validation: every table scored on the validation run, the lowest error recommended,
+  // and the same score again from the API, equal to an independent recomputation from the samples.
+  const std::int64_t vrun = camp["runs"][1]["id"];
+  CHECK(camp["runs"][1]["samples"].get<std::int64_t>() > 100);
+  REQUIRE(camp["recommendation"].is_object());
+  const std::int64_t recommended = camp["recommendation"]["table"];
+  CHECK(camp["recommendation"]["why"].get<std::string>().find("lowest error on the validation run") != std::string::npos);
+  double best = 1e300;
+  for (const json& t : camp["tables"]) {
+    REQUIRE(t["accuracy"].contains("held_out"));
+    best = std::min(best, t["accuracy"]["held_out"]["overall"]["rms_N"].get<double>());
+  }
+  for (const json& t : camp["tables"]) {
+    const std::int64_t tid = t["id"];
+    CAPTURE(tid);
+    CHECK(t["accuracy"]["recommended"].get<bool>() == (tid == recommended));
+    if (tid == recommended) CHECK(t["accuracy"]["held_out"]["overall"]["rms_N"].get<double>() == best);
+    r = c.Get(("/api/tables/" + std::to_string(tid) + "/score?run=" + std::to_string(vrun)).c_str());
+    REQUIRE(r->status == 200);
+    const json score = json::parse(r->body);
+    CHECK(score["overall"]["rms_N"].get<double>() == doctest::Approx(t["accuracy"]["held_out"]["overall"]["rms_N"].get<double>()).epsilon(1e-12));
+    CHECK(score["descending"]["max_N"].get<double>() == doctest::Approx(t["accuracy"]["held_out"]["descending"]["max_N"].get<double>()).epsilon(1e-12));
+    // Independently: the validation run's samples as CSV, the table's document, the library's compare.
+    const models::TableDocument td = models::table_from_json(c.Get(("/api/tables/" + std::to_string(tid) + "/export?format=json").c_str())->body);
+    std::istringstream vcsv(c.Get(("/api/runs/" + std::to_string(vrun) + "/samples.csv").c_str())->body);
+    std::vector<double> vx, vf;
+    std::getline(vcsv, line);
+    while (std::getline(vcsv, line)) {
+      double v[6];
+      REQUIRE(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) == 6);
+      vx.push_back(v[3]);
+      vf.push_back(v[4]);
+    }
+    models::PreisachModel pm(std::make_shared<const models::EverettTable>(td.table));
+    std::vector<double> vy(vx.size());
+    pm.evaluate(vx, vy);
+    const models::AccuracyReport rep = models::compare(vx, vf, vy);
+    CHECK(score["overall"]["rms_N"].get<double>() == doctest::Approx(rep.overall.rms).epsilon(1e-6));  // the CSV keeps 9 digits
+    CHECK(score["ascending"]["max_N"].get<double>() == doctest::Approx(rep.ascending.max_abs).epsilon(1e-5));
+  }
+  check_error(c.Get(("/api/tables/" + std::to_string(table) + "/score").c_str()), 400, "run");
+  check_error(c.Get(("/api/tables/" + std::to_string(table) + "/score?run=999").c_str()), 404, "no run 999");
+
+  // Loop figures of both runs: the rows' load-unload cycles from δmin and the validation's.
+  const json loops = json::parse(c.Get(("/api/campaigns/" + std::to_string(id) + "/loops").c_str())->body);
+  REQUIRE(loops.is_array());
+  int rows_loops = 0, validation_loops = 0;
+  for (const json& l : loops) {
+    rows_loops += l["phase"] == "rows";
+    validation_loops += l["phase"] == "validation";
+    CAPTURE(l.dump());
+    CHECK(l["energy_Nmm"].get<double>() > -1.0);
+  }
+  CHECK(rows_loops >= 3);  // one per row (n = 3)
+  CHECK(validation_loops >= 1);
 }
 
 TEST_CASE("every error path answers one JSON error with the right status") {

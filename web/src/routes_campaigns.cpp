@@ -17,8 +17,8 @@ db::CampaignRow campaign_or_404(db::Store& store, std::int64_t id) {
 json runs_of(db::Store& store, std::int64_t campaign) {
   json runs = json::array();
   for (const db::RunInfo& r : store.runs(campaign))
-    runs.push_back({{"id", r.id}, {"state", r.state}, {"started_at", r.started_at}, {"ended_at", r.ended_at}, {"samples", r.samples},
-                    {"nodes", r.nodes}, {"quality", run_quality(store, campaign, r.id)}});
+    runs.push_back({{"id", r.id}, {"role", r.role}, {"state", r.state}, {"started_at", r.started_at}, {"ended_at", r.ended_at},
+                    {"samples", r.samples}, {"nodes", r.nodes}, {"quality", run_quality(store, campaign, r.id)}});
   return runs;
 }
 
@@ -81,6 +81,15 @@ json campaign_json(const control::DaemonInterface& d, db::Store& store, const db
   j["runs"] = runs_of(store, row.id);
   j["tables"] = tables_of(store, row.id, j["runs"]);
   j["fit"] = last_fit(store, row.id);
+  // Training (each cycle's figures: the shakedown curve, and what it came to) and the table the
+  // campaign recommends, with the reason.
+  json shakedown = json::array();
+  for (const std::string& cycle : store.event_details(row.id, "shakedown")) shakedown.push_back(parse_or_text(cycle));
+  j["shakedown"] = shakedown;
+  const auto training = store.event_details(row.id, "training");
+  j["training"] = training.empty() ? json(nullptr) : parse_or_text(training.back());
+  const auto rec = store.event_details(row.id, "recommendation");
+  j["recommendation"] = rec.empty() ? json(nullptr) : parse_or_text(rec.back());
   if (row.kind == db::CampaignKind::fot) {
     const json nodes = nodes_json(d, store, row);
     j["progress"] = {{"nodes", nodes["identified"]}, {"required", nodes["required"]}};
@@ -134,6 +143,19 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/campaigns/(\d+)/nodes)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
     send_json(res, nodes_json(c.daemon, store, campaign_or_404(store, path_id(req))));
+  }));
+  s.Get(R"(/api/campaigns/(\d+)/loops)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    auto& store = reader(c.db_path);
+    json out = json::array();
+    for (const db::LoopInfo& l : store.loops(campaign_or_404(store, path_id(req)).id)) {
+      json j = parse_or_text(l.figures_json);
+      if (!j.is_object()) continue;
+      j["run"] = l.run;
+      j["k"] = l.k;
+      j["phase"] = l.phase;
+      out.push_back(std::move(j));
+    }
+    send_json(res, out);
   }));
   s.Get(R"(/api/campaigns/(\d+)/runs)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);

@@ -2,10 +2,12 @@
 // CSV), tables (list, get, export) and model evaluation.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/table_export.hpp"
+#include "hystlab/models/table_score.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
 
@@ -72,7 +74,7 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
     auto& store = reader(c.db_path);
     const db::RunInfo r = run_or_404(store, path_id(req));
     const auto [t0, t1] = store.time_span(r.id).value_or(std::make_pair(0.0, 0.0));
-    send_json(res, {{"id", r.id}, {"campaign", r.campaign}, {"state", r.state}, {"started_at", r.started_at}, {"ended_at", r.ended_at},
+    send_json(res, {{"id", r.id}, {"campaign", r.campaign}, {"role", r.role}, {"state", r.state}, {"started_at", r.started_at}, {"ended_at", r.ended_at},
                     {"wall_anchor_unix", r.wall_anchor_unix}, {"samples", r.samples}, {"t_range_s", {t0, t1}},
                     {"quality", run_quality(store, r.campaign, r.id)}});
   }));
@@ -108,6 +110,27 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
     if (!t) throw ApiError(404, "not found", "no table " + std::to_string(id));
     json j = table_json(*t);
     j["document"] = json::parse(table_document(store, id));
+    send_json(res, j);
+  }));
+  // A table scored on any run (a campaign's validation run, typically): the table from its initial
+  // state over the run's displacements, against the measured forces, per branch.
+  s.Get(R"(/api/tables/(\d+)/score)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    auto& store = reader(c.db_path);
+    const std::int64_t id = path_id(req);
+    if (!req.has_param("run")) throw ApiError(400, "invalid parameter", "run: the run to score the table on is required (?run=ID)", "run");
+    const std::int64_t run = static_cast<std::int64_t>(query_number(req, "run", 0, 1, 9e15));
+    const models::TableDocument doc = models::table_from_json(table_document(store, id));
+    const db::RunInfo r = run_or_404(store, run);
+    std::vector<double> x, f;
+    store.for_each_sample(r.id, 0, std::numeric_limits<std::int64_t>::max(), [&](const db::SampleRow& row) {
+      x.push_back(row.disp);
+      f.push_back(row.force);
+    });
+    if (x.size() < 2) throw ApiError(409, "conflict", "run " + std::to_string(run) + " has " + std::to_string(x.size()) + " sample(s): nothing to score on");
+    json j = models::accuracy_json(models::score_table(doc.table, x, f));
+    j["table"] = id;
+    j["run"] = r.id;
+    j["role"] = r.role;
     send_json(res, j);
   }));
   s.Get(R"(/api/tables/(\d+)/export)", guarded([&c](const httplib::Request& req, httplib::Response& res) {

@@ -63,6 +63,9 @@ struct RunnerResult {
   double longest_gap_s = 0, gap_total_s = 0;
   std::size_t nodes = 0;
   std::optional<std::int64_t> table_id, lsq_table_id;
+  // The validation run (fot, when the plan asks): created with the campaign's run, its samples
+  // stored under it from the first validation segment on. 0: none.
+  std::int64_t validation_run_id = 0;
 };
 
 // What finishing a run needs, handed off the acquisition thread.
@@ -71,7 +74,10 @@ struct FinishJob {
   Plan plan;
   RunnerResult result;
   std::shared_ptr<const models::OnlineTableBuilder> builder;  // every node of the campaign (fot)
-  RunSeries series;  // every sample of every run of the campaign (fot)
+  RunSeries series;  // every sample of every campaign run of the campaign (fot, waveform)
+  std::size_t rows_begin = 0;  // series[rows_begin..] came after training (loops before it are training loops)
+  RunSeries validation;        // the validation run's samples: every table is scored on them
+  std::string training_summary;  // what training came to (empty: no training)
 };
 
 struct RunnerContext {

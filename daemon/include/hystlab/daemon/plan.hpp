@@ -3,10 +3,20 @@
 //   {"kind": "fot", "range_mm": [0, 4], "subdivisions": 12, "ramp_rate_mm_s": 0.5, "dwell_s": 0.2,
 //    "sample_rate_hz": 1000, "repeats": 1, "training_cycles": 2,
 //    "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 300, "rate_mm_s": 5}}
+//   FOT plans may also say how to train the specimen, validate the tables and read its loops:
+//    "training": {"max_cycles": 40, "until": {"peak_force_change": "0.5 %", "energy_change": "2 %", "consecutive": 3}}
+//      (major loops until both cycle-to-cycle changes stay below their thresholds for that many
+//      cycles; "training_cycles": N is a fixed count, the same as {"max_cycles": N} without until;
+//      a threshold is a percentage, as a number or a string with %)
+//    "validation": {"reversals": 12, "range_mm": [0, 4], "rate_mm_s": 0.5, "seed": 1} or false
+//      (default on: after the rows, a seeded random reversal sequence, stored as its own run, on
+//      which every table of the campaign is scored)
+//    "plateaus_mm": [1, 3] (the loop figures' plateau forces are read at these displacements)
 //   {"kind": "waveform", "points_mm": [0, 2, 1, 3, 0], "ramp_rate_mm_s": 0.5, ...}
 //   {"kind": "sine", "frequencies_hz": [5, 10, 20], "amplitude_mm": 0.2, "settle_cycles": 10, "measured_cycles": 10}
 //   {"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "steps": 12, "spacing": "log"}, "amplitude_mm": 0.2}
 // Times are rig time (a simulated rig's time scale is applied by the daemon).
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -32,11 +42,28 @@ struct Limits {
   double safe_position_mm = 0.0, safe_rate_mm_s = 1.0;
 };
 
+struct Training {
+  int max_cycles = 0;  // major loops δmin → δmax → δmin before the rows
+  bool until = false;  // stop early once the loop is stable (below)
+  double peak_force_change_pct = 0.5, energy_change_pct = 2.0;
+  int consecutive = 3;
+};
+
+struct Validation {
+  bool enabled = false;
+  int reversals = 12;
+  double lo_mm = 0, hi_mm = 0, rate_mm_s = 0.5;
+  std::uint64_t seed = 1;
+};
+
 struct Plan {
   db::CampaignKind kind = db::CampaignKind::fot;
   // fot
   double lo_mm = 0, hi_mm = 0;
-  int subdivisions = 0, repeats = 1, training_cycles = 0;
+  int subdivisions = 0, repeats = 1;
+  Training training;
+  Validation validation;
+  std::vector<double> plateaus_mm;
   // waveform
   std::vector<double> points_mm;
   // sine (shaker dwell or stepped sweep)

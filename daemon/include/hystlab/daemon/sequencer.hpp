@@ -9,7 +9,7 @@
 
 namespace hystlab::daemon {
 
-enum class SegmentKind { preamble, training, rise, descent, waypoint, safe };
+enum class SegmentKind { preamble, training, rise, descent, waypoint, safe, validation };
 
 struct Segment {
   double target_mm = 0, rate_mm_s = 0, dwell_s = 0;
@@ -18,9 +18,15 @@ struct Segment {
 };
 
 // MODELS.md §1's identification input: (training cycles to the top), then for each repeat and
-// each i = 1..n: rise to δ_i, descend to δmin. Starts with a preamble to δmin.
+// each i = 1..n: rise to δ_i, descend to δmin. Starts with a preamble to δmin. Then, when the plan
+// asks (the default), the validation input: validation_points, each a validation segment.
+// Training holds training.max_cycles cycles: a rule that ends it early skips the rest.
 [[nodiscard]] std::vector<Segment> fot_schedule(const Plan& plan);
 [[nodiscard]] std::vector<Segment> waveform_schedule(const Plan& plan);
+// The validation input (the paper's Fig. 18): from δmin of its range, `reversals` turning points
+// drawn from the plan's seed, alternately up and down, each at least a tenth of the range away
+// from the last, then back to δmin. The same plan gives the same points on every machine.
+[[nodiscard]] std::vector<double> validation_points(const Validation& v);
 
 struct SetpointCommand {
   double target_mm, rate_mm_s;
@@ -38,6 +44,9 @@ class Sequencer {
   [[nodiscard]] std::size_t index() const noexcept { return index_; }
   [[nodiscard]] std::size_t size() const noexcept { return segments_.size(); }
   [[nodiscard]] const Segment* current() const noexcept { return done() ? nullptr : &segments_[index_]; }
+  [[nodiscard]] const Segment& at(std::size_t k) const { return segments_.at(k); }
+  // The first segment of this kind from k on, or size().
+  [[nodiscard]] std::size_t find(SegmentKind kind, std::size_t k = 0) const noexcept;
   // Restart at segment k (memory-aware resume re-takes the segment in progress).
   void restart_at(std::size_t k) noexcept;
   // Prepends segments before the current one (the wipe-out preamble on resume).

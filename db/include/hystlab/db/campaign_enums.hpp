@@ -25,4 +25,15 @@ enum class CampaignKind { fot, waveform, sine };
 [[nodiscard]] const char* to_string(CampaignKind k) noexcept;
 [[nodiscard]] std::optional<CampaignKind> campaign_kind_from(std::string_view text) noexcept;
 
+// A run of a campaign: its own input (training, the rows), or the validation input after it, on
+// which the campaign's tables are scored (never used to build them).
+enum class RunRole { campaign, validation };
+[[nodiscard]] const char* to_string(RunRole r) noexcept;
+[[nodiscard]] std::optional<RunRole> run_role_from(std::string_view text) noexcept;
+
+// Where a closed cycle of a run was taken: training loops, the FOT rows (or a waveform's
+// points), or the validation input.
+enum class LoopPhase { training, rows, validation };
+[[nodiscard]] const char* to_string(LoopPhase p) noexcept;
+
 }  // namespace hystlab::db

@@ -12,6 +12,12 @@ struct RunInfo {
   std::string state, started_at, ended_at;  // ended_at empty while it runs
   double wall_anchor_unix = 0;
   std::int64_t samples = 0, nodes = 0;
+  std::string role;  // campaign or validation
+};
+
+struct LoopInfo {  // one closed cycle of a run
+  std::int64_t run = 0, k = 0;
+  std::string phase, figures_json;
 };
 
 struct TableInfo {

@@ -56,7 +56,11 @@ class Store {
                                const std::string& now);
   // Updates the state and records the transition as an event, in one transaction.
   void transition(std::int64_t campaign_id, CampaignState to, const std::string& reason, const std::string& now);
-  std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s);
+  std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s,
+                       RunRole role = RunRole::campaign);
+  // The campaign's run and, when asked, its validation run (else 0), in one transaction.
+  std::pair<std::int64_t, std::int64_t> add_runs(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix,
+                                                 double monotonic_anchor_s, bool validation);
   void end_run(std::int64_t run_id, CampaignState state, const std::string& now);
   std::int64_t add_event(std::int64_t campaign_id, const std::string& kind, const std::string& detail, const std::string& now);
   std::int64_t add_transmissibility(std::int64_t run_id, double f_hz, double base_mm, double mass_mm, double ratio, double phase);
@@ -75,13 +79,31 @@ class Store {
     double lo = 0, hi = 0;
     std::string accuracy_json, document_json;
   };
-  // Ends a run and its campaign in one transaction: the tables, the run's state, the campaign's
-  // state with its transition event. When the campaign already has tables (finishing again after
-  // a crash), none are added. Returns the new tables' ids.
-  std::vector<std::int64_t> finish_run(std::int64_t campaign_id, std::int64_t run_id, const std::vector<TableRecord>& tables,
-                                       CampaignState state, const std::string& reason, const std::string& now);
+  struct LoopRecord {
+    std::int64_t run = 0;
+    int k = 0;
+    LoopPhase phase = LoopPhase::rows;
+    std::string figures_json;
+  };
+  struct RunEnd {
+    std::int64_t campaign = 0, run = 0;
+    std::int64_t validation_run = 0;  // 0: none; removed when it never took a sample
+    std::vector<TableRecord> tables;
+    std::vector<LoopRecord> loops;
+    CampaignState state = CampaignState::completed;
+    std::string reason, now;
+    // The table the campaign recommends (an index into tables) and why: stored as a
+    // "recommendation" event naming the new table's id, before the campaign's last state.
+    std::optional<std::size_t> recommended;
+    std::string recommendation;
+  };
+  // Ends a run (and its validation run) and its campaign in one transaction: the tables, the loop
+  // figures, the runs' state, the campaign's state with its transition event. When the campaign
+  // already has tables (finishing again after a crash), none are added. Returns the new tables' ids.
+  std::vector<std::int64_t> finish_run(const RunEnd& end);
   [[nodiscard]] std::int64_t table_count(std::int64_t campaign_id);
-  [[nodiscard]] std::vector<std::int64_t> runs_of_campaign(std::int64_t campaign_id);
+  // Every run of the campaign, or those of one role.
+  [[nodiscard]] std::vector<std::int64_t> runs_of_campaign(std::int64_t campaign_id, std::optional<RunRole> role = std::nullopt);
   [[nodiscard]] std::vector<std::string> rig_names();
   void add_io_stats(std::int64_t rig_id, const std::string& stats_json, const std::string& now);
 
@@ -118,6 +140,7 @@ class Store {
   [[nodiscard]] std::optional<TableInfo> newest_table_of_campaign(std::int64_t campaign_id, const std::string& method);
   [[nodiscard]] std::vector<NodeInfo> nodes(std::int64_t campaign_id);
   [[nodiscard]] std::vector<TransmissibilityInfo> transmissibility(std::int64_t campaign_id);
+  [[nodiscard]] std::vector<LoopInfo> loops(std::int64_t campaign_id);  // every run's, by run and order of closing
   // Details of a campaign's events of one kind, oldest first.
   [[nodiscard]] std::vector<std::string> event_details(std::int64_t campaign_id, const std::string& kind);
   // Records since an id, across campaigns, oldest first, at most limit (the event stream).
