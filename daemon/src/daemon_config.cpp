@@ -124,13 +124,23 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
       const json& s = r["simulate"];
       if (!s.is_object()) fail(where + ".simulate", "must be an object");
       for (const auto& [f, _] : s.items())
-        if (f != "time_scale" && f != "noise_N" && f != "corner_width_mm" && f != "rig" && f != "realtime_priority") fail(where + ".simulate." + f, "is not a known field");
+        if (f != "time_scale" && f != "noise_N" && f != "corner_width_mm" && f != "rig" && f != "realtime_priority" && f != "shakedown")
+          fail(where + ".simulate." + f, "is not a known field");
       e.simulated = true;
       e.sim.time_scale = positive(s, "time_scale", 10.0, where + ".simulate");
       e.sim.noise_N = s.contains("noise_N") && s["noise_N"] == 0 ? 0.0 : positive(s, "noise_N", 0.05, where + ".simulate");
       e.sim.rig = s.value("rig", std::string("load_frame"));
       if (e.sim.rig != "load_frame" && e.sim.rig != "shaker") fail(where + ".simulate.rig", "must be \"load_frame\" or \"shaker\"");
       e.sim.corner_width_mm = s.contains("corner_width_mm") && s["corner_width_mm"] == 0 ? 0.0 : positive(s, "corner_width_mm", 0.05, where + ".simulate");
+      if (s.contains("shakedown")) {  // [extra_N, tau_cycles]
+        const json& sd = s["shakedown"];
+        if (!sd.is_array() || sd.size() != 2 || !sd[0].is_number() || !sd[1].is_number() || !(sd[0].get<double>() > 0) ||
+            !(sd[1].get<double>() > 0) || sd[0].get<double>() > 1e4 || sd[1].get<double>() > 1e4)
+          fail(where + ".simulate.shakedown", "must be [extra_N, tau_cycles], both above 0 (e.g. [8, 4])");
+        if (e.sim.rig != "load_frame") fail(where + ".simulate.shakedown", "applies to a load frame's specimen only");
+        e.sim.shakedown_extra_N = sd[0].get<double>();
+        e.sim.shakedown_tau_cycles = sd[1].get<double>();
+      }
       if (s.contains("realtime_priority")) {
         const json& p = s["realtime_priority"];
         if (!p.is_number_integer() || p.get<long long>() < 0 || p.get<long long>() > 98)

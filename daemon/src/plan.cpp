@@ -119,8 +119,10 @@ Validation parse_validation(const json& j, const Plan& p) {
     if (!r.is_number() || !(r.get<double>() >= 1e-4 && r.get<double>() <= 1e3)) fail("validation.rate_mm_s", "must be between 0.0001 and 1000");
     v.rate_mm_s = r.get<double>();
   }
-  if (b.contains("seed") && (!b["seed"].is_number_unsigned())) fail("validation.seed", "must be a non-negative integer");
-  v.seed = b.value("seed", v.seed);
+  if (b.contains("seed")) {
+    if (!b["seed"].is_number_integer() || b["seed"].get<double>() < 0) fail("validation.seed", "must be a non-negative integer");
+    v.seed = b["seed"].get<std::uint64_t>();
+  }
   return v;
 }
 

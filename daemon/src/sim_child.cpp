@@ -53,6 +53,8 @@ int SimChild::ensure_running() {
   // --realtime only when configured: at a large time scale the physics catch-up is real work, and
   // at SCHED_FIFO it starved the daemon's other threads (a campaign stalled in a sanitizer build).
   if (opt_.realtime_priority > 0) args.insert(args.end(), {"--realtime", std::to_string(opt_.realtime_priority)});
+  if (opt_.shakedown_extra_N > 0)
+    args.insert(args.end(), {"--shakedown", std::to_string(opt_.shakedown_extra_N) + "," + std::to_string(opt_.shakedown_tau_cycles)});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

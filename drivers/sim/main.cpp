@@ -26,6 +26,7 @@
 #include "hystlab/models/simplified_sma.hpp"
 #include "hystlab/protocols/default_maps.hpp"
 #include "modbus_endpoint.hpp"
+#include "shakedown_specimen.hpp"
 #include "world_clock.hpp"
 
 namespace {
@@ -47,6 +48,8 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --seed N  --noise N  --drift N_PER_S      load cell noise (1 sigma, N) and drift
   --params P.json | --table T.json          the specimen (default: Table 1, corners smoothed)
   --corner-width MM              corner smoothing width of the specimen (default 0.05; 0: none)
+  --shakedown EXTRA,TAU          an untrained specimen (simplified model only): its upper plateau starts EXTRA N
+                                 higher and settles by exp(-N/TAU) over transformation cycles N (see SIM.md)
   --fault SPEC                   start with a fault: drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload,
                                  can-silent, or a controller event: estop, latch=CODE, deadband=MM
   --deadband-mm D                load frame servo dead band: no correction while |command - displacement| < D (default 0)
@@ -71,6 +74,7 @@ struct Args {
   int port = 1502, can_fd = -1, can_node = 1, control_port = 0, realtime = 0;
   double time_scale = 1, sample_rate = 1000, can_rate = 1000, noise = 0.05, drift = 0, corner = 0.05, duration = 0;
   double deadband_mm = 0, host_timeout_ms = 0, mode = 1;
+  double shakedown_N = 0, shakedown_tau = 0;  // 0: a trained specimen
   bool exit_with_parent = false;
   std::uint64_t seed = 1;
   std::vector<std::string> faults;
@@ -121,6 +125,16 @@ Args parse(int argc, char** argv) {
     else if (o == "--params") a.params = v;
     else if (o == "--table") a.table = v;
     else if (o == "--corner-width") a.corner = num();
+    else if (o == "--shakedown") {
+      const auto comma = v.find(',');
+      char* end = nullptr;
+      a.shakedown_N = std::strtod(v.c_str(), &end);
+      const bool first_ok = comma != std::string::npos && end == v.c_str() + comma;
+      a.shakedown_tau = first_ok ? std::strtod(v.c_str() + comma + 1, &end) : 0.0;
+      if (!first_ok || end != v.c_str() + v.size() || !(a.shakedown_N > 0) || !(a.shakedown_tau > 0) || !std::isfinite(a.shakedown_N) ||
+          !std::isfinite(a.shakedown_tau))
+        throw std::runtime_error("option --shakedown: expected EXTRA_N,TAU_CYCLES, both > 0 (e.g. 10,3), got '" + v + "'");
+    }
     else if (o == "--fault") a.faults.push_back(v);
     else if (o == "--deadband-mm") a.deadband_mm = num();
     else if (o == "--mode") a.mode = num();
@@ -143,8 +157,12 @@ Args parse(int argc, char** argv) {
 }
 
 std::unique_ptr<models::HysteresisModel> specimen(const Args& a) {
-  if (!a.table.empty()) return std::make_unique<models::PreisachModel>(models::table_from_json(read_file(a.table)).table);
+  if (!a.table.empty()) {
+    if (a.shakedown_N > 0) throw std::runtime_error("option --shakedown needs the simplified model (not --table)");
+    return std::make_unique<models::PreisachModel>(models::table_from_json(read_file(a.table)).table);
+  }
   const models::SmaParameters p = a.params.empty() ? models::table1_parameters() : models::params_from_json(read_file(a.params));
+  if (a.shakedown_N > 0) return std::make_unique<sim::ShakedownSpecimen>(p, a.shakedown_N, a.shakedown_tau);
   return std::make_unique<models::SimplifiedSmaModel>(p);
 }
 

@@ -497,3 +497,92 @@ TEST_CASE("acquisition thread: pinned to the CPU it names, its priority as far a
   CHECK(got.find("normal priority") == 0);
   if (cpus > 1) CHECK(cpu_seen == cpus - 1);
 }
+
+namespace {
+// The shakedown events of a campaign, oldest first.
+std::vector<nlohmann::json> shakedown_of(db::Store& s, std::int64_t id) {
+  std::vector<nlohmann::json> out;
+  for (const std::string& d : s.event_details(id, "shakedown")) out.push_back(nlohmann::json::parse(d));
+  return out;
+}
+}  // namespace
+
+TEST_CASE("training until stable on an untrained specimen: the plateau settles, training ends by the rule, the rows follow") {
+  // The simulated specimen's upper plateau starts 10 N high and settles by e^{-N/3} (SIM.md).
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0.05", "--shakedown", "10,3"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  auto j = fot_plan(4, 0.5);
+  j["training"] = {{"max_cycles", 25}, {"until", {{"peak_force_change", "0.5 %"}, {"energy_change", "2 %"}, {"consecutive", 3}}}};
+  j["validation"] = {{"reversals", 6}, {"seed", 3}};
+  j["plateaus_mm"] = {1.0, 3.0};
+  const auto plan = daemon::parse_plan(j);
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 200);
+  const daemon::RunnerResult r = run(id, plan, ctx);
+  b.writer->flush();
+  CAPTURE(r.reason);
+  REQUIRE(end_of(r) == "completed");
+  const auto cycles = shakedown_of(*b.store, id);
+  const auto training = b.store->event_details(id, "training");
+  REQUIRE(training.size() == 1);
+  const auto t = nlohmann::json::parse(training[0]);
+  CAPTURE(training[0]);
+  CHECK(t["stable"] == true);
+  CHECK(t["cycles"].get<std::size_t>() == cycles.size());
+  CHECK(cycles.size() >= 5);   // the drift is seen (10 N on a 30 N plateau)
+  CHECK(cycles.size() < 25);   // and training ended before its maximum
+  // The loop narrows while it settles, and the rule replayed on the stored figures stops where it stopped.
+  CHECK(cycles[0]["energy_Nmm"].get<double>() > cycles.back()["energy_Nmm"].get<double>() * 1.1);
+  int run_below = 0;
+  for (std::size_t k = 1; k < cycles.size(); ++k) {
+    CAPTURE(k);
+    const double dp = cycles[k]["peak_change_pct"], de = cycles[k]["energy_change_pct"];
+    const double pe = cycles[k - 1]["energy_Nmm"], e = cycles[k]["energy_Nmm"];
+    CHECK(de == doctest::Approx(100 * std::fabs(e - pe) / pe));
+    run_below = dp < 0.5 && de < 2.0 ? run_below + 1 : 0;
+    CHECK(cycles[k]["stable"].get<bool>() == (run_below >= 3));
+  }
+  CHECK(run_below == 3);
+  // The training loops are stored with their figures, then one loop per row (from δmin), and the validation's.
+  int training_loops = 0, row_loops = 0, validation_loops = 0;
+  for (const db::LoopInfo& l : b.store->loops(id)) {
+    training_loops += l.phase == "training";
+    row_loops += l.phase == "rows";
+    validation_loops += l.phase == "validation";
+    const auto fig = nlohmann::json::parse(l.figures_json);
+    if (l.phase == "training") {
+      CHECK(fig["plateaus"].size() == 2);
+      CHECK(fig["energy_Nmm"].get<double>() > 0);
+      CHECK(fig.contains("transformation"));  // a major loop of the specimen: both plateaus seen
+    }
+  }
+  CHECK(training_loops == static_cast<int>(cycles.size()));
+  CHECK(row_loops >= 3);
+  CHECK(validation_loops >= 1);
+  // Tables: scored on the validation run, one recommended.
+  CHECK(b.store->event_details(id, "recommendation").size() == 1);
+  for (const db::TableInfo& ti : b.store->tables(id)) CHECK(nlohmann::json::parse(ti.accuracy_json).contains("held_out"));
+}
+
+TEST_CASE("training until stable: at its maximum the campaign says the loop did not settle, and goes on") {
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0.05", "--shakedown", "10,3"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  auto j = fot_plan(3, 0.5);
+  j["training"] = {{"max_cycles", 3}, {"until", {{"energy_change", 2}, {"consecutive", 2}}}};
+  j["validation"] = false;
+  const auto plan = daemon::parse_plan(j);
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 200);
+  const daemon::RunnerResult r = run(id, plan, ctx);
+  b.writer->flush();
+  REQUIRE(end_of(r) == "completed");
+  const auto t = nlohmann::json::parse(b.store->event_details(id, "training").at(0));
+  CHECK(t["stable"] == false);
+  CHECK(t["cycles"] == 3);
+  CHECK(t["why"].get<std::string>().find("did not settle in 3 training cycle(s)") != std::string::npos);
+  CHECK(r.validation_run_id == 0);
+  CHECK(b.store->runs_of_campaign(id).size() == 1);
+  CHECK(b.store->event_details(id, "recommendation").empty());  // nothing held out: nothing recommended
+}

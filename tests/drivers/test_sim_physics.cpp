@@ -12,6 +12,7 @@
 #include "pacer.hpp"
 #include "world_clock.hpp"
 #include "shaker_sim.hpp"
+#include "shakedown_specimen.hpp"
 
 using namespace hystlab;
 using namespace hystlab::sim;
@@ -356,4 +357,40 @@ TEST_CASE("world clock: steps follow the wall clock; after a freeze at most 20 m
   CHECK(steps == 200);          // 20 ms of it, at time scale 10
   CHECK(w.lost_s() == doctest::Approx(0.48));
   CHECK(w.steps_due(0.516) == 10);  // and on as before
+}
+
+TEST_CASE("shakedown specimen: the upper plateau comes down cycle by cycle and settles, the force continuous") {
+  const models::SmaParameters settled = models::table1_parameters();
+  ShakedownSpecimen s(settled, 10.0, 3.0);
+  models::SimplifiedSmaModel trained(settled);
+  std::vector<double> energy;
+  double x = 0, f = s.step(0.0), work = 0, jump = 0;
+  for (int c = 0; c < 15; ++c)
+    for (int k = 1; k <= 1600; ++k) {
+      const double xn = k <= 800 ? 4.0 * k / 800 : 4.0 * (1600 - k) / 800;
+      const double fn = s.step(xn);
+      jump = std::max(jump, std::fabs(fn - f) - 150 * std::fabs(xn - x) - 1e-9);  // never more than the stiffest slope
+      work += 0.5 * (f + fn) * (xn - x);
+      x = xn, f = fn;
+      if (k == 1600) energy.push_back(work), work = 0;
+    }
+  CHECK(s.cycles() == 15);
+  CHECK(jump <= 0);
+  // The settled loop's energy, from the trained model.
+  double e_settled = 0, xp = 0, fp = trained.step(0.0);
+  for (int k = 1; k <= 1600; ++k) {
+    const double xn = k <= 800 ? 4.0 * k / 800 : 4.0 * (1600 - k) / 800;
+    const double fn = trained.step(xn);
+    e_settled += 0.5 * (fp + fn) * (xn - xp);
+    xp = xn, fp = fn;
+  }
+  for (std::size_t c = 1; c < energy.size(); ++c) {
+    CAPTURE(c);
+    CHECK(energy[c] < energy[c - 1]);  // the loop narrows every cycle
+  }
+  CHECK(energy.front() > 1.2 * e_settled);
+  CHECK(energy.back() == doctest::Approx(e_settled).epsilon(0.01));
+  // The forward plateau at cycle n is 10 e^{-n/3} N above the settled one.
+  CHECK(models::transitions(s.parameters_of(3)).Ms.force - models::transitions(settled).Ms.force == doctest::Approx(10 * std::exp(-1.0)));
+  CHECK(models::transitions(s.parameters_of(3)).As.force == doctest::Approx(models::transitions(settled).As.force));
 }

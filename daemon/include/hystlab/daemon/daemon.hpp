@@ -37,6 +37,9 @@ struct ConfigError : std::invalid_argument {
 struct SimulatorOptions {
   double time_scale = 10.0, noise_N = 0.05, corner_width_mm = 0.05;
   std::string rig = "load_frame";  // or "shaker"
+  // An untrained specimen (load frame): the upper plateau starts extra_N higher and settles over
+  // tau transformation cycles (hystlab-sim --shakedown); extra_N 0: a trained one.
+  double shakedown_extra_N = 0, shakedown_tau_cycles = 0;
   int cpu = -1;                     // pinned there when >= 0 (the daemon sets its acquisition CPU)
   int realtime_priority = -1;       // > 0: SCHED_FIFO, as a controller with a CPU of its own; 0: normal;
                                     // -1: one below the acquisition's when that is pinned and
