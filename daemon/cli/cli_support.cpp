@@ -258,6 +258,12 @@ LoadedModel load_model(const Options& opt) {
   return m;
 }
 
+db::Store open_store(const Options& opt) {
+  const std::string path = opt.get("db", "hystlab.db");
+  require_database(path);
+  return db::Store(path);
+}
+
 void require_database(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))

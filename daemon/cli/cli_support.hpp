@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "hystlab/db/store.hpp"
 #include "hystlab/models/hysteresis_model.hpp"
 
 namespace hystlab::cli {
@@ -39,6 +40,9 @@ class Options {
 // --db must name hystlabd's database: a CliError when no such file (a mistyped path would
 // otherwise create an empty database).
 void require_database(const std::string& path);
+// The daemon's database named by --db (default hystlab.db): it must exist (a mistyped --db would
+// otherwise create an empty one).
+[[nodiscard]] db::Store open_store(const Options& opt);
 void write_file(const std::string& path, const std::string& text);
 // Writes to the file, or to stdout when path is empty or "-".
 void write_output(const std::string& path, const std::string& text);

@@ -53,13 +53,6 @@ std::int64_t id_arg(const Args& args, std::size_t k, const char* what) {
 
 Args rest(const Args& args, std::size_t from) { return Args(args.begin() + static_cast<std::ptrdiff_t>(std::min(from, args.size())), args.end()); }
 
-// The daemon's database: it must exist (a mistyped --db would otherwise create an empty one).
-db::Store open_store(const Options& opt) {
-  const std::string path = opt.get("db", "hystlab.db");
-  require_database(path);
-  return db::Store(path);
-}
-
 // A waveform's points_csv: a file beside the plan, by name only (no other folder, no device).
 std::filesystem::path points_file(const std::string& plan_path, const nlohmann::json& name) {
   if (!name.is_string() || name.get<std::string>().empty()) throw CliError(plan_path + ": points_csv must be a file name");
@@ -95,13 +88,21 @@ std::string round_g(double v) {
   return b;
 }
 
-// One line of a table's accuracy: "RMS 3.2 N (0.4 % of range), max 12 N", or "".
+// One line of a table's accuracy on its own samples: "RMS 3.2 N (0.4 % of range), max 12 N", or "".
 std::string accuracy_line(const std::string& json_text) {
   const auto a = nlohmann::json::parse(json_text, nullptr, false);
   if (a.is_discarded() || !a.is_object() || !a.contains("overall")) return "";
   const auto& o = a["overall"];
   return "RMS " + round_g(o.value("rms_N", 0.0)) + " N (" + round_g(100 * o.value("rms_norm", 0.0)) + " % of range), max " +
          round_g(o.value("max_N", 0.0)) + " N";
+}
+
+// The held-out figures (on the validation run): "RMS 1.1 N, max 4 N *" (* recommended), or "-".
+std::string heldout_line(const std::string& json_text) {
+  const auto a = nlohmann::json::parse(json_text, nullptr, false);
+  if (a.is_discarded() || !a.is_object() || !a.contains("held_out") || !a["held_out"].contains("overall")) return "-";
+  const auto& o = a["held_out"]["overall"];
+  return "RMS " + round_g(o.value("rms_N", 0.0)) + " N, max " + round_g(o.value("max_N", 0.0)) + " N" + (a.value("recommended", false) ? " *" : "");
 }
 
 int print_preview(const nlohmann::json& p) {
@@ -123,19 +124,36 @@ int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
   if (as_json) {
     nlohmann::json j{{"id", row.id}, {"kind", db::to_string(row.kind)}, {"state", db::to_string(row.state)}, {"plan", nlohmann::json::parse(row.plan, nullptr, false)},
                      {"runs", nlohmann::json::array()}, {"tables", nlohmann::json::array()}, {"events", nlohmann::json::array()}};
-    for (const auto& r : runs) j["runs"].push_back({{"id", r.id}, {"state", r.state}, {"samples", r.samples}, {"nodes", r.nodes}});
+    for (const auto& r : runs) j["runs"].push_back({{"id", r.id}, {"role", r.role}, {"state", r.state}, {"samples", r.samples}, {"nodes", r.nodes}});
+    j["loops"] = nlohmann::json::array();
+    for (const auto& l : store.loops(row.id)) {
+      auto fig = nlohmann::json::parse(l.figures_json, nullptr, false);
+      if (!fig.is_object()) continue;
+      fig["run"] = l.run, fig["phase"] = l.phase;
+      j["loops"].push_back(std::move(fig));
+    }
     for (const auto& t : tables) j["tables"].push_back({{"id", t.id}, {"method", t.method}, {"n", t.n}, {"accuracy", nlohmann::json::parse(t.accuracy_json, nullptr, false)}});
     for (const auto& e : store.events(row.id)) j["events"].push_back({{"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", e.detail}});
     std::cout << j.dump(2) << "\n";
     return 0;
   }
   std::cout << "campaign " << row.id << ": " << db::to_string(row.kind) << " on " << store.rig_name(row.rig_id) << ", " << db::to_string(row.state) << " (updated " << row.updated_at << ")\n";
-  for (const auto& r : runs) std::cout << "  run " << r.id << ": " << r.state << ", " << r.samples << " samples, " << r.nodes << " FOT nodes\n";
+  for (const auto& r : runs)
+    std::cout << "  run " << r.id << (r.role == "validation" ? " (validation)" : "") << ": " << r.state << ", " << r.samples << " samples, "
+              << r.nodes << " FOT nodes\n";
+  for (const std::string& d : store.event_details(row.id, "training"))
+    std::cout << "  training: " << nlohmann::json::parse(d, nullptr, false).value("why", std::string("?")) << "\n";
   for (const auto& t : tables) {
-    const std::string acc = accuracy_line(t.accuracy_json);
+    const std::string acc = accuracy_line(t.accuracy_json), held = heldout_line(t.accuracy_json);
     std::cout << "  table " << t.id << ": " << t.method << ", n = " << t.n << ", " << round_g(t.range_lo) << "–" << round_g(t.range_hi) << " mm"
-              << (acc.empty() ? "" : ", " + acc) << "\n";
+              << (acc.empty() ? "" : ", own samples " + acc) << (held == "-" ? "" : "; held-out " + held) << "\n";
   }
+  for (const std::string& d : store.event_details(row.id, "recommendation")) {
+    const auto r = nlohmann::json::parse(d, nullptr, false);
+    std::cout << "  recommended: table " << r.value("table", std::int64_t{0}) << ": " << r.value("why", std::string()) << "\n";
+  }
+  if (const auto loops = store.loops(row.id); !loops.empty())
+    std::cout << "  " << loops.size() << " closed cycle(s) with their figures (--json, or hystlab loops on a run's CSV)\n";
   std::cout << "  events (newest last):\n";
   for (const auto& e : store.events(row.id)) {
     if (e.kind == "gap") continue;  // one per hole: the "gaps" summary says it in one line
@@ -198,11 +216,14 @@ int run_tables_cmd(const Args& args) {
   if (args[0] == "list") {
     const Options opt(rest(args, 1), {"db"}, {});
     db::Store store = open_store(opt);
-    std::printf("%6s %9s  %-8s %4s  %-12s  %-44s %s\n", "id", "campaign", "method", "n", "range (mm)", "accuracy", "created");
+    // Held-out: on the campaign's validation run, which no table was built from (* the one it recommends).
+    std::printf("%6s %9s  %-8s %4s  %-12s  %-44s %-26s %s\n", "id", "campaign", "method", "n", "range (mm)", "accuracy (own samples)",
+                "held-out (validation run)", "created");
     for (const auto& t : store.tables()) {
       const std::string range = round_g(t.range_lo) + ".." + round_g(t.range_hi), acc = accuracy_line(t.accuracy_json);
-      std::printf("%6lld %9s  %-8s %4lld  %-12s  %-44s %s\n", static_cast<long long>(t.id), t.campaign ? std::to_string(*t.campaign).c_str() : "-",
-                  t.method.c_str(), static_cast<long long>(t.n), range.c_str(), acc.empty() ? "-" : acc.c_str(), t.created_at.c_str());
+      std::printf("%6lld %9s  %-8s %4lld  %-12s  %-44s %-26s %s\n", static_cast<long long>(t.id), t.campaign ? std::to_string(*t.campaign).c_str() : "-",
+                  t.method.c_str(), static_cast<long long>(t.n), range.c_str(), acc.empty() ? "-" : acc.c_str(),
+                  heldout_line(t.accuracy_json).c_str(), t.created_at.c_str());
     }
     return 0;
   }

@@ -1,10 +1,13 @@
 // hystlab check / compare: numbers about a data set and about a model against it.
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "hystlab/models/accuracy.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/representation_checks.hpp"
 
 namespace hystlab::cli {
@@ -19,11 +22,15 @@ normalised by the force range. --dead-band: reversals smaller than this are nois
 of the displacement range); --tolerance: extrema that agree within it count as the same.
 )";
 
-const char* kCompareHelp = R"(usage: hystlab compare (--table T.json | --model simplified [--params P.json]) --data X.csv [--clamp]
+const char* kCompareHelp = R"(usage: hystlab compare (--table T.json | --table-id ID | --model simplified [--params P.json])
+                       (--data X.csv | --run RUN) [--clamp] [--db hystlab.db]
 
 Runs the model on column displacement_mm of X.csv and compares with column force_N: RMS and max
 error, normalised by the reference force range, per branch direction (ascending, descending) and
 overall; the loop energy error when the input returns to where it began.
+--table-id and --run take a table and a run's samples from hystlabd's database (--db): a
+campaign's validation run re-scored against any table, later ones included, as the campaign
+scored its own tables (the API: GET /api/tables/ID/score?run=RUN).
 )";
 
 std::string pct(double v) {
@@ -83,20 +90,58 @@ int run_check(const Args& args) {
 
 int run_compare(const Args& args) {
   if (print_help_if_asked(args, kCompareHelp)) return 0;
-  const Options opt(args, {"table", "model", "params", "data"}, {"clamp"});
-  LoadedModel m = load_model(opt);
-  const std::string path = opt.require("data");
-  const Csv csv = Csv::load(path);
-  const auto x = csv.column("displacement_mm"), ref = csv.column("force_N");
-  if (m.hi > m.lo && !opt.has("clamp"))
+  const Options opt(args, {"table", "table-id", "model", "params", "data", "run", "db"}, {"clamp"});
+  if (opt.has("data") == opt.has("run")) throw CliError("give one of --data X.csv or --run RUN");
+  LoadedModel m;
+  std::unique_ptr<db::Store> store;
+  if (opt.has("table-id") || opt.has("run")) {
+    require_database(opt.get("db", "hystlab.db"));
+    store = std::make_unique<db::Store>(opt.get("db", "hystlab.db"));
+  }
+  if (opt.has("table-id")) {
+    if (opt.has("table") || opt.has("model")) throw CliError("give one of --table, --table-id or --model");
+    const int id = opt.integer("table-id", 0, 1, 2000000000);
+    const auto doc = store->table_document(id);
+    if (!doc) throw CliError("--table-id: no table " + std::to_string(id) + " in " + opt.get("db", "hystlab.db"));
+    auto t = models::table_from_json(*doc);
+    m.lo = t.table.grid().lo, m.hi = t.table.grid().hi;
+    m.description = "table " + std::to_string(id) + " (" + t.provenance.method + ", n = " + std::to_string(t.table.grid().n) + ")";
+    m.model = std::make_unique<models::PreisachModel>(std::move(t.table));
+  } else {
+    m = load_model(opt);
+  }
+  std::string path;
+  std::vector<double> x, ref;
+  std::vector<std::size_t> lines;
+  if (opt.has("run")) {
+    const int run = opt.integer("run", 0, 1, 2000000000);
+    const auto info = store->run(run);
+    if (!info) throw CliError("--run: no run " + std::to_string(run) + " in " + opt.get("db", "hystlab.db"));
+    store->for_each_sample(run, 0, std::int64_t{1} << 50, [&](const db::SampleRow& r) {
+      x.push_back(r.disp);
+      ref.push_back(r.force);
+      lines.push_back(static_cast<std::size_t>(r.seq));
+    });
+    path = "run " + std::to_string(run) + (info->role == "validation" ? " (validation)" : "");
+    if (x.size() < 2) throw CliError("--run: run " + std::to_string(run) + " has " + std::to_string(x.size()) + " sample(s)");
+  } else {
+    path = opt.require("data");
+    const Csv csv = Csv::load(path);
+    x = csv.column("displacement_mm"), ref = csv.column("force_N");
+    for (std::size_t k = 0; k < x.size(); ++k) lines.push_back(csv.line_of(k));
+  }
+  // A run is scored as the campaign scored it: inputs beyond the table's range clamped, and counted.
+  if (m.hi > m.lo && !opt.has("clamp") && !opt.has("run"))
     for (std::size_t k = 0; k < x.size(); ++k)
       if (x[k] < m.lo || x[k] > m.hi)
-        throw CliError(path + ": line " + std::to_string(csv.line_of(k)) + ": displacement " + format_number(x[k]) +
+        throw CliError(path + (opt.has("run") ? ": sample " : ": line ") + std::to_string(lines[k]) + ": displacement " + format_number(x[k]) +
                        " mm is outside the table's range (--clamp clamps and counts)");
   std::vector<double> y(x.size());
   m.model->evaluate(x, y);
   std::cout << "model: " << m.description << "\ndata: " << path << " (" << x.size() << " samples)\n"
             << accuracy_text(models::compare(x, ref, y));
+  if (const auto sat = m.model->saturation_count())
+    std::cout << sat << " input(s) beyond the table's range " << format_number(m.lo) << ".." << format_number(m.hi) << " mm were clamped\n";
   return 0;
 }
 

@@ -27,6 +27,7 @@
 #include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/loop_figures.hpp"
+#include "hystlab/models/table_score.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/simplified_sma.hpp"
 
@@ -353,6 +354,48 @@ TEST_CASE("cli: the daemon's records, read from its file with no daemon running"
   check_error(w.run("campaign frobnicate 1"), "unknown campaign verb 'frobnicate'");
   check_error(w.run("tables export 5 --db d.db"), "no table 5");
   check_error(w.run("runs export 3 --db d.db"), "no samples for run 3");
+}
+
+TEST_CASE("cli: a validation run re-scored against a stored table, as the campaign scored it; held-out figures listed") {
+  Workdir w;
+  SimplifiedSmaModel sma(table1_parameters());
+  const EverettTable table = identify_virtual(sma, Grid::make(0, 4, 8));
+  const auto vx = ramp_through({0.0, 3.1, 0.7, 2.6, 1.2, 3.9, 0.0}, 0.01);
+  std::vector<double> vf(vx.size());
+  sma.reset();
+  sma.evaluate(vx, vf);
+  nlohmann::json acc = accuracy_json(score_table(table, vx, vf));  // what the campaign stores beside it
+  acc = {{"overall", acc["overall"]}, {"held_out", acc}, {"recommended", true}};
+  {
+    hystlab::db::Store s((w / "d.db").string());
+    const auto rig = s.upsert_rig("sim frame", "{}", "t");
+    const auto c = s.create_campaign(rig, hystlab::db::CampaignKind::fot, R"({"kind": "fot"})", "t");
+    const auto [run, vrun] = s.add_runs(c, "t", 0, 0, true);
+    std::vector<hystlab::db::SampleRow> rows;
+    for (std::size_t k = 0; k < vx.size(); ++k) rows.push_back({vrun, static_cast<std::int64_t>(k), 0.01 * static_cast<double>(k), vx[k], vx[k], vf[k], 0});
+    hystlab::db::Transaction tx(s.database());
+    s.insert_samples(rows);
+    (void)s.add_table(c, run, "fot", 8, 0, 4, "t", acc.dump(), table_to_json(table, {"test", "fot", "t", "", {}}).dump());
+    tx.commit();
+  }
+  const Result list = w.run("tables list --db d.db");
+  CAPTURE(list.out);
+  CHECK(list.out.find("held-out (validation run)") != std::string::npos);
+  char rms[32];
+  std::snprintf(rms, sizeof rms, "%.4g", acc["held_out"]["overall"]["rms_N"].get<double>());
+  CHECK(list.out.find(std::string("RMS ") + rms + " N, max") != std::string::npos);
+  CHECK(list.out.find(" *") != std::string::npos);
+  const Result cmp = w.run("compare --table-id 1 --run 2 --db d.db");
+  REQUIRE(cmp.code == 0);
+  CAPTURE(cmp.out);
+  CHECK(cmp.out.find("data: run 2 (validation)") != std::string::npos);
+  char line[64];
+  std::snprintf(line, sizeof line, "%12.6g", acc["held_out"]["overall"]["rms_N"].get<double>());
+  CHECK(cmp.out.find(std::string("overall") ) != std::string::npos);
+  CHECK(cmp.out.find(line) != std::string::npos);  // the same figure as stored, to its printed digits
+  check_error(w.run("compare --table-id 1 --run 9 --db d.db"), "--run: no run 9");
+  check_error(w.run("compare --table-id 7 --run 2 --db d.db"), "--table-id: no table 7");
+  check_error(w.run("compare --table-id 1 --db d.db"), "give one of --data X.csv or --run RUN");
 }
 
 // A loopback port nothing listens on: bound to learn a free one, then closed.
