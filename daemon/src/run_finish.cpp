@@ -1,6 +1,7 @@
 #include "run_finish.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -77,9 +78,14 @@ std::string recommend(std::vector<Candidate>& cs) {
   for (std::size_t k = 0; k < cs.size(); ++k)
     if (cs[k].heldout_rms && (!best || *cs[k].heldout_rms < *cs[*best].heldout_rms)) best = k;
   if (!best) return "";
+  auto newtons = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g N", v);
+    return std::string(b);
+  };
   std::string why = cs[*best].label + " has the lowest error on the validation run (held-out RMS";
   for (const Candidate& c : cs)
-    if (c.heldout_rms) why += (&c == &cs.front() ? " " : "; ") + c.label + ": " + plan_number(*c.heldout_rms) + " N";
+    if (c.heldout_rms) why += (&c == &cs.front() ? " " : "; ") + c.label + ": " + newtons(*c.heldout_rms);
   why += ")";
   for (std::size_t k = 0; k < cs.size(); ++k) {
     cs[k].accuracy["recommended"] = k == *best;

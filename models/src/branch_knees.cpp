@@ -100,6 +100,8 @@ std::optional<BranchKnees> fit_branch_knees(std::span<const double> x, std::span
   r.slope_end = coef(1) + coef(2) + coef(3);
   const double n = static_cast<double>(p.x.size());
   r.rms_N = std::sqrt(best / n);
+  r.lo_mm = lo;
+  r.hi_mm = hi;
   r.line_rms_N = std::sqrt(line_ss(p) / n);
   return r;
 }

@@ -51,7 +51,7 @@ json table_to_json(const EverettTable& t, const TableProvenance& p) {
     rows.push_back(std::move(row));
   }
   return json{{"format", kTableFormat},
-              {"version", kTableVersion},
+              {"version", g.uniform() ? kTableVersion : kTableVersionNodes},
               {"units", {{"displacement", "mm"}, {"force", "N"}}},
               {"range_mm", {g.lo, g.hi}},
               {"subdivisions", g.n},
@@ -78,9 +78,10 @@ TableDocument parse_table(std::string_view text) {
   if (!fmt.is_string() || fmt.get<std::string>() != kTableFormat)
     fail(what, "'format' is " + fmt.dump() + ", expected \"" + std::string(kTableFormat) + "\"");
   const json& ver = field(j, "version", what);
-  if (!ver.is_number_integer() || ver.get<int>() != kTableVersion)
-    fail(what, "unknown format version " + ver.dump() + " (this hystlab reads version " +
-                   std::to_string(kTableVersion) + ")");
+  if (!ver.is_number_integer() || (ver.get<int>() != kTableVersion && ver.get<int>() != kTableVersionNodes))
+    fail(what, "unknown format version " + ver.dump() + " (this hystlab reads versions " + std::to_string(kTableVersion) + " and " +
+                   std::to_string(kTableVersionNodes) + ")");
+  const bool own_nodes = ver.get<int>() == kTableVersionNodes;
   if (const auto u = j.find("units"); u != j.end()) {
     if (!u->is_object() || u->value("displacement", "mm") != "mm" || u->value("force", "N") != "N")
       fail(what, "'units' must be {\"displacement\": \"mm\", \"force\": \"N\"}");
@@ -97,16 +98,24 @@ TableDocument parse_table(std::string_view text) {
   } catch (const std::invalid_argument& e) {
     fail(what, e.what());
   }
-  if (const auto nodes = j.find("nodes_mm"); nodes != j.end()) {
+  const auto nodes = j.find("nodes_mm");
+  if (own_nodes && nodes == j.end()) fail(what, "version 2 needs 'nodes_mm' (the grid's nodes)");
+  if (nodes != j.end()) {
     if (!nodes->is_array() || nodes->size() != static_cast<std::size_t>(g.n) + 1)
       fail(what, "'nodes_mm' must hold subdivisions + 1 values");
+    std::vector<double> x;
     for (std::size_t i = 0; i < nodes->size(); ++i) {
       const double v = number((*nodes)[i], "nodes_mm[" + std::to_string(i) + "]", what);
-      if (i > 0 && !(v > (*nodes)[i - 1].get<double>()))
+      if (i > 0 && !(v > x.back()))
         fail(what, "non-monotone grid: nodes_mm[" + std::to_string(i) + "] is not above nodes_mm[" +
                        std::to_string(i - 1) + "]");
-      if (std::fabs(v - g.node(static_cast<int>(i))) > 1e-9 * (hi - lo) + 1e-12)
-        fail(what, "nodes_mm[" + std::to_string(i) + "] is off the uniform grid of range_mm and subdivisions");
+      if (!own_nodes && std::fabs(v - g.node(static_cast<int>(i))) > 1e-9 * (hi - lo) + 1e-12)
+        fail(what, "nodes_mm[" + std::to_string(i) + "] is off the uniform grid of range_mm and subdivisions (a grid of its own is version 2)");
+      x.push_back(v);
+    }
+    if (own_nodes) {
+      if (x.front() != lo || x.back() != hi) fail(what, "nodes_mm must run from range_mm[0] to range_mm[1]");
+      g = Grid::from_nodes(x);
     }
   }
   const json& rows = field(j, "rows", what);

@@ -71,7 +71,8 @@ const getJSON = async p => {
 const campaigns = [];
 for (const c of (await getJSON('/api/campaigns')).sort((a, b) => a.id - b.id)) {
   const d = await getJSON(`/api/campaigns/${c.id}`);
-  const run = d.runs[d.runs.length - 1];
+  const own = d.runs.filter(r => r.role !== 'validation');  // the campaign's run, not its validation run
+  const run = own[own.length - 1];
   const samples = (await getJSON(`/api/runs/${run.id}`)).samples;
   const buckets = (await getJSON(`/api/runs/${run.id}/samples?points=3000`)).buckets;
   campaigns.push({ id: c.id, run: run.id, samples, buckets, title: `Campaign #${c.id}: ${d.kind} on ${d.rig}` });

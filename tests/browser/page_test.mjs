@@ -34,6 +34,9 @@ function startDaemon(portArg) {
   return startHystlabd(daemonPath, ['--config', path.join(outDir, 'hystlab.json'), '--port', String(portArg)],
                        { cwd: outDir, timeoutMs: 20000, onOutput: d => { daemonLog += d; } });
 }
+// A campaign's own run (the newest, after a resume): not the validation run created beside it.
+const ownRun = d => { const own = d.runs.filter(r => r.role !== 'validation'); return own[own.length - 1]; };
+
 async function stopDaemon(d) { await stopHystlabd(d.proc); }
 let daemonLog = '';
 let pageWarnings = [];  // everything the daemons printed, shown when a check fails
@@ -181,7 +184,7 @@ async function checkLongLoop(page) {
   check(await wait(page, () => window.hystlab.state() === 'completed', null, 'the long campaign completing', 900000), 'the long campaign completes');
   const id = await page.evaluate(() => window.hystlab.selected());
   const d = await getJSON(`/api/campaigns/${id}`);
-  const run = d.runs[d.runs.length - 1];
+  const run = ownRun(d);
   const samples = (await getJSON(`/api/runs/${run.id}`)).samples;
   check(samples >= 20000, `the long run stored ${samples} samples (at least 20,000${samples < 20000 ? ': a very busy machine stores fewer' : ''})`);
   if (!(await has(`/api/runs/${run.id}/loop?points=10`))) {
@@ -278,7 +281,7 @@ async function checkOutage(page) {
   let d = null, stored = 0;
   for (const until = Date.now() + 120000; Date.now() < until; await sleep(100)) {
     d = await getJSON(`/api/campaigns/${id}`);
-    if (d.state === 'running' && d.runs.length) stored = (await getJSON(`/api/runs/${d.runs[d.runs.length - 1].id}`)).samples || 0;
+    if (d.state === 'running' && d.runs.length) stored = (await getJSON(`/api/runs/${ownRun(d).id}`)).samples || 0;
     if ((d.state === 'running' && stored >= 20) || !LIVE_STATES.includes(d.state)) break;
   }
   if (!check(d && d.state === 'running' && stored >= 20, `the outage campaign #${id} runs and stores samples (${d && d.state}, ${stored} samples)`)) return;
@@ -315,7 +318,7 @@ async function checkOutage(page) {
 
   // The daemon's account: a hole at least half the outage long (in rig time) overlapping at
   // least half of it. Its wall time is from the gap event: stored as the hole closed (`at`).
-  const run = d.runs[d.runs.length - 1];
+  const run = ownRun(d);
   const q = run.quality || {};
   const events = await getJSON(`/api/campaigns/${id}/events`);
   const holes = events.filter(e => e.kind === 'gap' && e.detail).map(e => {
@@ -378,10 +381,13 @@ try {
     check(await wait(page, () => document.getElementById('f-hi-msg').textContent === '' && !document.querySelector('input[name=hi][aria-invalid]'), null, 'the message cleared', 10000),
           'typing a valid δmax clears the message');
 
-    // 1. A short FOT campaign from the form, run to completion.
+    // 1. A short FOT campaign from the form, run to completion: three training cycles, the rows,
+    // then the validation run (the form's default: 12 reversals).
     await page.fill('input[name=n]', '4');
     await page.fill('input[name=rate]', '1');
     await page.fill('input[name=dwell]', '0.1');
+    await page.fill('input[name=training]', '3');
+    await page.fill('input[name=plateaus]', '1, 3');
     await page.click('#submit');
     check(await wait(page, () => window.hystlab.selected() != null && window.hystlab.loopPoints() > 50, null, 'loop points'),
           'the force-displacement loop grows from live samples');
@@ -402,6 +408,19 @@ try {
     await download.saveAs(file);
     const doc = JSON.parse(fs.readFileSync(file, 'utf8'));
     check(doc.format === 'hystlab-everett-table' && Array.isArray(doc.nodes_mm) && doc.nodes_mm.length === 5, `a table downloads (${download.suggestedFilename()})`);
+    // Identification: the training curve, each table's held-out error, the recommended table, the loop figures.
+    check(await wait(page, () => window.hystlab.shakedownPoints() === 3, null, 'the shakedown curve', 20000), 'the training curve shows its 3 cycles');
+    check(await wait(page, () => window.hystlab.heldOut().length === 2, null, 'held-out figures', 20000),
+          'both tables show their error on the validation run (held out)');
+    const shown = await getJSON(`/api/campaigns/${await page.evaluate(() => window.hystlab.selected())}`);
+    check(shown.recommendation && await page.evaluate(() => window.hystlab.recommended()) === shown.recommendation.table,
+          `the recommended table is marked (#${shown.recommendation && shown.recommendation.table}) and its reason given`);
+    check(/lowest error on the validation run/.test(await page.textContent('#accuracy')), 'the recommendation says why');
+    check(await wait(page, () => window.hystlab.loopRows() >= 7, null, 'loop figures', 20000),
+          'the loop figures list every closed cycle (3 training loops, 4 rows, the validation\'s)');
+    await page.evaluate(() => { document.getElementById('loops-box').open = true; });
+    await page.fill('input[name=training]', '0');
+    await page.fill('input[name=plateaus]', '');
     await page.screenshot({ path: path.join(outDir, 'fot-completed.png'), fullPage: true });
 
     // 2. A slower campaign: pause, resume and abort from the buttons.

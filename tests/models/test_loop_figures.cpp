@@ -93,7 +93,7 @@ TEST_CASE("loop figures: random piecewise-linear loops, energy and knees against
     const double top = 2 + 4 * u(rng), ka = 20 + 40 * u(rng), km = 80 + 120 * u(rng);
     const double ms = (0.15 + 0.15 * u(rng)) * top, mf = (0.65 + 0.15 * u(rng)) * top;
     const double fms = ka * ms, fmf = fms + (0.1 + 0.2 * u(rng)) * ka * (mf - ms), ftop = fmf + km * (top - mf);
-    const double af = (0.05 + 0.1 * u(rng)) * top, faf = ka * af;
+    const double af = (0.08 + 0.07 * u(rng)) * top, faf = ka * af;
     const double fas = faf + (0.5 + 0.4 * u(rng)) * (fmf - fms), as = top - (ftop - fas) / km;
     CAPTURE(top);
     CAPTURE(as);

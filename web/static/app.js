@@ -6,6 +6,7 @@ import { XYPlot, TimePlot, TriangleHeatmap } from './plots.js';
 import { RigPanel } from './rigs.js';
 import { PlanForm } from './form.js';
 import { showQuality } from './quality.js';
+import { tableLines, ShakedownPlot, shakedownCaption, loopRows } from './identification.js';
 import { count, num, round2, roughly, localTime, el } from './fmt.js';
 
 const $ = id => document.getElementById(id);
@@ -23,6 +24,7 @@ const heat = new TriangleHeatmap($('heatmap-plot'));
 const timeplot = new TimePlot($('time-plot'), ['displacement (mm)', 'force (N)']);
 const trans = new XYPlot($('trans-plot'), 'frequency (Hz)', 'mass / base amplitude', [{ label: 'transmissibility', color: '#6a1b9a', points: true }],
   { aspect: 0.5, maxHeight: 420 });
+const shakedown = new ShakedownPlot($('shakedown-plot'));
 const rigPanel = new RigPanel($('rigs'), { onChange: rigs => planForm.setRigs(rigs) });
 // In the chain with the stream's handlers: a select() running beside them would reset what
 // they just added (a sweep's first transmissibility point, say).
@@ -37,6 +39,9 @@ window.hystlab = {
   heatmapIdentified: () => heat.identified(), heatmapRequired: () => heat.required(), heatmapLimits: () => heat.limits(),
   transmissibilityPoints: () => trans.points(0), online: () => S.online,
   rigs: () => rigPanel.rigs(), warnings: () => S.warnings.slice(),
+  shakedownPoints: () => shakedown.points(), loopRows: () => $('loops').querySelectorAll('tbody tr').length,
+  heldOut: () => [...document.querySelectorAll('#accuracy .heldout')].map(e => e.textContent),
+  recommended: () => { const r = document.querySelector('#accuracy .recommended'); return r ? Number(r.dataset.table) : null; },
 };
 
 // ---- the campaign list and the selected campaign ----
@@ -88,7 +93,9 @@ async function refreshDetail() {
   }
   // The stored count is the truth: a node missed on the stream (or a failed load) is fetched again.
   if (d.kind === 'fot' && d.progress && (heat.grid ? d.progress.nodes !== heat.identified() : true)) await loadNodes(d.id);
-  S.runId = d.runs.length ? d.runs[d.runs.length - 1].id : null;
+  // The campaign's own run (the newest, after a resume), not the validation run beside it.
+  const own = d.runs.filter(r => r.role !== 'validation');
+  S.runId = own.length ? own[own.length - 1].id : null;
   $('title').textContent = `Campaign #${d.id}: ${d.kind} on ${d.rig}`;
   $('state').textContent = d.state;
   $('state').className = 'state ' + d.state;
@@ -98,6 +105,9 @@ async function refreshDetail() {
   $('resume').disabled = !can('resume');
   $('abort').disabled = !can('abort');
   document.querySelector('.fot-only').hidden = d.kind !== 'fot';
+  const cycles = d.shakedown || [];
+  $('shakedown-fig').hidden = !cycles.length;
+  if (cycles.length) { shakedown.set(cycles); $('shakedown-caption').textContent = shakedownCaption(d); }
   document.querySelector('.sine-only').hidden = d.kind !== 'sine';
   const shaker = d.kind === 'sine';
   timeplot.setLabels(shaker ? ['base displacement (mm)', 'mass displacement (mm)'] : ['displacement (mm)', 'force (N)']);
@@ -107,6 +117,7 @@ async function refreshDetail() {
   showAccuracy(d);
   S.warnings = showQuality(d, $('quality'), $('warnings'));
   showDownloads(d);
+  await showLoops(d);
   S.events = await api(`/api/campaigns/${d.id}/events`);
   showProgress(d);
   $('events').replaceChildren(...S.events.slice(-50).reverse().map(e =>
@@ -123,6 +134,10 @@ function describe(e) {
   if (e.kind === 'gaps') return `${d.count} holes in the time axis, ${num(d.total_ms / 1000, 2)} s in all, the longest ${num(d.longest_ms / 1000, 2)} s`;
   if (e.kind === 'quality') return `run #${d.run}: ${d.samples} samples at ${num(d.rate_hz, 3)} Hz of rig time, ${d.missed_deadlines} missed deadlines, ` +
     `${d.lost_samples} lost samples, ${d.io_errors} I/O errors, ${d.gaps} gaps`;
+  if (e.kind === 'validation') return `validation run #${d.run}: ${d.reversals} random reversals (seed ${d.seed}), not used to build any table`;
+  if (e.kind === 'recommendation' || e.kind === 'training') return d.why;
+  if (e.kind === 'shakedown') return `cycle ${d.cycle}: E_d ${num(d.energy_Nmm)} N·mm` + (d.energy_change_pct != null ? ` (${num(d.energy_change_pct, 2)} %)` : '') +
+    `, peak ${round2(d.peak_force_N)} N` + (d.peak_change_pct != null ? ` (${num(d.peak_change_pct, 2)} %)` : '') + (d.stable ? ': stable' : '');
   if (e.kind === 'limits') return Object.entries(d).map(([k, v]) => `${k.replace(/_/g, ' ')} ${Array.isArray(v) ? v.map(x => num(x)).join('…') : num(v)}`).join(', ');
   return JSON.stringify(d);
 }
@@ -150,16 +165,22 @@ function showProgress(d) {
   $('coverage').textContent = `— ${k} of ${n} nodes identified`;
 }
 
-// One line per table: "RMS 3.2 N (0.4 % of range) · max 12 N": the percentage is the RMS's.
-function showAccuracy(d) {
-  const line = (what, a) => `${what}: RMS ${round2(a.rms_N)} N (${num(100 * a.rms_norm, 2)} % of range) · max ${round2(a.max_N)} N`;
-  const lines = [];
-  if (d.fit && d.fit.accuracy && !d.tables.length) lines.push(line(`partial table (${d.fit.nodes}/${d.fit.required} nodes, samples so far)`, d.fit.accuracy.overall));
-  for (const t of d.tables) {
-    const a = t.accuracy && t.accuracy.overall;
-    if (a) lines.push(line(`table #${t.id} (${t.method}, n = ${t.n})`, a));
-  }
-  $('accuracy').replaceChildren(...lines.map(l => el('div', { text: l })));
+// Each table's error on its own samples and on the validation run, and the recommended one.
+function showAccuracy(d) { $('accuracy').replaceChildren(...tableLines(d)); }
+
+// The figures of every closed cycle, once the campaign has stored them (at its end).
+async function showLoops(d) {
+  const key = `${d.id}:${d.state}:${d.tables.length}`;
+  if (S.loopsKey === key) return;
+  S.loopsKey = key;
+  const loops = d.final || d.state === 'interrupted' ? await api(`/api/campaigns/${d.id}/loops`) : [];
+  if (S.selected !== d.id) return;
+  $('loops-box').hidden = !loops.length;
+  $('loops').replaceChildren(...loopRows(loops));
+  const phases = {};
+  for (const l of loops) phases[l.phase] = (phases[l.phase] || 0) + 1;
+  $('loops-summary').textContent = `Loop figures: ${count(loops.length)} closed cycles (` +
+    Object.entries(phases).map(([k, v]) => `${v} ${k}`).join(', ') + ')';
 }
 
 function link(href, text) { return el('a', { href, download: true, text }); }
@@ -239,7 +260,7 @@ function connect() {
   on('campaign', serial(onCampaign));
   on('node', onNode);
   on('table', serial(onTable));
-  for (const k of ['fit', 'transmissibility', 'command']) on(k, serial(r => onRecord(k, r)));
+  for (const k of ['fit', 'transmissibility', 'command', 'shakedown', 'training', 'validation']) on(k, serial(r => onRecord(k, r)));
   es.onerror = () => {
     setOnline(false);
     if (es.readyState === EventSource.CLOSED) { es.close(); setTimeout(connect, 2000); }  // the browser gave up: start again

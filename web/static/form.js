@@ -13,7 +13,10 @@ const FIELDS = [
   { name: 'n', group: 'fot', label: 'subdivisions n', value: '8', int: true, min: 1, max: 200, plan: 'subdivisions' },
   { name: 'rate', group: 'fot', label: 'ramp rate', unit: 'mm/s', value: '0.5', min: 1e-4, max: 1e3, plan: 'ramp_rate_mm_s' },
   { name: 'dwell', group: 'fot', label: 'dwell', unit: 's', value: '0.2', min: 0, max: 3600, plan: 'dwell_s' },
-  { name: 'training', group: 'fot', label: 'training cycles', value: '0', int: true, min: 0, max: 1000, plan: 'training_cycles' },
+  { name: 'training', group: 'fot', label: 'training cycles (at most)', value: '0', int: true, min: 0, max: 1000, plan: 'training.max_cycles' },
+  { name: 'stable', group: 'fot', label: 'train until energy changes less than', unit: '% per cycle', value: '', optional: true, placeholder: 'all cycles', min: 0.01, max: 100, plan: 'training.until.energy_change' },
+  { name: 'reversals', group: 'fot', label: 'validation reversals (0: none)', value: '12', int: true, min: 0, max: 10000, plan: 'validation.reversals' },
+  { name: 'plateaus', group: 'fot', label: 'plateau forces at', unit: 'mm', value: '', optional: true, list: true, placeholder: 'none', min: -1e4, max: 1e4, plan: 'plateaus_mm', type: 'text' },
   { name: 'repeats', group: 'fot', label: 'repeats', value: '1', int: true, min: 1, max: 100, plan: 'repeats' },
   { name: 'freqs', group: 'sine', label: 'frequencies', unit: 'Hz', value: '2, 4, 6, 8, 10, 12', list: true, min: 1e-3, max: 1000, plan: 'frequencies_hz', type: 'text' },
   { name: 'amp', group: 'sine', label: 'amplitude', unit: 'mm', value: '0.5', min: 1e-4, max: 100, plan: 'amplitude_mm' },
@@ -29,6 +32,8 @@ const GROUP_TITLES = { fot: null, sine: null, common: null, limits: 'Limits (bla
 // The server's field names, as the form says them (for its messages).
 const WORDS = [['limits.displacement_mm', 'displacement limits'], ['limits.safe_position_mm', 'safe position'],
   ['limits.force_N', 'force limit'], ['limits.rate_mm_s', 'rate limit'], ['range_mm', 'δmin … δmax'],
+  ['training.until.energy_change', 'energy change per cycle'], ['training.until.consecutive', 'cycles in a row'],
+  ['training.max_cycles', 'training cycles'], ['validation.reversals', 'validation reversals'], ['validation.rate_mm_s', 'validation rate'],
   ...FIELDS.filter(f => !f.plan.includes('.') && f.plan !== 'range_mm').map(f => [f.plan, f.label])];
 
 export function humanize(text) {
@@ -108,6 +113,9 @@ export class PlanForm {
     if (key === 'limits.displacement_mm' || key === 'limits.safe_position_mm') return ['dlo', 'dhi'];
     if (key === 'sweep' || key.startsWith('sweep.')) return ['freqs'];
     if (key === 'limits') return ['force'];
+    if (key.startsWith('training.until')) return ['stable'];
+    if (key.startsWith('training')) return ['training'];
+    if (key.startsWith('validation')) return ['reversals'];
     const f = FIELDS.find(x => x.plan === key && !this.inputOf(x.name).closest('fieldset').hidden);
     return f ? [f.name] : [];
   }
@@ -178,7 +186,15 @@ export class PlanForm {
     if (v.force != null) limits.force_N = v.force;
     if (v.ratelim != null) limits.rate_mm_s = v.ratelim;
     const plan = { kind: 'fot', range_mm: [v.lo, v.hi], subdivisions: v.n, ramp_rate_mm_s: v.rate, dwell_s: v.dwell, sample_rate_hz: v.hz };
-    if (v.training) plan.training_cycles = v.training;
+    if (v.training) {
+      plan.training = { max_cycles: v.training };
+      // Until stable: the energy's change per cycle below the given %, the peak force's below 0.5 %, 3 cycles in a row.
+      if (v.stable != null) plan.training.until = { energy_change: v.stable, peak_force_change: 0.5, consecutive: Math.min(3, Math.max(1, v.training - 1)) };
+    }
+    if (v.reversals === 1) return { errors: [['reversals', 'at least 2 reversals, or 0 for no validation run']] };
+    if (v.reversals === 0) plan.validation = false;
+    else if (v.reversals !== 12) plan.validation = { reversals: v.reversals };
+    if (v.plateaus && v.plateaus.length) plan.plateaus_mm = v.plateaus;
     if (v.repeats !== 1) plan.repeats = v.repeats;
     if (Object.keys(limits).length) plan.limits = limits;
     return { plan };

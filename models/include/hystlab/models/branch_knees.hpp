@@ -13,10 +13,14 @@ struct BranchKnees {
   double slope_start = 0, slope_middle = 0, slope_end = 0;      // N/mm, in increasing displacement
   double rms_N = 0;                                             // of the three-line fit
   double line_rms_N = 0;                                        // of one straight line, for comparison
-  // A branch has knees when three lines fit it much better than one, and its middle is softer
-  // than both ends (a plateau).
+  double lo_mm = 0, hi_mm = 0;                                  // the branch's displacement range
+  // A branch has knees when three lines fit it much better than one, its middle is softer than
+  // both ends (a plateau), and each of the three spans 5 % of the branch at least: a loop that
+  // turns inside its plateau has two lines, and its "upper knee" would be the rounding of a corner.
   [[nodiscard]] bool has_plateau() const noexcept {
-    return rms_N < 0.5 * line_rms_N && slope_middle < 0.7 * slope_start && slope_middle < 0.7 * slope_end;
+    const double twentieth = 0.05 * (hi_mm - lo_mm);
+    return rms_N < 0.5 * line_rms_N && slope_middle < 0.7 * slope_start && slope_middle < 0.7 * slope_end && lower_mm - lo_mm >= twentieth &&
+           upper_mm - lower_mm >= twentieth && hi_mm - upper_mm >= twentieth;
   }
 };
 

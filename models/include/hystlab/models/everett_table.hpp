@@ -63,6 +63,12 @@ class EverettTable {
   // Cell of (a, b), lo <= b <= a <= hi: column i with a in [δ_{i-1}, δ_i], row j <= i with b in
   // [δ_{j-1}, δ_j], and the local coordinates s, t in [0, 1] (t <= s in a triangle).
   void cell_of(double a, double b, int& i, int& j, double& s, double& t) const noexcept {
+    if (!grid_.uniform()) {  // a grid of its own: the cells by binary search, s and t in each cell's own width
+      i = grid_.cell_of(a, s);
+      j = grid_.cell_of(b, t);
+      if (j > i) j = i, t = s;
+      return;
+    }
     // floor + 1: a point on a node line may be read from either neighbouring cell, where both
     // interpolations agree (F is continuous), so the cheaper floor is as good as a ceiling.
     const double u = (a - grid_.lo) * inv_step_, w = (b - grid_.lo) * inv_step_;

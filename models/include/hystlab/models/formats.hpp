@@ -16,7 +16,11 @@ struct FormatError : std::invalid_argument {
 };
 
 inline constexpr std::string_view kTableFormat = "hystlab-everett-table";
+// Version 1: a uniform grid (nodes_mm, when present, must be that grid). Version 2: the grid's own
+// nodes in nodes_mm (any strictly increasing list). A uniform table is written as version 1, so
+// that readers of version 1 still read it; this hystlab reads both.
 inline constexpr int kTableVersion = 1;
+inline constexpr int kTableVersionNodes = 2;
 inline constexpr std::string_view kParamsModel = "simplified-sma";
 
 struct TableProvenance {
