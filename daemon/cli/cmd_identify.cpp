@@ -12,11 +12,16 @@
 namespace hystlab::cli {
 
 namespace {
-const char* kIdentifyHelp = R"(usage: hystlab identify --model simplified [--params P.json] --range A,B --subdivisions N -o T.json
+const char* kIdentifyHelp = R"(usage: hystlab identify --model simplified [--params P.json] --range A,B --subdivisions N
+                         [--refine CENTER,WIDTH[,SHARE] | --nodes D0,D1,...,Dn] -o T.json
        hystlab identify --fot nodes.csv [--noise SIGMA_N] -o T.json
 
 Virtual campaign: runs the FOT identification input (to δmin, up to each δ_i, down through every
 δ_j) on the model and tabulates F(α,β) (MODELS.md §3). Without --params, Table 1.
+The grid is n equal steps of the range, or a grid of its own (table format version 2): --refine
+puts SHARE (default 0.5) of the n steps evenly in [CENTER - WIDTH/2, CENTER + WIDTH/2], around an
+operating preload say, and spreads the rest outside it; --nodes gives every node (the range and
+n are then the nodes').
 From measured nodes: columns alpha_mm,beta_mm,force_alpha_N,force_alpha_beta_N. Repeated nodes
 are averaged; the spread of repeated f_α is the drift figure; cells whose Preisach weight is
 negative beyond noise (--noise, default: the drift figure) are reported.
@@ -45,13 +50,37 @@ come from --initial or the options, and the transition temperatures are derived 
 std::string grid_text(const models::Grid& g) {
   std::ostringstream s;
   s << "n = " << g.n << " on " << format_number(g.lo) << ".." << format_number(g.hi) << " mm";
+  if (!g.uniform()) {
+    s << ", nodes";
+    for (int i = 0; i <= g.n; ++i) s << (i ? ", " : " ") << format_number(g.node(i));
+    s << " mm";
+  }
   return s.str();
+}
+
+// --range and --subdivisions, refined by --refine, or --nodes.
+models::Grid grid_option(const Options& opt) {
+  try {
+    if (opt.has("nodes")) {
+      if (opt.has("range") || opt.has("subdivisions") || opt.has("refine")) throw CliError("--nodes gives the whole grid: leave out --range, --subdivisions and --refine");
+      return models::Grid::from_nodes(opt.numbers("nodes"));
+    }
+    const auto [lo, hi] = opt.range("range");
+    if (!opt.has("subdivisions")) throw CliError("missing required option --subdivisions");
+    const int n = opt.integer("subdivisions", 0, 1, 2000);
+    if (!opt.has("refine")) return models::Grid::make(lo, hi, n);
+    const std::vector<double> r = opt.numbers("refine");
+    if (r.size() != 2 && r.size() != 3) throw CliError("option --refine: expected CENTER,WIDTH or CENTER,WIDTH,SHARE");
+    return models::Grid::refined(lo, hi, n, r[0], r[1], r.size() == 3 ? r[2] : 0.5);
+  } catch (const std::invalid_argument& e) {
+    throw CliError(std::string(opt.has("nodes") ? "option --nodes: " : opt.has("refine") ? "option --refine: " : "") + e.what());
+  }
 }
 }  // namespace
 
 int run_identify(const Args& args) {
   if (print_help_if_asked(args, kIdentifyHelp)) return 0;
-  const Options opt(args, {"model", "params", "range", "subdivisions", "fot", "noise", "output"}, {});
+  const Options opt(args, {"model", "params", "range", "subdivisions", "fot", "noise", "output", "refine", "nodes"}, {});
   const std::string out = opt.require("output");
   models::TableProvenance prov;
   prov.created = now_iso8601();
@@ -85,9 +114,7 @@ int run_identify(const Args& args) {
                 << " N (below -" << format_number(id.violation_threshold) << " N): F is not monotone there\n";
   } else {
     LoadedModel m = load_model(opt);
-    const auto [lo, hi] = opt.range("range");
-    if (!opt.has("subdivisions")) throw CliError("missing required option --subdivisions");
-    const models::Grid g = models::Grid::make(lo, hi, opt.integer("subdivisions", 0, 1, 2000));
+    const models::Grid g = grid_option(opt);
     table = models::identify_virtual(*m.model, g);
     prov.source = m.description;
     prov.method = "virtual-fot";

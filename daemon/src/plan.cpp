@@ -140,6 +140,26 @@ std::vector<double> parse_plateaus(const json& j, const Plan& p) {
   return out;
 }
 
+// A grid of its own: 3 to 201 strictly increasing nodes; range_mm and subdivisions, when given, must agree.
+void parse_nodes(const json& j, Plan& p) {
+  const json& a = j["nodes_mm"];
+  if (!a.is_array() || a.size() < 2 || a.size() > 201) fail("nodes_mm", "must be an array of 2 to 201 node positions (mm)");
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const std::string f = "nodes_mm[" + std::to_string(k) + "]";
+    if (!a[k].is_number() || !std::isfinite(a[k].get<double>())) fail(f, "must be a number");
+    if (k > 0 && !(a[k].get<double>() > a[k - 1].get<double>())) fail(f, "must be above nodes_mm[" + std::to_string(k - 1) + "] (nodes increase)");
+    p.nodes_mm.push_back(a[k].get<double>());
+  }
+  p.lo_mm = p.nodes_mm.front();
+  p.hi_mm = p.nodes_mm.back();
+  p.subdivisions = static_cast<int>(p.nodes_mm.size()) - 1;
+  if (j.contains("range_mm") && pair_of(j["range_mm"], "range_mm") != std::make_pair(p.lo_mm, p.hi_mm))
+    fail("range_mm", "must be the first and last of nodes_mm (or left out)");
+  if (j.contains("subdivisions") && (!j["subdivisions"].is_number_integer() || j["subdivisions"].get<int>() != p.subdivisions))
+    fail("subdivisions", "must be the number of nodes_mm less one (or left out)");
+  if (models::Grid::from_nodes(p.nodes_mm).uniform()) p.nodes_mm.clear();  // the uniform grid, written out
+}
+
 void parse_sine(const json& j, Plan& p) {
   if (j.contains("frequencies_hz") == j.contains("sweep")) fail("frequencies_hz", "or sweep: exactly one is required");
   if (j.contains("frequencies_hz")) {
@@ -193,12 +213,16 @@ Plan parse_plan(const json& j) {
   p.dwell_s = number(j, "dwell_s", 0.0, 0.0, 3600.0);
   p.sample_rate_hz = number(j, "sample_rate_hz", 1000.0, 1.0, 10000.0);
   if (p.kind == db::CampaignKind::fot) {
-    known({"range_mm", "subdivisions", "repeats", "training_cycles", "training", "validation", "plateaus_mm"});
-    if (!j.contains("range_mm")) fail("range_mm", "is required");
-    std::tie(p.lo_mm, p.hi_mm) = pair_of(j["range_mm"], "range_mm");
-    if (!j.contains("subdivisions") || !j["subdivisions"].is_number_integer() || j["subdivisions"] < 1 || j["subdivisions"] > 200)
-      fail("subdivisions", "must be an integer from 1 to 200");
-    p.subdivisions = j["subdivisions"].get<int>();
+    known({"range_mm", "subdivisions", "nodes_mm", "repeats", "training_cycles", "training", "validation", "plateaus_mm"});
+    if (j.contains("nodes_mm")) {
+      parse_nodes(j, p);
+    } else {
+      if (!j.contains("range_mm")) fail("range_mm", "is required");
+      std::tie(p.lo_mm, p.hi_mm) = pair_of(j["range_mm"], "range_mm");
+      if (!j.contains("subdivisions") || !j["subdivisions"].is_number_integer() || j["subdivisions"] < 1 || j["subdivisions"] > 200)
+        fail("subdivisions", "must be an integer from 1 to 200");
+      p.subdivisions = j["subdivisions"].get<int>();
+    }
     p.repeats = static_cast<int>(number(j, "repeats", 1, 1, 100));
     p.training = parse_training(j);
     p.limits = parse_limits(j.value("limits", json()), p.lo_mm, p.hi_mm);
@@ -233,6 +257,10 @@ Plan parse_plan(const json& j) {
   if (own_rate && p.validation.enabled && p.validation.rate_mm_s > p.limits.rate_max_mm_s)
     fail("validation.rate_mm_s", "is above limits.rate_mm_s");
   return p;
+}
+
+models::Grid fot_grid(const Plan& p) {
+  return p.nodes_mm.empty() ? models::Grid::make(p.lo_mm, p.hi_mm, p.subdivisions) : models::Grid::from_nodes(p.nodes_mm);
 }
 
 }  // namespace hystlab::daemon

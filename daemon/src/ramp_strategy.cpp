@@ -25,7 +25,7 @@ class RampStrategy final : public Strategy {
     series_ = L.job.prior_series;
     rows_begin_ = series_.x.size();
     if (plan_.kind != db::CampaignKind::fot) return;
-    const models::Grid g = models::Grid::make(plan_.lo_mm, plan_.hi_mm, plan_.subdivisions);
+    const models::Grid g = fot_grid(plan_);
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
     for (const models::FotNode& n : L.job.prior_nodes) (void)builder_->add(n);
     if (!L.job.prior_nodes.empty()) resume_rows_only(L);

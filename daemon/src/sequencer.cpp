@@ -13,9 +13,10 @@ std::vector<Segment> fot_schedule(const Plan& p) {
     s.push_back({p.hi_mm, p.ramp_rate_mm_s, 0.0, SegmentKind::training, 0});
     s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::training, 0});
   }
+  const models::Grid g = fot_grid(p);
   for (int r = 0; r < p.repeats; ++r)
     for (int i = 1; i <= p.subdivisions; ++i) {
-      const double top = i == p.subdivisions ? p.hi_mm : p.lo_mm + (p.hi_mm - p.lo_mm) * i / p.subdivisions;
+      const double top = g.node(i);
       s.push_back({top, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::rise, i});
       s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::descent, i});
     }

@@ -77,17 +77,17 @@ Grid infer_grid(const std::vector<FotNode>& nodes) {
   std::vector<double> distinct;
   for (double a : alphas)
     if (distinct.empty() || a - distinct.back() > tol) distinct.push_back(a);
-  const Grid g = Grid::make(lo, hi, static_cast<int>(distinct.size()));
-  for (std::size_t k = 0; k < distinct.size(); ++k) {
-    const double expected = g.node(static_cast<int>(k) + 1);
-    if (std::fabs(distinct[k] - expected) > tol) {
-      std::ostringstream s;
-      s << "FOT data: alpha values do not form a uniform grid: alpha number " << k + 1 << " is " << distinct[k]
-        << " mm, expected " << expected << " mm (range " << lo << ".." << hi << " mm, n = " << g.n << ")";
-      throw std::invalid_argument(s.str());
-    }
-  }
-  return g;
+  // The distinct α values are the grid's nodes above δmin: uniform when they are (within 1e-6 of
+  // the range), else a grid of its own (table format version 2). The β values must lie on the same
+  // nodes (the builder refuses any other).
+  const Grid u = Grid::make(lo, hi, static_cast<int>(distinct.size()));
+  bool uniform = true;
+  for (std::size_t k = 0; k < distinct.size() && uniform; ++k) uniform = std::fabs(distinct[k] - u.node(static_cast<int>(k) + 1)) <= tol;
+  if (uniform) return u;
+  std::vector<double> x{lo};
+  x.insert(x.end(), distinct.begin(), distinct.end());
+  x.back() = hi;
+  return Grid::from_nodes(x);
 }
 
 FotIdentification identify_from_nodes(const std::vector<FotNode>& nodes, double noise_std, double force_offset) {

@@ -17,6 +17,8 @@ std::string num(double v) {
   return std::string(buf, r.ptr);
 }
 
+int version_of(const Grid& g) { return g.uniform() ? kTableVersion : kTableVersionNodes; }
+
 // Provenance as comment text: one line, no line breaks smuggled in from a source name.
 std::string one_line(std::string s) {
   for (char& c : s)
@@ -72,10 +74,16 @@ end
 function v = hystlab_everett(T, a, b)
   % F(a, b): bilinear on rectangles (Eq. 8), linear on the diagonal triangles (Eq. 9).
   a = min(max(a, T.lo), T.hi); b = min(max(b, T.lo), a);
-  h = (T.hi - T.lo) / T.n;
-  u = (a - T.lo) / h; w = (b - T.lo) / h;
-  i = min(floor(u) + 1, T.n); j = min(floor(w) + 1, i);
-  s = u - (i - 1); t = w - (j - 1);
+  if isfield(T, 'nodes')  % a grid of its own (format version 2): the cells by search
+    i = min(max(sum(T.nodes(2:end) <= a) + 1, 1), T.n); j = min(max(sum(T.nodes(2:end) <= b) + 1, 1), i);
+    s = (a - T.nodes(i)) / (T.nodes(i + 1) - T.nodes(i)); t = (b - T.nodes(j)) / (T.nodes(j + 1) - T.nodes(j));
+    if j == i, t = min(t, s); end
+  else
+    h = (T.hi - T.lo) / T.n;
+    u = (a - T.lo) / h; w = (b - T.lo) / h;
+    i = min(floor(u) + 1, T.n); j = min(floor(w) + 1, i);
+    s = u - (i - 1); t = w - (j - 1);
+  end
   F = T.F;
   if j < i
     v = (1 - s) * ((1 - t) * F(i, j) + t * F(i, j + 1)) + s * ((1 - t) * F(i + 1, j) + t * F(i + 1, j + 1));
@@ -108,16 +116,23 @@ std::string table_to_c_header(const EverettTable& table, const TableProvenance& 
   const std::string N = upper(name);
   const Grid& g = table.grid();
   std::ostringstream o;
-  o << "/* hystlab Everett table (" << kTableFormat << " v" << kTableVersion << "), " << one_line(p.method) << ", "
+  o << "/* hystlab Everett table (" << kTableFormat << " v" << version_of(g) << "), " << one_line(p.method) << ", "
     << one_line(p.source) << ", created " << one_line(p.created) << ".\n"
     << " * F(delta_i, delta_j) in N for 0 <= j <= i <= n at " << N << "_VALUES_N[i*(i+1)/2 + j];\n"
-    << " * delta_i = lo + (hi - lo) * i / n in mm. Evaluate with the memory-stack rule of hystlab's docs. */\n"
+    << (g.uniform() ? " * delta_i = lo + (hi - lo) * i / n in mm." : " * delta_i = " + N + "_NODES_MM[i] in mm (a grid of its own).")
+    << " Evaluate with the memory-stack rule of hystlab's docs. */\n"
     << "#ifndef " << N << "_H\n#define " << N << "_H\n\n"
     << "#define " << N << "_N " << g.n << "\n"
     << "#define " << N << "_NODE_COUNT " << Grid::node_count(g.n) << "\n"
     << "static const double " << N << "_LO_MM = " << num(g.lo) << ";\n"
     << "static const double " << N << "_HI_MM = " << num(g.hi) << ";\n"
-    << "static const double " << N << "_FORCE_OFFSET_N = " << num(table.force_offset()) << ";\n"
+    << "static const double " << N << "_FORCE_OFFSET_N = " << num(table.force_offset()) << ";\n";
+  if (!g.uniform()) {
+    o << "static const double " << N << "_NODES_MM[" << N << "_N + 1] = {";
+    for (int i = 0; i <= g.n; ++i) o << (i ? ", " : "") << num(g.node(i));
+    o << "};\n";
+  }
+  o
     << "static const double " << N << "_VALUES_N[" << N << "_NODE_COUNT] = {\n";
   for (int i = 0; i <= g.n; ++i) {
     o << "   ";
@@ -155,7 +170,7 @@ std::string params_to_c_header(const SmaParameters& p, const std::string& name) 
 std::string table_to_csv(const EverettTable& table, const TableProvenance& p) {
   const Grid& g = table.grid();
   std::ostringstream o;
-  o << "# " << kTableFormat << " v" << kTableVersion << "\n";
+  o << "# " << kTableFormat << " v" << version_of(g) << "\n";
   o << "# n=" << g.n << " lo_mm=" << num(g.lo) << " hi_mm=" << num(g.hi) << " force_offset_N=" << num(table.force_offset()) << "\n";
   o << "# source: " << one_line(p.source) << "; method: " << one_line(p.method) << "; created: " << one_line(p.created) << "\n";
   o << "i,j,alpha_mm,beta_mm,F_N\n";
@@ -167,12 +182,17 @@ std::string table_to_csv(const EverettTable& table, const TableProvenance& p) {
 std::string table_to_matlab(const EverettTable& table, const TableProvenance& p) {
   const Grid& g = table.grid();
   std::ostringstream o;
-  o << "% hystlab Everett table (" << kTableFormat << " v" << kTableVersion << "), " << one_line(p.method) << ", "
+  o << "% hystlab Everett table (" << kTableFormat << " v" << version_of(g) << "), " << one_line(p.method) << ", "
     << one_line(p.source) << ", created " << one_line(p.created) << ".\n"
     << "% Run this script, then: f = hystlab_eval(T, x) for displacements x in mm (force in N).\n"
     << "T = struct();\nT.lo = " << num(g.lo) << ";\nT.hi = " << num(g.hi) << ";\nT.n = " << g.n
-    << ";\nT.force_offset = " << num(table.force_offset()) << ";\n"
-    << "% T.F(i+1, j+1) = F(delta_i, delta_j) in N for j <= i; NaN above the diagonal.\nT.F = [\n";
+    << ";\nT.force_offset = " << num(table.force_offset()) << ";\n";
+  if (!g.uniform()) {
+    o << "T.nodes = [";
+    for (int i = 0; i <= g.n; ++i) o << (i ? " " : "") << num(g.node(i));
+    o << "];  % the grid's own nodes (mm)\n";
+  }
+  o << "% T.F(i+1, j+1) = F(delta_i, delta_j) in N for j <= i; NaN above the diagonal.\nT.F = [\n";
   for (int i = 0; i <= g.n; ++i) {
     o << " ";
     for (int j = 0; j <= g.n; ++j) o << " " << (j <= i ? num(table.node_value(i, j)) : std::string("NaN"));

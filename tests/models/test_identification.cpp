@@ -108,7 +108,8 @@ TEST_CASE("identification: incomplete or off-grid data is refused with the node 
   auto skewed = nodes;
   for (FotNode& n : skewed)
     if (n.alpha == 2.0) n.alpha = 2.2;
-  CHECK_THROWS_WITH((void)identify_from_nodes(skewed), doctest::Contains("uniform grid"));
+  // The α values make a grid of its own (0, 1, 2.2, 3, 4): the β = 2 nodes are then off it.
+  CHECK_THROWS_WITH((void)identify_from_nodes(skewed), doctest::Contains("(alpha 3 mm, beta 2 mm): beta is not on a grid node"));
   auto above = nodes;
   above[0].beta = above[0].alpha + 1.0;
   CHECK_THROWS_WITH((void)identify_from_nodes(above), doctest::Contains("beta above alpha"));
@@ -153,8 +154,15 @@ TEST_CASE("table format: round trip and errors naming the field") {
   for (std::size_t k = 0; k < t.values().size(); ++k) CHECK(d.table.values()[k] == t.values()[k]);
   CHECK(d.provenance.method == "virtual-fot");
   auto bad = j;
+  bad["version"] = 3;
+  CHECK_THROWS_WITH((void)table_from_json(bad.dump()), doctest::Contains("unknown format version 3"));
+  bad = j;
   bad["version"] = 2;
-  CHECK_THROWS_WITH((void)table_from_json(bad.dump()), doctest::Contains("unknown format version 2"));
+  bad.erase("nodes_mm");
+  CHECK_THROWS_WITH((void)table_from_json(bad.dump()), doctest::Contains("version 2 needs 'nodes_mm'"));
+  bad = j;
+  bad["nodes_mm"][2] = 2.2;  // increasing, but not the uniform grid: only version 2 may say so
+  CHECK_THROWS_WITH((void)table_from_json(bad.dump()), doctest::Contains("a grid of its own is version 2"));
   bad = j;
   bad["nodes_mm"][2] = 0.5;
   CHECK_THROWS_WITH((void)table_from_json(bad.dump()), doctest::Contains("non-monotone grid"));

@@ -48,7 +48,8 @@ json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::C
   json out{{"campaign", row.id}, {"nodes", nodes}};
   const auto grid = row.kind == db::CampaignKind::fot ? d.fot_grid(json::parse(row.plan)) : std::nullopt;
   if (!grid) return out;
-  const models::Grid g = models::Grid::make(grid->lo_mm, grid->hi_mm, grid->subdivisions);
+  const models::Grid g = grid->nodes_mm.empty() ? models::Grid::make(grid->lo_mm, grid->hi_mm, grid->subdivisions)
+                                                : models::Grid::from_nodes(grid->nodes_mm);
   std::set<std::pair<int, int>> seen;  // a resumed campaign may measure a node twice
   const double tol = 0.25 * g.step();
   for (const json& n : nodes) {
@@ -56,7 +57,7 @@ json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::C
     if (i > 0 && j >= 0 && j < i) seen.insert({i, j});
   }
   const std::size_t required = static_cast<std::size_t>(g.n) * static_cast<std::size_t>(g.n + 1) / 2;
-  out["grid"] = {{"n", g.n}, {"lo_mm", g.lo}, {"hi_mm", g.hi}};
+  out["grid"] = {{"n", g.n}, {"lo_mm", g.lo}, {"hi_mm", g.hi}, {"nodes_mm", g.nodes()}};
   out["identified"] = seen.size();
   out["required"] = required;
   out["coverage"] = static_cast<double>(seen.size()) / static_cast<double>(required);

@@ -157,7 +157,7 @@ function niceUp(v) {
 // the colours of the nodes already drawn do not shift as each new node arrives.
 export class TriangleHeatmap {
   constructor(el) {
-    this.grid = null;        // {n, lo_mm, hi_mm}
+    this.grid = null;        // {n, lo_mm, hi_mm, nodes_mm (a grid of its own, when given)}
     this.values = new Map(); // "i,j" -> F
     this.lim = null;         // [lo, hi] of the colour scale (N)
     this.el = el;
@@ -181,8 +181,17 @@ export class TriangleHeatmap {
   size(w = this.el.clientWidth) { const width = Math.max(200, w); return { width, height: Math.round(Math.min(560, Math.max(240, width * 0.75))) }; }
   range() {
     if (!this.grid) return [0, 1];
-    const h = (this.grid.hi_mm - this.grid.lo_mm) / this.grid.n;
-    return [this.grid.lo_mm - h / 2, this.grid.hi_mm + h / 2];
+    return [this.lower(0), this.upper(this.grid.n)];
+  }
+  // Node i's square runs from halfway to its lower neighbour to halfway to its upper one (at the
+  // ends, half its one cell): equal squares on a uniform grid, smaller where a grid is refined.
+  lower(i) { return i > 0 ? (this.node(i - 1) + this.node(i)) / 2 : this.node(0) - (this.node(1) - this.node(0)) / 2; }
+  upper(i) { const n = this.grid.n; return i < n ? (this.node(i) + this.node(i + 1)) / 2 : this.node(n) + (this.node(n) - this.node(n - 1)) / 2; }
+  // The nearest node's index to x.
+  nearest(x) {
+    let best = 0;
+    for (let i = 1; i <= this.grid.n; i++) if (Math.abs(this.node(i) - x) < Math.abs(this.node(best) - x)) best = i;
+    return best;
   }
   // The grid of a campaign, with the nodes measured so far (they replace what was shown).
   setGrid(grid) {
@@ -192,12 +201,14 @@ export class TriangleHeatmap {
     this.u.setData([[grid ? grid.lo_mm : 0, grid ? grid.hi_mm : 1], [null, null]]);
     this.drawScale();
   }
-  node(i) { return this.grid.lo_mm + (this.grid.hi_mm - this.grid.lo_mm) * i / this.grid.n; }
+  node(i) {
+    const g = this.grid;
+    return Array.isArray(g.nodes_mm) && g.nodes_mm.length === g.n + 1 ? g.nodes_mm[i] : g.lo_mm + (g.hi_mm - g.lo_mm) * i / g.n;
+  }
   // A measured node: its (α, β) snapped to the grid.
   add(alpha, beta, F) {
     if (!this.grid) return;
-    const h = (this.grid.hi_mm - this.grid.lo_mm) / this.grid.n;
-    const i = Math.round((alpha - this.grid.lo_mm) / h), j = Math.round((beta - this.grid.lo_mm) / h);
+    const i = this.nearest(alpha), j = this.nearest(beta);
     if (i < 1 || i > this.grid.n || j < 0 || j >= i) return;
     this.values.set(`${i},${j}`, F);
     this.extend(F);
@@ -235,23 +246,22 @@ export class TriangleHeatmap {
   hover(u) {
     if (!this.grid || u.cursor.left == null || u.cursor.left < 0) return;
     const b = u.posToVal(u.cursor.left, 'x'), a = u.posToVal(u.cursor.top, 'y');
-    const h = (this.grid.hi_mm - this.grid.lo_mm) / this.grid.n;
-    const i = Math.round((a - this.grid.lo_mm) / h), j = Math.round((b - this.grid.lo_mm) / h);
-    if (i < 0 || i > this.grid.n || j < 0 || j > i) { this.readout.textContent = 'hover over a cell for its α, β and F'; return; }
+    const [lo, hi] = this.range();
+    const i = this.nearest(a), j = this.nearest(b);
+    if (a < lo || a > hi || b < lo || b > hi || j > i) { this.readout.textContent = 'hover over a cell for its α, β and F'; return; }
     const where = `α = ${num(this.node(i))} mm, β = ${num(this.node(j))} mm`;
     const F = i === j ? 0 : this.values.get(`${i},${j}`);
     this.readout.textContent = F === undefined ? `${where}: not measured yet` : `${where}: F = ${round2(F)} N${i === j ? ' (zero on the diagonal)' : ''}`;
   }
   draw(u) {
     if (!this.grid) return;
-    const ctx = u.ctx, n = this.grid.n, h = (this.grid.hi_mm - this.grid.lo_mm) / n;
+    const ctx = u.ctx, n = this.grid.n;
     const [flo, fhi] = this.lim || [0, 1];
     ctx.save();
     for (let i = 0; i <= n; i++) {
       for (let j = 0; j <= i; j++) {
-        const a = this.node(i), b = this.node(j);
-        const x0 = u.valToPos(b - h / 2, 'x', true), x1 = u.valToPos(b + h / 2, 'x', true);
-        const y0 = u.valToPos(a + h / 2, 'y', true), y1 = u.valToPos(a - h / 2, 'y', true);
+        const x0 = u.valToPos(this.lower(j), 'x', true), x1 = u.valToPos(this.upper(j), 'x', true);
+        const y0 = u.valToPos(this.upper(i), 'y', true), y1 = u.valToPos(this.lower(i), 'y', true);
         const key = `${i},${j}`;
         const known = i === j || this.values.has(key);  // F(δ_i, δ_i) = 0 by definition
         const F = i === j ? 0 : this.values.get(key);

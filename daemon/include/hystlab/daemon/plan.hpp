@@ -12,6 +12,8 @@
 //      (default on: after the rows, a seeded random reversal sequence, stored as its own run, on
 //      which every table of the campaign is scored)
 //    "plateaus_mm": [1, 3] (the loop figures' plateau forces are read at these displacements)
+//    "nodes_mm": [0, 1, 1.5, 1.75, 2, 2.25, 2.5, 3, 4] instead of range_mm and subdivisions: a grid
+//      of its own, refined where accuracy is needed (table format version 2)
 //   {"kind": "waveform", "points_mm": [0, 2, 1, 3, 0], "ramp_rate_mm_s": 0.5, ...}
 //   {"kind": "sine", "frequencies_hz": [5, 10, 20], "amplitude_mm": 0.2, "settle_cycles": 10, "measured_cycles": 10}
 //   {"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "steps": 12, "spacing": "log"}, "amplitude_mm": 0.2}
@@ -24,6 +26,7 @@
 
 #include "hystlab/control/values.hpp"
 #include "hystlab/db/campaign_enums.hpp"
+#include "hystlab/models/grid.hpp"
 
 namespace hystlab::daemon {
 
@@ -61,6 +64,7 @@ struct Plan {
   // fot
   double lo_mm = 0, hi_mm = 0;
   int subdivisions = 0, repeats = 1;
+  std::vector<double> nodes_mm;  // a grid of its own (n + 1 nodes over range_mm); empty: uniform
   Training training;
   Validation validation;
   std::vector<double> plateaus_mm;
@@ -77,5 +81,8 @@ struct Plan {
 };
 
 [[nodiscard]] Plan parse_plan(const nlohmann::json& j);  // throws PlanError
+
+// A fot plan's grid: subdivisions equal steps of range_mm, or its nodes_mm.
+[[nodiscard]] models::Grid fot_grid(const Plan& p);
 
 }  // namespace hystlab::daemon

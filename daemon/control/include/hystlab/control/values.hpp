@@ -96,10 +96,12 @@ struct PlanPreview {
   double sample_rate_hz = 0, force_limit_N = 0;  // the plan's
 };
 
-// A FOT plan's grid: its nodes are on n = subdivisions steps of [lo_mm, hi_mm].
+// A FOT plan's grid: its nodes are on n = subdivisions steps of [lo_mm, hi_mm], or nodes_mm (a
+// grid of its own, n + 1 nodes from lo_mm to hi_mm).
 struct FotGrid {
   double lo_mm = 0, hi_mm = 0;
   int subdivisions = 0;
+  std::vector<double> nodes_mm;  // empty: uniform
 };
 
 }  // namespace hystlab::control
