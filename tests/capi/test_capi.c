@@ -23,6 +23,11 @@ static const char* kTable =
     "{\"format\": \"hystlab-everett-table\", \"version\": 1, \"range_mm\": [0, 3], \"subdivisions\": 3,"
     " \"rows\": [[0], [10, 0], [20, 10, 0], [30, 20, 10, 0]]}";
 
+/* The same spring on a grid of its own (format version 2: nodes 0, 0.5, 2, 3 mm). */
+static const char* kTableNodes =
+    "{\"format\": \"hystlab-everett-table\", \"version\": 2, \"range_mm\": [0, 3], \"subdivisions\": 3,"
+    " \"nodes_mm\": [0, 0.5, 2, 3], \"rows\": [[0], [5, 0], [20, 15, 0], [30, 25, 10, 0]]}";
+
 int main(void) {
   hystlab_model* m = NULL;
   double f = 0;
@@ -56,6 +61,14 @@ int main(void) {
     CHECK(hystlab_model_step(m, NAN, &f) == HYSTLAB_ERROR_ARGUMENT);
     CHECK(strstr(hystlab_last_error(), "finite") != NULL);
     CHECK(hystlab_model_step(m, 1.0, NULL) == HYSTLAB_ERROR_ARGUMENT);
+    hystlab_model_free(m);
+  }
+
+  CHECK(hystlab_model_from_json(kTableNodes, &m) == HYSTLAB_OK);
+  if (m) {
+    CHECK(hystlab_model_step(m, 2.5, &f) == HYSTLAB_OK && fabs(f - 25.0) < 1e-12);
+    CHECK(hystlab_model_step(m, 1.0, &f) == HYSTLAB_OK && fabs(f - 10.0) < 1e-12);
+    CHECK(hystlab_model_step(m, 0.25, &f) == HYSTLAB_OK && fabs(f - 2.5) < 1e-12);
     hystlab_model_free(m);
   }
 

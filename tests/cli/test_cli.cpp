@@ -273,6 +273,20 @@ TEST_CASE("cli: demo writes the report, plots and tables") {
   const std::string report = slurp(w / "d" / "report.md");
   for (const char* n : {"|   4 |", "|   8 |", "|  12 |", "|  24 |", "|  48 |"}) CHECK(report.find(n) != std::string::npos);
   CHECK(slurp(w / "d" / "major_loop.svg").find("<polyline") != std::string::npos);
+  // The refined grid's rows: at each n, its error on loops about the preload below the uniform grid's.
+  const auto at = report.find("## A grid refined where the part works");
+  REQUIRE(at != std::string::npos);
+  std::istringstream rows(report.substr(at));
+  int compared = 0;
+  for (std::string line; std::getline(rows, line);) {
+    int n = 0;
+    double uniform = 0, refined = 0;
+    if (std::sscanf(line.c_str(), "| %d | %lf | %lf |", &n, &uniform, &refined) != 3) continue;
+    CAPTURE(line);
+    CHECK(refined < 0.75 * uniform);
+    ++compared;
+  }
+  CHECK(compared == 3);
 }
 
 TEST_CASE("cli: every error is one line naming the problem, exit code 2") {

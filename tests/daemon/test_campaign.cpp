@@ -21,6 +21,7 @@
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/safety.hpp"
 #include <random>
+#include <set>
 #include "hystlab/drivers/can_rig.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "hystlab/models/fot_identification.hpp"
@@ -563,6 +564,45 @@ TEST_CASE("training until stable on an untrained specimen: the plateau settles, 
   // Tables: scored on the validation run, one recommended.
   CHECK(b.store->event_details(id, "recommendation").size() == 1);
   for (const db::TableInfo& ti : b.store->tables(id)) CHECK(nlohmann::json::parse(ti.accuracy_json).contains("held_out"));
+}
+
+TEST_CASE("fot campaign on a grid of its own: the rows go to its nodes, the table keeps them (format v2)") {
+  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0.05", "--corner-width", "0"});
+  Bench b;
+  auto rig = tcp_rig(sim.modbus_port);
+  auto j = fot_plan(4, 0.5);
+  j.erase("range_mm");
+  j.erase("subdivisions");
+  j["nodes_mm"] = {0.0, 1.0, 1.6, 2.0, 2.4, 4.0};
+  j["validation"] = {{"reversals", 4}};
+  const auto plan = daemon::parse_plan(j);
+  REQUIRE(plan.subdivisions == 5);
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 200);
+  const daemon::RunnerResult r = run(id, plan, ctx);
+  b.writer->flush();
+  CAPTURE(r.reason);
+  REQUIRE(end_of(r) == "completed");
+  REQUIRE(r.table_id);
+  db::Statement st(b.store->database(), "SELECT document FROM tables WHERE id = ?");
+  st.bind(1, *r.table_id);
+  REQUIRE(st.step());
+  const std::string doc = st.column_text(0);
+  CHECK(nlohmann::json::parse(doc)["version"] == 2);
+  const models::EverettTable t = models::table_from_json(doc).table;
+  const models::Grid g = models::Grid::from_nodes({0.0, 1.0, 1.6, 2.0, 2.4, 4.0});
+  CHECK(t.grid().same_nodes(g));
+  // Against the virtual identification of the simulator's specimen on the same nodes: within the noise.
+  models::SimplifiedSmaModel sma(models::table1_parameters());
+  const models::EverettTable virt = models::identify_virtual(sma, g);
+  double worst = 0;
+  for (std::size_t k = 0; k < virt.values().size(); ++k) worst = std::max(worst, std::fabs(t.values()[k] - virt.values()[k]));
+  CHECK(worst < 3.0);
+  // Its nodes' rows: each rise reached its own δ_i.
+  const auto nodes = b.store->fot_nodes_of_campaign(id);
+  std::set<double> alphas;
+  for (const auto& [a, bb, fa, fab] : nodes) alphas.insert(a);
+  CHECK(alphas == std::set<double>{1.0, 1.6, 2.0, 2.4, 4.0});
 }
 
 TEST_CASE("training until stable: at its maximum the campaign says the loop did not settle, and goes on") {
