@@ -27,8 +27,8 @@ are averaged; the spread of repeated f_α is the drift figure; cells whose Preis
 negative beyond noise (--noise, default: the drift figure) are reported.
 )";
 
-const char* kFitHelp = R"(usage: hystlab fit --data X.csv --subdivisions N [--prior auto|signed|monotone] [--range A,B]
-                  [--lambda L] [--folds K] -o T.json
+const char* kFitHelp = R"(usage: hystlab fit --data X.csv (--subdivisions N [--range A,B] [--refine C,W[,SHARE]] | --nodes D0,...,Dn)
+                  [--prior auto|signed|monotone] [--lambda L] [--folds K] -o T.json
 
 Least-squares Preisach table from any displacement/force record (columns displacement_mm,
 force_N), F(α,α) = 0. The prior is the model class: `signed` lets cell masses take either sign
@@ -37,6 +37,9 @@ measure), `auto` (the default) fits both and keeps the one with the lower error 
 blocks of the record. The smoothing weight is chosen by K-fold cross-validation on contiguous
 blocks (default 4) unless --lambda is given. N at most 200. The range defaults to the data's
 displacement range. The record is assumed to start from rest at the bottom of the range.
+--refine and --nodes give a grid of its own, as for identify. Above 200,000 samples, the prior and
+lambda are chosen (and sigma estimated) on the record thinned to about 200,000 with every turning
+point kept; the chosen prior's table is then fitted on every sample.
 )";
 
 const char* kCalibrateHelp = R"(usage: hystlab calibrate --data loop.csv (--initial P.json | --temperature T --clausius C) -o P.json
@@ -129,16 +132,32 @@ int run_identify(const Args& args) {
 
 int run_fit(const Args& args) {
   if (print_help_if_asked(args, kFitHelp)) return 0;
-  const Options opt(args, {"data", "subdivisions", "range", "lambda", "output", "prior", "folds"}, {});
+  const Options opt(args, {"data", "subdivisions", "range", "lambda", "output", "prior", "folds", "refine", "nodes"}, {});
   const std::string out = opt.require("output"), path = opt.require("data");
   const Csv csv = Csv::load(path);
   const auto x = csv.column("displacement_mm"), y = csv.column("force_N");
-  if (!opt.has("subdivisions")) throw CliError("missing required option --subdivisions");
   models::PreisachFitOptions fo;
-  const int n = opt.integer("subdivisions", 0, 1, fo.max_subdivisions);
-  double lo = *std::min_element(x.begin(), x.end()), hi = *std::max_element(x.begin(), x.end());
-  if (opt.has("range")) std::tie(lo, hi) = opt.range("range");
-  if (!(hi > lo)) throw CliError(path + ": the displacement never changes");
+  models::Grid grid;
+  if (opt.has("nodes")) {
+    grid = grid_option(opt);
+    if (grid.n > fo.max_subdivisions) throw CliError("option --nodes: at most " + std::to_string(fo.max_subdivisions + 1) + " nodes");
+  } else {
+    if (!opt.has("subdivisions")) throw CliError("missing required option --subdivisions");
+    const int n = opt.integer("subdivisions", 0, 1, fo.max_subdivisions);
+    double lo = *std::min_element(x.begin(), x.end()), hi = *std::max_element(x.begin(), x.end());
+    if (opt.has("range")) std::tie(lo, hi) = opt.range("range");
+    if (!(hi > lo)) throw CliError(path + ": the displacement never changes");
+    grid = models::Grid::make(lo, hi, n);
+    if (opt.has("refine")) {
+      const std::vector<double> r = opt.numbers("refine");
+      if (r.size() != 2 && r.size() != 3) throw CliError("option --refine: expected CENTER,WIDTH or CENTER,WIDTH,SHARE");
+      try {
+        grid = models::Grid::refined(lo, hi, n, r[0], r[1], r.size() == 3 ? r[2] : 0.5);
+      } catch (const std::invalid_argument& e) {
+        throw CliError(std::string("option --refine: ") + e.what());
+      }
+    }
+  }
   fo.lambda = opt.number("lambda", -1.0);
   if (opt.has("lambda") && fo.lambda < 0) throw CliError("option --lambda: must be >= 0");
   fo.folds = opt.integer("folds", 4, 2, 20);
@@ -147,13 +166,14 @@ int run_fit(const Args& args) {
   } catch (const std::invalid_argument& e) {
     throw CliError(std::string("option --") + e.what());
   }
-  const models::PreisachFitResult r = models::fit_preisach(x, y, models::Grid::make(lo, hi, n), fo);
+  const models::PreisachFitResult r = models::fit_preisach(x, y, grid, fo);
   const models::PriorFit& c = r.chosen;
   models::TableProvenance prov{"displacement/force record", "lsq", now_iso8601(), path, models::fit_provenance(r)};
   write_file(out, models::table_to_json(c.table, prov).dump(2) + "\n");
   std::cout << "fitted " << grid_text(c.table.grid()) << " to " << x.size() << " samples in "
             << format_number(r.seconds) << " s (" << format_number(static_cast<double>(r.peak_bytes) / 1048576.0)
-            << " MiB)\n"
+            << " MiB)" << (r.selection_samples < x.size() ? "; the prior and lambda chosen on " + std::to_string(r.selection_samples) +
+                                                   " of them (every turning point kept)" : std::string()) << "\n"
             << "prior " << models::to_string(c.prior) << ": " << r.reason << "\n"
             << "smoothing lambda " << format_number(c.lambda)
             << (opt.has("lambda") ? " (given)" : " (" + std::to_string(fo.folds) + "-fold cross-validation)") << "\n"

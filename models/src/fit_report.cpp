@@ -23,7 +23,8 @@ nlohmann::json fit_provenance(const PreisachFitResult& r) {
           {"cell_sigma_N", c.cell_sigma},
           {"candidates", candidates},
           {"seconds", r.seconds},
-          {"peak_bytes", r.peak_bytes}};
+          {"peak_bytes", r.peak_bytes},
+          {"selection_samples", r.selection_samples}};
 }
 
 }  // namespace hystlab::models

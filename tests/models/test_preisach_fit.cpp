@@ -124,6 +124,35 @@ TEST_CASE("signed prior: a noiseless record of a table with masses of both signs
   }
 }
 
+TEST_CASE("a long record: the prior and λ chosen on it thinned (every turning point kept), the table fitted on every sample") {
+  std::mt19937_64 rng(21);
+  const Grid g = Grid::make(0.0, 4.0, 6);
+  std::uniform_real_distribution<double> mass(-0.6, 1.0);
+  std::vector<double> w(g.cell_count()), F(g.node_count());
+  for (double& e : w) e = mass(rng);
+  fit::cells_to_nodes(g, w, F);
+  const EverettTable truth(g, F, 0.0);
+  PreisachModel gen(truth);
+  const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 700, 0.003);  // about 450 samples per reversal
+  REQUIRE(x.size() > 250000);
+  const auto y = run_model(gen, x);
+  const auto [lo, hi] = std::minmax_element(y.begin(), y.end());
+  PreisachFitOptions o;
+  o.prior = FitPrior::signed_masses;
+  o.folds = 2;
+  o.uncertainty_probes = 2;
+  const PreisachFitResult r = fit_preisach(x, y, g, o);
+  CAPTURE(r.reason);
+  CHECK(r.selection_samples < x.size());
+  // Every d-th sample (d the smallest stride bringing it to 200,000 or below) and the turning points.
+  const std::size_t d = (x.size() + 199999) / 200000;
+  CHECK(r.selection_samples >= x.size() / d);
+  CHECK(r.selection_samples <= x.size() / d + 700 + 2);
+  // The chosen table's residual is on every sample (run through the model), and small.
+  CHECK(r.chosen.rms_residual < 0.01 * (*hi - *lo));
+  for (double s : r.chosen.cell_sigma) CHECK(std::isfinite(s));
+}
+
 TEST_CASE("acceptance: on the simplified SMA model, auto's error on held-out data is at most the FOT table's") {
   // A random walk over 0..4 mm with 0.2 N of noise. The fit sees the first three quarters; both
   // tables are run over the whole record (so the memory is the specimen's) and scored on the rest.
