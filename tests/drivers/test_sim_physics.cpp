@@ -211,6 +211,21 @@ TEST_CASE("the simulator's fault codes have their texts in the shipped maps") {
   for (std::uint16_t code : {kEstopPressed, kHostHeartbeatLost, kOperatorLatch}) CHECK_FALSE(shaker.fault_text(code).empty());
 }
 
+namespace {
+// The work ∮ f dδ of a specimen over one loop 0 -> top -> 0 in 1600 steps (trapezoids).
+template <class Specimen>
+double loop_work(Specimen& s, double top) {
+  double work = 0, xp = 0, fp = s.step(0.0);
+  for (int k = 1; k <= 1600; ++k) {
+    const double x = k <= 800 ? top * k / 800 : top * (1600 - k) / 800;
+    const double f = s.step(x);
+    work += 0.5 * (f + fp) * (x - xp);
+    xp = x, fp = f;
+  }
+  return work;
+}
+}  // namespace
+
 TEST_CASE("specimen smoothing: corners rounded, straight parts exact, nearly independent of the step size") {
   const double w = 0.05;
   SmoothedSpecimen coarse(sma(), w), fine(sma(), w);
@@ -232,14 +247,7 @@ TEST_CASE("specimen smoothing: corners rounded, straight parts exact, nearly ind
   // An elastic loop on the austenite line dissipates nothing: the smoothing adds no loop of its own
   // (the force filter before stop 23 gave -3 N·mm here, a spring returning more than it took).
   SmoothedSpecimen elastic(sma(), w);
-  double work = 0, xp = 0, fp = elastic.step(0.0);
-  for (int k = 1; k <= 1600; ++k) {
-    const double x = k <= 800 ? 0.8 * k / 800 : 0.8 * (1600 - k) / 800;
-    const double f = elastic.step(x);
-    work += 0.5 * (f + fp) * (x - xp);
-    xp = x, fp = f;
-  }
-  CHECK(std::fabs(work) < 1e-6);
+  CHECK(std::fabs(loop_work(elastic, 0.8)) < 1e-6);
 }
 
 TEST_CASE("shaker: rests at its preload, follows the base at low frequency, refuses an unstable step") {
@@ -377,13 +385,7 @@ TEST_CASE("shakedown specimen: the upper plateau comes down cycle by cycle and s
   CHECK(s.cycles() == 15);
   CHECK(jump <= 0);
   // The settled loop's energy, from the trained model.
-  double e_settled = 0, xp = 0, fp = trained.step(0.0);
-  for (int k = 1; k <= 1600; ++k) {
-    const double xn = k <= 800 ? 4.0 * k / 800 : 4.0 * (1600 - k) / 800;
-    const double fn = trained.step(xn);
-    e_settled += 0.5 * (fp + fn) * (xn - xp);
-    xp = xn, fp = fn;
-  }
+  const double e_settled = loop_work(trained, 4.0);
   for (std::size_t c = 1; c < energy.size(); ++c) {
     CAPTURE(c);
     CHECK(energy[c] < energy[c - 1]);  // the loop narrows every cycle

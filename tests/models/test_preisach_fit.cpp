@@ -34,6 +34,17 @@ double rms_between(std::span<const double> a, std::span<const double> b, std::si
 
 }  // namespace
 
+namespace {
+// A table of random cell masses of both signs (-0.6..1 N) and the given force offset.
+EverettTable signed_table(std::mt19937_64& rng, const Grid& g, double offset) {
+  std::uniform_real_distribution<double> mass(-0.6, 1.0);
+  std::vector<double> w(g.cell_count()), F(g.node_count());
+  for (double& e : w) e = mass(rng);
+  fit::cells_to_nodes(g, w, F);
+  return EverettTable(g, F, offset);
+}
+}  // namespace
+
 TEST_CASE("the operator is the model's linear map: it matches the row-by-row regressors, and Aᵀ is its adjoint") {
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     CAPTURE(seed);
@@ -99,11 +110,7 @@ TEST_CASE("signed prior: a noiseless record of a table with masses of both signs
     CAPTURE(seed);
     std::mt19937_64 rng(seed);
     const Grid g = Grid::make(0.0, 4.0, 10);
-    std::uniform_real_distribution<double> mass(-0.6, 1.0);
-    std::vector<double> w(g.cell_count()), F(g.node_count());
-    for (double& e : w) e = mass(rng);
-    fit::cells_to_nodes(g, w, F);
-    const EverettTable truth(g, F, 2.0);
+    const EverettTable truth = signed_table(rng, g, 2.0);
     PreisachModel gen(truth);
     const auto x = rough_walk(rng, g, 400);
     const auto y = run_model(gen, x);
@@ -127,11 +134,7 @@ TEST_CASE("signed prior: a noiseless record of a table with masses of both signs
 TEST_CASE("a long record: the prior and λ chosen on it thinned (every turning point kept), the table fitted on every sample") {
   std::mt19937_64 rng(21);
   const Grid g = Grid::make(0.0, 4.0, 6);
-  std::uniform_real_distribution<double> mass(-0.6, 1.0);
-  std::vector<double> w(g.cell_count()), F(g.node_count());
-  for (double& e : w) e = mass(rng);
-  fit::cells_to_nodes(g, w, F);
-  const EverettTable truth(g, F, 0.0);
+  const EverettTable truth = signed_table(rng, g, 0.0);
   PreisachModel gen(truth);
   const auto x = hystlab::test::random_ramps(rng, 0.0, 4.0, 700, 0.003);  // about 450 samples per reversal
   REQUIRE(x.size() > 250000);
