@@ -42,12 +42,34 @@ void Loop::event(const std::string& kind, const json& detail) {
 }
 
 void Loop::publish(double t, double a, double b, double c, std::uint16_t status) {
-  ctx.writer.try_push({result.run_id, next_seq++, t, a, b, c, status});
+  ctx.writer.try_push(db::SampleRow{result.run_id, next_seq++, t, a, b, c, status});
   ++result.samples;
   if (ctx.live) {
     ctx.live->ring.push({ctx.clock.now(), t, a, b, c, result.run_id, status});
     ctx.live->samples.fetch_add(1, std::memory_order_relaxed);
   }
+}
+
+void Loop::publish(const drivers::ShakerSample& s) {
+  db::ShakerRow row{result.run_id, next_seq++, s.time_s, {}, s.status_word};
+  row.v = {drive_hz, drive_mm, s.base_displacement_mm, s.mass_displacement_mm, s.base_accel_m_s2, s.mass_accel_m_s2};
+  ctx.writer.try_push(row);
+  ++result.samples;
+  if (ctx.live) {
+    ctx.live->ring.push({ctx.clock.now(), s.time_s, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, result.run_id, s.status_word});
+    ctx.live->samples.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+bool Loop::command_drive(double t, double f_hz, double amplitude_mm) {
+  if (auto ec = ctx.rig.command_shaker(f_hz, amplitude_mm, true)) {
+    ctx.supervisor.hold(t, "shaker command refused: no drive");
+    end(CampaignEnd::failed, "shaker command refused: " + ec.message());
+    return false;
+  }
+  drive_hz = f_hz;
+  drive_mm = amplitude_mm;
+  return true;
 }
 
 // A hole in the time axis (a lost link, a frozen sensor, a stall, a reconnect): counted always,
@@ -227,7 +249,7 @@ bool frame_sample(Loop& L, Strategy& strategy, const drivers::RigSample& s) {
 
 bool shaker_sample(Loop& L, Strategy& strategy, const drivers::ShakerSample& s) {
   L.check_gap(s.time_s);
-  L.publish(s.time_s, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, s.status_word);
+  L.publish(s);
   if (auto why = L.ctx.supervisor.on_status(s.time_s, view_of(s))) return L.end(CampaignEnd::failed, *why), false;
   if (std::fabs(s.mass_displacement_mm) > L.plan.limits.displacement_max_mm) {
     L.begin_safing(s.time_s, CampaignEnd::aborted, "safety trip: mass displacement beyond the limits", 0.0);

@@ -68,6 +68,10 @@ struct Loop {
   // rig is within the in-position tolerance of the safe position, or holds where it stopped.
   void begin_safing(double t, CampaignEnd e, const std::string& reason, double position_mm);
   void publish(double t, double a, double b, double c, std::uint16_t status);
+  void publish(const drivers::ShakerSample& s);  // stored with the drive in force (drive_hz, drive_mm)
+  double drive_hz = 0, drive_mm = 0;              // the shaker's drive as last commanded
+  // The shaker's drive; false (result set, rig held) when the rig refused it.
+  bool command_drive(double t, double f_hz, double amplitude_mm);
   void check_gap(double t);
   // A command the rig did not take. A lost answer (timeout, dropped link) holds the rig like a
   // lost read, and the segment is commanded again when the rig answers; true while the campaign

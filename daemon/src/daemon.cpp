@@ -114,6 +114,7 @@ struct Daemon::Impl {
     const auto row = store.campaign(id);
     if (!row) return std::nullopt;
     CampaignJob job;
+    job.isolator = w.entry.isolator;
     job.id = id;
     try {
       job.plan = parse_plan(json::parse(row->plan));

@@ -91,7 +91,7 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
   DaemonConfig c;
   c.base_dir = base_dir;
   if (j.is_null()) {  // embedded defaults: one simulated load frame
-    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}});
+    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}, nullptr});
     return c;
   }
   if (!j.is_object()) fail("", "must be a JSON object");
@@ -104,7 +104,7 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
     c.db_path = j["db"].get<std::string>();
   }
   if (!j.contains("rigs")) {
-    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}});
+    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}, nullptr});
     return c;
   }
   if (!j["rigs"].is_array() || j["rigs"].empty()) fail("rigs", "must be a non-empty array");
@@ -158,6 +158,17 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
     }
     r.erase("envelope");
     r.erase("supervision");
+    try {
+      if (r.contains("isolator")) {
+        if (!shaker) throw std::invalid_argument("config: " + where + ".isolator is for a shaker's isolator; this rig is a load frame");
+        e.isolator = std::make_shared<const IsolatorModel>(parse_isolator(r["isolator"], where + ".isolator"));
+      } else if (e.simulated && shaker) {
+        e.isolator = std::make_shared<const IsolatorModel>(simulated_isolator());
+      }
+    } catch (const std::invalid_argument& err) {
+      throw ConfigError(err.what());
+    }
+    r.erase("isolator");
     e.driver = r;
     c.rigs.push_back(e);
   }

@@ -97,22 +97,25 @@ json supervision_json(const SupervisionSettings& s) {
 }
 
 namespace {
+// The highest amplitude at the highest frequency is the plan's peak velocity and acceleration
+// (the base amplitude is held at the demand in closed loop; the drive may be larger).
 void check_shaker(const Plan& p, const RigEnvelope& e) {
-  if (p.amplitude_mm > e.shaker_displacement_max_mm)
-    refuse("amplitude_mm", num(p.amplitude_mm) + " exceeds the shaker's maximum displacement " + num(e.shaker_displacement_max_mm) + " mm");
-  for (std::size_t k = 0; k < p.frequencies_hz.size(); ++k) {
-    const double f = p.frequencies_hz[k], w = 2 * std::numbers::pi * f;
-    const std::string field = p.source.contains("frequencies_hz") ? "frequencies_hz[" + std::to_string(k) + "]" : "sweep";
+  const SinePlan& s = p.sine;
+  const double a = s.max_amplitude_mm(), lo = s.lowest_hz(), hi = s.highest_hz(), w = 2 * std::numbers::pi * hi;
+  const std::string amp = p.source.contains("amplitudes_mm") ? "amplitudes_mm" : "amplitude_mm";
+  const std::string freq = p.source.contains("frequencies_hz") ? "frequencies_hz" : "sweep";
+  if (a > e.shaker_displacement_max_mm)
+    refuse(amp, num(a) + " mm exceeds the shaker's maximum displacement " + num(e.shaker_displacement_max_mm) + " mm");
+  for (const double f : {lo, hi})
     if (f < e.shaker_freq_min_hz * (1 - 1e-9) || f > e.shaker_freq_max_hz * (1 + 1e-9))
-      refuse(field, num(f) + " Hz is outside the shaker's range " + num(e.shaker_freq_min_hz) + "–" + num(e.shaker_freq_max_hz) + " Hz");
-    if (w * p.amplitude_mm > e.shaker_velocity_max_mm_s)
-      refuse(field, num(f) + " Hz at " + num(p.amplitude_mm) + " mm needs a peak velocity of " + num(w * p.amplitude_mm) +
-                        " mm/s; the shaker's maximum is " + num(e.shaker_velocity_max_mm_s) + " mm/s");
-    const double g = w * w * p.amplitude_mm / 9806.65;
-    if (g > e.shaker_accel_max_g)
-      refuse(field, num(f) + " Hz at " + num(p.amplitude_mm) + " mm needs a peak acceleration of " + num(g) +
-                        " g; the shaker's maximum is " + num(e.shaker_accel_max_g) + " g");
-  }
+      refuse(freq, num(f) + " Hz is outside the shaker's range " + num(e.shaker_freq_min_hz) + "–" + num(e.shaker_freq_max_hz) + " Hz");
+  if (w * a > e.shaker_velocity_max_mm_s)
+    refuse(freq, num(hi) + " Hz at " + num(a) + " mm needs a peak velocity of " + num(w * a) + " mm/s; the shaker's maximum is " +
+                     num(e.shaker_velocity_max_mm_s) + " mm/s");
+  const double g = w * w * a / 9806.65;
+  if (g > e.shaker_accel_max_g)
+    refuse(freq, num(hi) + " Hz at " + num(a) + " mm needs a peak acceleration of " + num(g) + " g; the shaker's maximum is " +
+                     num(e.shaker_accel_max_g) + " g");
 }
 
 void check_frame(const Plan& p, const RigEnvelope& e) {

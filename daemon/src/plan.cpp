@@ -1,4 +1,5 @@
 #include "hystlab/daemon/plan.hpp"
+#include "plan_fields.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -15,15 +16,8 @@ std::string plan_number(double v) {
 namespace {
 using nlohmann::json;
 
-[[noreturn]] void fail(const std::string& field, const std::string& why) { throw PlanError(field, "plan: " + field + " " + why); }
-
-double number(const json& j, const char* f, double def, double lo, double hi) {
-  if (!j.contains(f)) return def;
-  if (!j[f].is_number() || !std::isfinite(j[f].get<double>())) fail(f, "must be a number");
-  const double v = j[f].get<double>();
-  if (v < lo || v > hi) fail(f, "must be between " + plan_number(lo) + " and " + plan_number(hi));
-  return v;
-}
+using fields::fail;
+using fields::number;
 
 std::pair<double, double> pair_of(const json& j, const std::string& f) {
   if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number()) fail(f, "must be [low, high]");
@@ -50,23 +44,6 @@ Limits parse_limits(const json& j, double lo, double hi) {
     fail("limits.safe_position_mm", "must lie inside limits.displacement_mm");
   return l;
 }
-// A percentage: 0.5 or "0.5 %" or "0.5%".
-double percent(const json& j, const std::string& f, double def) {
-  if (!j.contains(f)) return def;
-  double v = NAN;
-  if (j[f].is_number()) {
-    v = j[f].get<double>();
-  } else if (j[f].is_string()) {
-    std::string t = j[f].get<std::string>();
-    while (!t.empty() && (t.back() == ' ' || t.back() == '%')) t.pop_back();
-    char* end = nullptr;
-    v = std::strtod(t.c_str(), &end);
-    if (t.empty() || end != t.c_str() + t.size()) v = NAN;
-  }
-  if (!std::isfinite(v) || !(v > 0) || v > 100) fail("training.until." + f, "must be a percentage above 0 and at most 100, e.g. 0.5 or \"0.5 %\"");
-  return v;
-}
-
 Training parse_training(const json& j) {
   Training t;
   if (!j.contains("training")) {
@@ -88,8 +65,8 @@ Training parse_training(const json& j) {
     if (k != "peak_force_change" && k != "energy_change" && k != "consecutive")
       fail("training.until." + k, "is not a known field (peak_force_change, energy_change, consecutive)");
   t.until = true;
-  t.peak_force_change_pct = percent(u, "peak_force_change", t.peak_force_change_pct);
-  t.energy_change_pct = percent(u, "energy_change", t.energy_change_pct);
+  t.peak_force_change_pct = fields::percent(u, "peak_force_change", t.peak_force_change_pct, "training.until.");
+  t.energy_change_pct = fields::percent(u, "energy_change", t.energy_change_pct, "training.until.");
   if (u.contains("consecutive") && (!u["consecutive"].is_number_integer() || u["consecutive"] < 1 || u["consecutive"] > 100))
     fail("training.until.consecutive", "must be an integer from 1 to 100");
   t.consecutive = u.value("consecutive", t.consecutive);
@@ -161,34 +138,11 @@ void parse_nodes(const json& j, Plan& p) {
 }
 
 void parse_sine(const json& j, Plan& p) {
-  if (j.contains("frequencies_hz") == j.contains("sweep")) fail("frequencies_hz", "or sweep: exactly one is required");
-  if (j.contains("frequencies_hz")) {
-    if (!j["frequencies_hz"].is_array() || j["frequencies_hz"].empty()) fail("frequencies_hz", "must be a non-empty array");
-    for (std::size_t k = 0; k < j["frequencies_hz"].size(); ++k) {
-      const json& v = j["frequencies_hz"][k];
-      if (!v.is_number() || !(v.get<double>() > 0) || v.get<double>() > 1000)
-        fail("frequencies_hz[" + std::to_string(k) + "]", "must be a frequency above 0 and at most 1000 Hz");
-      p.frequencies_hz.push_back(v.get<double>());
-    }
-  } else {
-    const json& s = j["sweep"];
-    if (!s.is_object()) fail("sweep", "must be an object");
-    const double a = number(s, "from_hz", 0, 1e-3, 1000), b = number(s, "to_hz", 0, 1e-3, 1000);
-    if (!(b > a)) fail("sweep.to_hz", "must be above sweep.from_hz");
-    const int n = static_cast<int>(number(s, "steps", 10, 2, 1000));
-    const bool log = s.value("spacing", std::string("log")) == "log";
-    for (int k = 0; k < n; ++k)
-      p.frequencies_hz.push_back(log ? a * std::pow(b / a, k / double(n - 1)) : a + (b - a) * k / double(n - 1));
-  }
-  if (!j.contains("amplitude_mm")) fail("amplitude_mm", "is required");
-  p.amplitude_mm = number(j, "amplitude_mm", 0, 1e-4, 100);
-  p.settle_cycles = static_cast<int>(number(j, "settle_cycles", 10, 0, 100000));
-  p.measured_cycles = static_cast<int>(number(j, "measured_cycles", 10, 1, 100000));
-  for (double f : p.frequencies_hz)
-    if (f > p.sample_rate_hz / 8) fail("frequencies_hz", "must stay below sample_rate_hz / 8 (at least 8 samples a cycle)");
-  p.lo_mm = -p.amplitude_mm;
-  p.hi_mm = p.amplitude_mm;
-  p.limits = parse_limits(j.value("limits", json()), -10 * p.amplitude_mm - 1, 10 * p.amplitude_mm + 1);
+  p.sine = parse_sine_plan(j, p.sample_rate_hz);
+  const double a = p.sine.max_amplitude_mm();
+  p.lo_mm = -a;
+  p.hi_mm = a;
+  p.limits = parse_limits(j.value("limits", json()), -10 * a - 1, 10 * a + 1);
 }
 }  // namespace
 
@@ -247,7 +201,8 @@ Plan parse_plan(const json& j) {
       if (p.points_mm[k] < p.limits.displacement_min_mm || p.points_mm[k] > p.limits.displacement_max_mm)
         fail("points_mm[" + std::to_string(k) + "]", "lies outside limits.displacement_mm");
   } else {
-    known({"frequencies_hz", "sweep", "amplitude_mm", "settle_cycles", "measured_cycles"});
+    known({"frequencies_hz", "sweep", "amplitude_mm", "amplitudes_mm", "direction", "settle_cycles", "settle", "measured_cycles", "control",
+           "jump_threshold"});
     parse_sine(j, p);
   }
   // Only against a rate the plan wrote: without one, the rig's envelope decides at submission and

@@ -10,13 +10,11 @@ namespace hystlab::daemon {
 namespace {
 PlanPreview preview_sine(const Plan& p) {
   PlanPreview v;
-  for (const double f : p.frequencies_hz) {
-    v.duration_s += static_cast<double>(p.settle_cycles + p.measured_cycles) / f;
-    const double w = 2 * std::numbers::pi * f;
-    v.peak_speed_mm_s = std::max(v.peak_speed_mm_s, w * p.amplitude_mm);
-    v.peak_accel_m_s2 = std::max(v.peak_accel_m_s2, w * w * p.amplitude_mm * 1e-3);
-  }
-  v.nodes = p.frequencies_hz.size();
+  const double a = p.sine.max_amplitude_mm(), w = 2 * std::numbers::pi * p.sine.highest_hz();
+  v.duration_s = nominal_duration_s(p.sine);
+  v.peak_speed_mm_s = w * a;
+  v.peak_accel_m_s2 = w * w * a * 1e-3;
+  v.nodes = step_count(p.sine);
   return v;
 }
 }  // namespace

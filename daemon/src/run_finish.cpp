@@ -147,6 +147,16 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
       end.recommendation = recommendation;
     }
   }
+  if (j.plan.kind == db::CampaignKind::sine && j.isolator && !j.sine_steps.empty()) {
+    try {  // the isolator model at the measured amplitudes, in the order the rig took them
+      std::vector<PredictStep> steps;
+      for (const auto& [k, step] : j.sine_steps) steps.push_back(step);
+      const std::vector<Predicted> p = predict_sweep(*j.isolator, steps);
+      for (std::size_t k = 0; k < p.size(); ++k) end.predictions.push_back({j.sine_steps[k].first, p[k].ratio, p[k].phase_rad});
+    } catch (const std::exception& e) {  // a prediction is extra: it never costs the campaign its end
+      note += std::string("; no prediction: ") + e.what();
+    }
+  }
   if (j.plan.kind != db::CampaignKind::sine) {
     try {
       end.loops = loop_records(j, r.run_id, r.validation_run_id);

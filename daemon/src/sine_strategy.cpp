@@ -1,6 +1,10 @@
-// sine campaigns on a shaker: each frequency is driven for settle_cycles, then measured for
-// measured_cycles; amplitude and phase of base and mass motion come from a least-squares sine
-// fit, and the transmissibility point is stored as it comes.
+// Sine campaigns on a shaker, as a sine controller runs them: each pass (one base amplitude, one
+// direction) is either stepped (each frequency: the base amplitude brought to the demand in
+// closed loop, the response settled, then measured) or continuous (the frequency moves every
+// cycle at the plan's rate, each measured window a point). Every window is fitted against the
+// drive's own phase (integrated over the commanded frequencies), so a continuous sweep is
+// measured as exactly as a dwell; the mass response is fitted with its harmonics, and how far it
+// is from a sine (THD) is a result of its own. The result of each step is stored as it comes.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,115 +12,249 @@
 #include <vector>
 
 #include "acquisition_loop.hpp"
+#include "hystlab/daemon/base_control.hpp"
 #include "hystlab/models/sine_fit.hpp"
+#include "sine_window.hpp"
 
 namespace hystlab::daemon {
 namespace {
+constexpr double kTwoPi = 2 * std::numbers::pi;
 
 class SineStrategy final : public Strategy {
  public:
-  explicit SineStrategy(const Plan& p) : plan_(p) {}
+  explicit SineStrategy(const Plan& p) : plan_(p), s_(p.sine), control_(p.sine.control), passes_(sweep_passes(p.sine)), total_(step_count(p.sine)) {}
 
   bool on_shaker(Loop& L, const drivers::ShakerSample& s) override {
-    if (!started_) return start_step(L, s.time_s);
-    if (s.time_s >= t_measure_) {
-      t_.push_back(s.time_s);
-      base_.push_back(s.base_displacement_mm);
-      mass_.push_back(s.mass_displacement_mm);
+    if (!started_) {
+      started_ = true;
+      t0_ = s.time_s;
+      w_.restart(s.time_s);
+      return begin_step(L, s.time_s);
     }
-    if (s.time_s < t_end_) return true;
-    if (const std::string hole = window_hole(plan_.frequencies_hz[k_]); !hole.empty()) return retake(L, s.time_s, hole);
-    if (!store_point(L)) return false;
-    ++k_;
-    retakes_ = 0;
-    started_ = false;
-    return true;
+    w_.advance(s.time_s, L.drive_hz);
+    w_.collect(s.time_s, s.base_displacement_mm, s.mass_displacement_mm);
+    if (mode_ == Mode::sweep && w_.phase() >= next_cycle_) {
+      next_cycle_ += kTwoPi;
+      if (!sweep_frequency(L, s.time_s)) return L.result.end == CampaignEnd::none;
+    }
+    if (!w_.complete()) return true;
+    return on_window(L, s.time_s);
   }
 
-  // The step is taken again from its start, at the next sample: on the rig's clock, as every
-  // window is (a shaker's samples may be on the controller's clock, behind the loop's).
-  void on_resume(Loop&, double, bool) override { started_ = false; }
+  // The step is taken again from its start (a pause, a held link): the response has changed.
+  void on_resume(Loop& L, double t, bool) override {
+    w_.restart(t);
+    if (pass_ < passes_.size()) (void)begin_step(L, t);
+  }
 
-  [[nodiscard]] bool done() const override { return k_ >= plan_.frequencies_hz.size(); }
+  [[nodiscard]] bool done() const override { return pass_ >= passes_.size(); }
+
+  void fill_finish(Loop& L, FinishJob& fj) override {
+    fj.isolator = L.job.isolator;
+    fj.sine_steps = steps_;
+    if (points_ > 0)
+      L.event("sweep_done", {{"points", points_}, {"of", total_}, {"seconds", last_t_ - t0_}, {"nominal_seconds", nominal_duration_s(s_)},
+                             {"warnings", warnings_}, {"predicted_with", L.job.isolator ? L.job.isolator->describe : ""}});
+  }
 
  private:
-  bool start_step(Loop& L, double t) {
-    const double f = plan_.frequencies_hz[k_];
-    if (auto ec = L.ctx.rig.command_shaker(f, plan_.amplitude_mm, true)) {
-      L.ctx.supervisor.hold(t, "shaker command refused: no drive");
-      L.end(CampaignEnd::failed, "shaker command refused: " + ec.message());
-      return false;
-    }
-    started_ = true;
-    t_measure_ = t + plan_.settle_cycles / f;
-    t_end_ = t_measure_ + plan_.measured_cycles / f;
-    t_.clear(), base_.clear(), mass_.clear();
+  enum class Mode { control, settle, measure, sweep };
+
+  double demand() const { return passes_[pass_].amplitude_mm; }
+  bool up() const { return passes_[pass_].up; }
+  int harmonics(double f) const { return std::clamp(static_cast<int>(0.45 * plan_.sample_rate_hz / f), 1, 5); }
+
+  // A step (stepped pass) or the start of a continuous pass: drive at the learnt response.
+  bool begin_step(Loop& L, double t) {
+    f_ = s_.continuous ? (up() ? s_.from_hz : s_.to_hz) : pass_frequencies(s_, passes_[pass_])[step_];
+    drive_ = control_.start(demand());
+    control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false;
+    prev_mass_ = NAN;
+    if (!L.command_drive(t, f_, drive_)) return false;
+    L.event("sine_step", {{"k", points_ + 1}, {"of", total_}, {"pass", pass_ + 1}, {"passes", passes_.size()}, {"frequency_hz", f_},
+                          {"amplitude_mm", demand()}, {"direction", up() ? "up" : "down"}, {"drive_mm", drive_}, {"eta_s", eta(t)}});
+    if (s_.control.closed) return open(Mode::control, 1, s_.control.window_cycles);
+    return to_settle();
+  }
+
+  bool open(Mode m, int skip_cycles, int cycles) {
+    mode_ = m;
+    w_.open(skip_cycles, cycles);
     return true;
   }
 
-  // A measurement window with too little in it (a stalled host, a lost link) is taken again, up
-  // to kMaxRetakes times, and the campaign fails only then. The fit is a least-squares sine at
-  // the known frequency on the samples' own times, so a hole biases nothing; what it needs is
-  // the signal's rate, not the loop's: 8 samples a cycle, and at least half of the window
-  // sampled (a gap over a quarter cycle counts as unsampled). A starved 2-core VM polled the
-  // shaker at 170 Hz with 0.6 s stalls; judging by the longest gap, 10 Hz never passed there.
-  std::string window_hole(double f) const {
-    const double window = t_end_ - t_measure_, needed = 8.0 * plan_.measured_cycles;
-    double holes = 0, longest = 0, prev = t_measure_;
-    for (const double t : t_) {  // the window's stretches between samples, its edges included
-      const double gap = std::min(t, t_end_) - std::max(prev, t_measure_);
-      longest = std::max(longest, gap);
-      if (gap > 0.25 / f) holes += gap;
-      prev = t;
+  bool to_settle() {
+    if (s_.settle.until) return open(Mode::settle, 0, s_.control.window_cycles);
+    if (s_.settle.cycles > 0) return open(Mode::settle, 0, s_.settle.cycles);
+    return to_measure();
+  }
+
+  bool to_measure() {
+    if (!s_.continuous) return open(Mode::measure, 0, s_.measured_cycles);
+    next_cycle_ = w_.phase() + kTwoPi;
+    return open(Mode::sweep, 0, s_.measured_cycles);
+  }
+
+  // Seconds left at the pace so far (the plan's nominal time, stretched by how much longer the
+  // steps done took than theirs).
+  double eta(double t) const {
+    const double nominal = nominal_duration_s(s_), done_fraction = total_ > 0 ? static_cast<double>(points_) / static_cast<double>(total_) : 0;
+    const double elapsed = t - t0_, pace = done_fraction > 0 ? std::max(1.0, elapsed / (nominal * done_fraction)) : 1.0;
+    return nominal * (1 - done_fraction) * pace;
+  }
+
+  bool on_window(Loop& L, double t) {
+    last_t_ = t;
+    if (const std::string hole = w_.hole(); !hole.empty()) return retake(L, t, hole);
+    const models::HarmonicFit b = w_.fit_base(), m = w_.fit_mass(harmonics(f_));
+    if (!b.fundamental.ok || !m.fundamental.ok) return retake(L, t, "no sine fit");
+    const ControlVerdict v = control_.update(demand(), drive_, b.fundamental.amplitude);
+    if (!check_band(L, t, v, b.fundamental.amplitude)) return false;
+    switch (mode_) {
+      case Mode::control: return after_control(L, t, v);
+      case Mode::settle: return after_settle(L, t, v, m.fundamental.amplitude);
+      case Mode::measure: store_point(L, t, b, m, v), ++step_;
+        return next_step(L, t);
+      case Mode::sweep: return after_sweep_window(L, t, b, m, v);
     }
-    char buf[160];
-    if (static_cast<double>(t_.size()) < needed)
-      std::snprintf(buf, sizeof buf, "%zu samples, %.0f needed", t_.size(), needed);
-    else if (holes > 0.5 * window)
-      std::snprintf(buf, sizeof buf, "%.0f of its %.0f ms in gaps (the longest %.0f ms)", holes * 1e3, window * 1e3, longest * 1e3);
-    else
-      return {};
-    return buf;
+    return true;
+  }
+
+  // Warning and abort bands: a warning is said once per step; two windows in a row beyond the
+  // abort band (or one while measuring) stop the drive and end the campaign with the reason.
+  bool check_band(Loop& L, double t, const ControlVerdict& v, double base) {
+    if (v.band == ControlBand::abort && (++abort_windows_ >= 2 || mode_ == Mode::measure || mode_ == Mode::sweep)) {
+      char buf[240];
+      std::snprintf(buf, sizeof buf, "control abort: the base amplitude was %.4g mm against the demand %.4g mm (error %+.1f %%, abort band ±%g %%) at %.4g Hz",
+                    base, demand(), v.error_pct, s_.control.abort_pct, f_);
+      L.event("control_abort", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"base_mm", base}, {"error_pct", v.error_pct}, {"drive_mm", drive_}});
+      L.ctx.supervisor.hold(t, "control abort: no drive");
+      L.end(CampaignEnd::aborted, buf);
+      return false;
+    }
+    if (v.band != ControlBand::abort) abort_windows_ = 0;
+    if ((v.band == ControlBand::warning || v.band == ControlBand::abort) && !warned_) {
+      warned_ = true;
+      ++warnings_;
+      L.event("control_warning", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"base_mm", base}, {"error_pct", v.error_pct}, {"band", to_string(v.band)}});
+    }
+    return true;
+  }
+
+  bool redrive(Loop& L, double t, const ControlVerdict& v) {
+    drive_ = v.next_drive_mm;
+    if (!L.command_drive(t, f_, drive_)) return false;
+    return open(Mode::control, 1, s_.control.window_cycles);
+  }
+
+  bool after_control(Loop& L, double t, const ControlVerdict& v) {
+    if (v.band == ControlBand::within) return to_settle();
+    if (++control_windows_ >= s_.control.max_windows) {
+      L.event("control_unreached", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"error_pct", v.error_pct}, {"windows", control_windows_},
+                                    {"drive_mm", drive_}, {"limited", v.limited}});
+      return to_settle();
+    }
+    return redrive(L, t, v);
+  }
+
+  bool after_settle(Loop& L, double t, const ControlVerdict& v, double mass) {
+    // The base wandered off while the response settled (the load changed as it did): back to control.
+    if (s_.control.closed && v.band != ControlBand::within && control_windows_ < s_.control.max_windows) {
+      ++control_windows_;
+      stable_ = 0, prev_mass_ = NAN;
+      return redrive(L, t, v);
+    }
+    if (!s_.settle.until) return to_measure();
+    settled_cycles_ += s_.control.window_cycles;
+    const double change = std::fabs(mass - prev_mass_) / std::max(prev_mass_, 1e-12) * 100;
+    stable_ = change < s_.settle.change_pct ? stable_ + 1 : 0;
+    prev_mass_ = mass;
+    if (stable_ >= s_.settle.consecutive) return to_measure();
+    if (settled_cycles_ >= s_.settle.max_cycles) {
+      L.event("unsettled", {{"frequency_hz", f_}, {"cycles", settled_cycles_}, {"change_pct", change}});
+      return to_measure();
+    }
+    return open(Mode::settle, 0, s_.control.window_cycles);
+  }
+
+  // A continuous pass: each window is a point; the drive is corrected for the next window at once.
+  bool after_sweep_window(Loop& L, double t, const models::HarmonicFit& b, const models::HarmonicFit& m, const ControlVerdict& v) {
+    store_point(L, t, b, m, v);
+    if (sweep_over_) {
+      ++pass_;
+      sweep_over_ = false;
+      return pass_ < passes_.size() ? begin_step(L, t) : true;
+    }
+    if (s_.control.closed && v.band != ControlBand::within) {
+      drive_ = v.next_drive_mm;
+      if (!L.command_drive(t, f_, drive_)) return false;
+    }
+    return open(Mode::sweep, 0, s_.measured_cycles);
+  }
+
+  // A cycle of a continuous pass has gone by: the next frequency at the plan's rate.
+  bool sweep_frequency(Loop& L, double t) {
+    const double sign = up() ? 1.0 : -1.0;
+    const double next = s_.rate_oct_min > 0 ? f_ * std::exp2(sign * s_.rate_oct_min / 60.0 / f_) : f_ + sign * s_.rate_hz_s / f_;
+    if (next > s_.to_hz || next < s_.from_hz) sweep_over_ = true;  // this window is the pass's last
+    if (sweep_over_) return true;
+    f_ = next;
+    return L.command_drive(t, f_, drive_);
+  }
+
+  bool next_step(Loop& L, double t) {
+    if (step_ >= s_.frequencies_hz.size()) step_ = 0, ++pass_;
+    if (pass_ >= passes_.size()) return true;
+    return begin_step(L, t);
   }
 
   bool retake(Loop& L, double t, const std::string& hole) {
-    const double f = plan_.frequencies_hz[k_];
     if (++retakes_ > kMaxRetakes) {
       L.ctx.supervisor.hold(t, "no complete measurement: no drive");
       char buf[200];
-      std::snprintf(buf, sizeof buf, "the measurement window at %g Hz was incomplete %d times (last: %s)", f, kMaxRetakes + 1, hole.c_str());
+      std::snprintf(buf, sizeof buf, "the measurement window at %g Hz was incomplete %d times (last: %s)", f_, kMaxRetakes + 1, hole.c_str());
       L.end(CampaignEnd::failed, buf);
       return false;
     }
-    L.event("retake", {{"frequency_hz", f}, {"why", hole}, {"attempt", retakes_ + 1}});
-    return start_step(L, t);
-  }
-
-  bool store_point(Loop& L) {
-    const double f = plan_.frequencies_hz[k_];
-    const models::SineFit b = models::fit_sine(t_, base_, f), m = models::fit_sine(t_, mass_, f);
-    if (!b.ok || !m.ok || b.amplitude <= 0) {
-      L.ctx.supervisor.hold(t_end_, "no fit: no drive");
-      L.end(CampaignEnd::failed, "too few samples to fit the sine at " + std::to_string(f) + " Hz");
-      return false;
-    }
-    const double ratio = m.amplitude / b.amplitude, phase = std::remainder(m.phase_rad - b.phase_rad, 2 * std::numbers::pi);
-    const auto run = L.result.run_id, id = L.job.id;
-    const std::string now = L.ctx.now_iso();
-    L.ctx.writer.post([run, f, b, m, ratio, phase, id, now](db::Store& st) {
-      st.add_transmissibility(run, f, b.amplitude, m.amplitude, ratio, phase);
-      st.add_event(id, "transmissibility", nlohmann::json{{"frequency_hz", f}, {"ratio", ratio}, {"phase_rad", phase}}.dump(), now);
-    });
+    L.event("retake", {{"frequency_hz", f_}, {"why", hole}, {"attempt", retakes_ + 1}});
+    w_.reopen();
     return true;
   }
 
+  void store_point(Loop& L, double t, const models::HarmonicFit& b, const models::HarmonicFit& m, const ControlVerdict& v) {
+    const double ratio = m.fundamental.amplitude / b.fundamental.amplitude;
+    const double phase = std::remainder(m.fundamental.phase_rad - b.fundamental.phase_rad, kTwoPi);
+    const double f = s_.continuous ? w_.mean_frequency() : f_;
+    ++points_;
+    const nlohmann::json rec{{"k", points_}, {"of", total_}, {"pass", pass_ + 1}, {"frequency_hz", f}, {"amplitude_mm", demand()},
+                             {"direction", up() ? "up" : "down"}, {"drive_mm", drive_}, {"base_amplitude_mm", b.fundamental.amplitude},
+                             {"base_phase_rad", b.fundamental.phase_rad}, {"mass_amplitude_mm", m.fundamental.amplitude},
+                             {"mass_phase_rad", m.fundamental.phase_rad}, {"ratio", ratio}, {"phase_rad", phase}, {"thd", m.thd},
+                             {"harmonics", m.harmonics}, {"control_error_pct", v.error_pct}, {"band", to_string(v.band)},
+                             {"control_windows", control_windows_}, {"settle_cycles", settled_cycles_}, {"t_s", t}, {"eta_s", eta(t)}};
+    steps_.push_back({points_, PredictStep{f, b.fundamental.amplitude, settled_cycles_ + s_.settle.cycles, s_.measured_cycles}});
+    db::SinePointRow row{points_, f, demand(), b.fundamental.amplitude, m.fundamental.amplitude, ratio, phase, up() ? "up" : "down", rec.dump()};
+    const auto run = L.result.run_id, id = L.job.id;
+    const std::string now = L.ctx.now_iso(), text = rec.dump();
+    L.ctx.writer.post([run, row, id, now, text](db::Store& st) {
+      st.add_sine_point(run, row);
+      st.add_event(id, "transmissibility", text, now);
+    });
+  }
+
   const Plan& plan_;
+  const SinePlan& s_;
+  BaseControl control_;
+  std::vector<SweepPass> passes_;
+  std::vector<std::pair<std::int64_t, PredictStep>> steps_;
+  std::size_t total_ = 0, pass_ = 0, step_ = 0;
+  std::int64_t points_ = 0;
   static constexpr int kMaxRetakes = 3;
-  std::size_t k_ = 0;
-  int retakes_ = 0;
-  bool started_ = false;
-  double t_measure_ = 0, t_end_ = 0;
-  std::vector<double> t_, base_, mass_;
+  Mode mode_ = Mode::control;
+  SineWindow w_;
+  bool started_ = false, sweep_over_ = false, warned_ = false;
+  double t0_ = 0, last_t_ = 0, f_ = 0, drive_ = 0, prev_mass_ = NAN, next_cycle_ = 0;
+  int control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warnings_ = 0;
 };
 }  // namespace
 

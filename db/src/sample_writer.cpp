@@ -48,12 +48,12 @@ WriterStats SampleWriter::stats() const {
   return s;
 }
 
-bool SampleWriter::write_batch(std::vector<SampleRow>& batch, Store& store) {
+bool SampleWriter::write_batch(std::vector<AnyRow>& batch, Store& store) {
   if (batch.empty()) return true;
   const auto t0 = std::chrono::steady_clock::now();
   try {
     Transaction tx(store.database());
-    store.insert_samples(batch);
+    store.insert_rows(batch);
     tx.commit();
   } catch (const DbError& e) {  // kept for the next attempt; counted and reported, never silent
     errors_.fetch_add(1);
@@ -65,15 +65,14 @@ bool SampleWriter::write_batch(std::vector<SampleRow>& batch, Store& store) {
   if (ms > max_commit_ms_.load()) max_commit_ms_.store(ms);
   written_.fetch_add(batch.size());
   commits_.fetch_add(1);
-  ack_run_.store(batch.back().run_id);
-  ack_seq_.store(batch.back().seq);
+  std::visit([this](const auto& r) { ack_run_.store(r.run_id), ack_seq_.store(r.seq); }, batch.back());
   batch.clear();
   return true;
 }
 
 void SampleWriter::run() {
   Store store(path_, opt_.synchronous_full);
-  std::vector<SampleRow> batch;
+  std::vector<AnyRow> batch;
   batch.reserve(opt_.max_batch);
   const auto window = std::chrono::duration<double>(opt_.batch_window_s);
   for (;;) {

@@ -65,6 +65,21 @@ CREATE TABLE loops(
   run_id INTEGER NOT NULL REFERENCES runs(id), k INTEGER NOT NULL, phase TEXT NOT NULL, figures TEXT NOT NULL,
   PRIMARY KEY(run_id, k)) WITHOUT ROWID;
 )sql",
+    // 5: a shaker's samples in its own terms (the columns are kShakerSignals' names; before, the
+    // load frame's columns held base and mass displacement and the mass's acceleration), and a
+    // sine step's place in its sweep, its whole record, and the isolator model's prediction.
+    R"sql(
+CREATE TABLE shaker_samples(
+  run_id INTEGER NOT NULL, seq INTEGER NOT NULL, t REAL NOT NULL, drive_frequency_hz REAL, drive_amplitude_mm REAL,
+  base_displacement_mm REAL, mass_displacement_mm REAL, base_accel_m_s2 REAL, mass_accel_m_s2 REAL, status INTEGER,
+  PRIMARY KEY(run_id, seq)) WITHOUT ROWID;
+ALTER TABLE transmissibility ADD COLUMN step INTEGER;
+ALTER TABLE transmissibility ADD COLUMN demand_mm REAL;
+ALTER TABLE transmissibility ADD COLUMN direction TEXT;
+ALTER TABLE transmissibility ADD COLUMN detail TEXT;
+ALTER TABLE transmissibility ADD COLUMN predicted_ratio REAL;
+ALTER TABLE transmissibility ADD COLUMN predicted_phase_rad REAL;
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof kMigrations / sizeof kMigrations[0]);
 static_assert(kMigrationCount == kSchemaVersion);

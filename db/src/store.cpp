@@ -8,6 +8,7 @@
 #include <map>
 
 #include "hystlab/db/schema.hpp"
+#include "hystlab/db/signals.hpp"
 
 namespace hystlab::db {
 namespace {
@@ -26,11 +27,11 @@ struct BlockDelta {
   std::int64_t n = 0;
   double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min, d_min = t_min, d_max = -t_min,
          f_min = t_min, f_max = -t_min;
-  void add(const SampleRow& r) {
+  void add(double t, double d, double f) {
     ++n;
-    t_min = std::min(t_min, r.t), t_max = std::max(t_max, r.t);
-    d_min = std::min(d_min, r.disp), d_max = std::max(d_max, r.disp);
-    f_min = std::min(f_min, r.force), f_max = std::max(f_max, r.force);
+    t_min = std::min(t_min, t), t_max = std::max(t_max, t);
+    d_min = std::min(d_min, d), d_max = std::max(d_max, d);
+    f_min = std::min(f_min, f), f_max = std::max(f_max, f);
   }
 };
 
@@ -51,7 +52,9 @@ Store::Store(const std::string& path, bool synchronous_full)
                     "VALUES(?,?,?,?,?,?,?,?,?) ON CONFLICT(run_id, block) DO UPDATE SET n = n + excluded.n, "
                     "t_min = min(t_min, excluded.t_min), t_max = max(t_max, excluded.t_max), "
                     "disp_min = min(disp_min, excluded.disp_min), disp_max = max(disp_max, excluded.disp_max), "
-                    "force_min = min(force_min, excluded.force_min), force_max = max(force_max, excluded.force_max)") {}
+                    "force_min = min(force_min, excluded.force_min), force_max = max(force_max, excluded.force_max)"),
+      insert_shaker_(db_, "INSERT INTO shaker_samples(run_id, seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, "
+                          "mass_displacement_mm, base_accel_m_s2, mass_accel_m_s2, status) VALUES(?,?,?,?,?,?,?,?,?,?)") {}
 
 std::int64_t Store::upsert_rig(const std::string& name, const std::string& config, const std::string& now) {
   Statement st(db_, "INSERT INTO rigs(name, config, created_at) VALUES(?,?,?) "
@@ -133,6 +136,23 @@ std::int64_t Store::add_transmissibility(std::int64_t run, double f, double base
   return db_.last_insert_rowid();
 }
 
+std::int64_t Store::add_sine_point(std::int64_t run, const SinePointRow& p) {
+  Statement st(db_, "INSERT INTO transmissibility(run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad, step, demand_mm, "
+                    "direction, detail) VALUES(?,?,?,?,?,?,?,?,?,?)");
+  st.bind(1, run).bind(2, p.frequency_hz).bind(3, p.base_amplitude_mm).bind(4, p.mass_amplitude_mm).bind(5, p.ratio).bind(6, p.phase_rad);
+  st.bind(7, p.step).bind(8, p.demand_mm).bind(9, p.direction).bind(10, p.detail);
+  st.step();
+  records_changed();
+  return db_.last_insert_rowid();
+}
+
+void Store::set_prediction(std::int64_t point, double ratio, double phase) {
+  Statement st(db_, "UPDATE transmissibility SET predicted_ratio = ?, predicted_phase_rad = ? WHERE id = ?");
+  st.bind(1, ratio).bind(2, phase).bind(3, point);
+  st.step();
+  records_changed();
+}
+
 std::int64_t Store::add_fot_node(std::int64_t run, double a, double b, double fa, double fab, double t) {
   Statement st(db_, "INSERT INTO fot_nodes(run_id, alpha, beta, force_alpha, force_alpha_beta, t) VALUES(?,?,?,?,?,?)");
   st.bind(1, run).bind(2, a).bind(3, b).bind(4, fa).bind(5, fab).bind(6, t);
@@ -186,13 +206,32 @@ std::vector<std::tuple<double, double, double, double>> Store::fot_nodes_of_camp
   return out;
 }
 
+namespace {
+using Blocks = std::map<std::pair<std::int64_t, std::int64_t>, BlockDelta>;
+}
+
 void Store::insert_samples(std::span<const SampleRow> rows) {
-  std::map<std::pair<std::int64_t, std::int64_t>, BlockDelta> blocks;
-  for (const SampleRow& r : rows) {
-    insert_sample_.reset();
-    insert_sample_.bind(1, r.run_id).bind(2, r.seq).bind(3, r.t).bind(4, r.cmd).bind(5, r.disp).bind(6, r.force).bind(7, r.status);
-    insert_sample_.step();
-    blocks[{r.run_id, r.seq / kBlockSize}].add(r);
+  std::vector<AnyRow> all(rows.begin(), rows.end());
+  insert_rows(all);
+}
+
+void Store::insert_rows(std::span<const AnyRow> rows) {
+  Blocks blocks;
+  for (const AnyRow& any : rows) {
+    if (const auto* r = std::get_if<SampleRow>(&any)) {
+      insert_sample_.reset();
+      insert_sample_.bind(1, r->run_id).bind(2, r->seq).bind(3, r->t).bind(4, r->cmd).bind(5, r->disp).bind(6, r->force).bind(7, r->status);
+      insert_sample_.step();
+      blocks[{r->run_id, r->seq / kBlockSize}].add(r->t, r->disp, r->force);
+      continue;
+    }
+    const ShakerRow& r = std::get<ShakerRow>(any);
+    insert_shaker_.reset();
+    insert_shaker_.bind(1, r.run_id).bind(2, r.seq).bind(3, r.t);
+    for (std::size_t k = 0; k < r.v.size(); ++k) insert_shaker_.bind(static_cast<int>(k) + 4, r.v[k]);
+    insert_shaker_.bind(10, r.status);
+    insert_shaker_.step();
+    blocks[{r.run_id, r.seq / kBlockSize}].add(r.t, r.v[shaker_signal::base_displacement], r.v[shaker_signal::mass_displacement]);
   }
   for (const auto& [key, b] : blocks) {
     upsert_block_.reset();
@@ -262,7 +301,7 @@ std::int64_t Store::max_seq(std::int64_t run) {
 // Raw rows an overview reads at most (about 0.2 s here); beyond, block summaries.
 constexpr std::int64_t kRawOverviewRows = 200'000;
 
-std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int buckets) {
+std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int buckets, bool shaker) {
   std::vector<Bucket> out(static_cast<std::size_t>(std::max(1, buckets)));
   const double span = t1 > t0 ? t1 - t0 : 1.0;
   auto slot = [&](double t) {
@@ -293,9 +332,15 @@ std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int 
     std::erase_if(from_blocks, [](const Bucket& b) { return b.n == 0; });
     return from_blocks;
   }
-  for_each_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const SampleRow& r) {
-    if (r.t >= t0 && r.t <= t1) merge(out[slot(r.t)], r.t, r.t, r.disp, r.disp, r.force, r.force, 1);
-  });
+  auto take = [&](double t, double d, double f) {
+    if (t >= t0 && t <= t1) merge(out[slot(t)], t, t, d, d, f, f, 1);
+  };
+  if (shaker)
+    for_each_shaker_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const ShakerRow& r) {
+      take(r.t, r.v[shaker_signal::base_displacement], r.v[shaker_signal::mass_displacement]);
+    });
+  else
+    for_each_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const SampleRow& r) { take(r.t, r.disp, r.force); });
   std::erase_if(out, [](const Bucket& b) { return b.n == 0; });
   return out;
 }
@@ -305,6 +350,24 @@ void Store::for_each_sample(std::int64_t run, std::int64_t seq0, std::int64_t se
   st.bind(1, run).bind(2, seq0).bind(3, seq1);
   while (st.step())
     f(SampleRow{run, st.column_int(0), st.column_double(1), st.column_double(2), st.column_double(3), st.column_double(4), st.column_int(5)});
+}
+
+void Store::for_each_shaker_sample(std::int64_t run, std::int64_t seq0, std::int64_t seq1, const std::function<void(const ShakerRow&)>& f) {
+  Statement st(db_, "SELECT seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, mass_displacement_mm, base_accel_m_s2, "
+                    "mass_accel_m_s2, status FROM shaker_samples WHERE run_id = ? AND seq BETWEEN ? AND ? ORDER BY seq");
+  st.bind(1, run).bind(2, seq0).bind(3, seq1);
+  while (st.step()) {
+    ShakerRow r{run, st.column_int(0), st.column_double(1), {}, st.column_int(8)};
+    for (int k = 0; k < 6; ++k) r.v[static_cast<std::size_t>(k)] = st.column_double(k + 2);
+    f(r);
+  }
+}
+
+std::int64_t Store::max_shaker_seq(std::int64_t run) {
+  Statement st(db_, "SELECT coalesce(max(seq), -1) FROM shaker_samples WHERE run_id = ?");
+  st.bind(1, run);
+  st.step();
+  return st.column_int(0);
 }
 
 std::string Store::integrity_check() {

@@ -34,6 +34,11 @@ std::vector<std::int64_t> Store::runs_of_campaign(std::int64_t campaign, std::op
 std::vector<std::int64_t> Store::finish_run(const RunEnd& e) {
   std::vector<std::int64_t> ids;
   Transaction tx(db_);
+  for (const RunEnd::Prediction& p : e.predictions) {
+    Statement st(db_, "UPDATE transmissibility SET predicted_ratio = ?, predicted_phase_rad = ? WHERE run_id = ? AND step = ?");
+    st.bind(1, p.ratio).bind(2, p.phase_rad).bind(3, e.run).bind(4, p.step);
+    st.step();
+  }
   if (table_count(e.campaign) == 0) {
     for (const TableRecord& t : e.tables)
       ids.push_back(add_table(e.campaign, e.run, t.method, t.n, t.lo, t.hi, e.now, t.accuracy_json, t.document_json));

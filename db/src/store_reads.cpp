@@ -126,11 +126,14 @@ std::vector<NodeInfo> Store::nodes(std::int64_t campaign) {
 
 std::vector<TransmissibilityInfo> Store::transmissibility(std::int64_t campaign) {
   Statement st(db_, "SELECT t.id, t.run_id, frequency_hz, coalesce(base_amplitude_mm, 0), coalesce(mass_amplitude_mm, 0), coalesce(ratio, 0), "
-                    "coalesce(phase_rad, 0) FROM transmissibility t JOIN runs r ON r.id = t.run_id WHERE r.campaign_id = ? ORDER BY t.id");
+                    "coalesce(phase_rad, 0), coalesce(step, 0), coalesce(demand_mm, 0), coalesce(direction, ''), coalesce(detail, ''), "
+                    "predicted_ratio, predicted_phase_rad FROM transmissibility t JOIN runs r ON r.id = t.run_id WHERE r.campaign_id = ? ORDER BY t.id");
   st.bind(1, campaign);
   return all<TransmissibilityInfo>(st, [](Statement& s) {
-    return TransmissibilityInfo{s.column_int(0), s.column_int(1), s.column_double(2), s.column_double(3), s.column_double(4), s.column_double(5),
-                                s.column_double(6)};
+    TransmissibilityInfo t{s.column_int(0), s.column_int(1), s.column_double(2), s.column_double(3), s.column_double(4), s.column_double(5),
+                           s.column_double(6), s.column_int(7), s.column_double(8), s.column_text(9), s.column_text(10)};
+    if (!s.column_is_null(11)) t.predicted_ratio = s.column_double(11), t.predicted_phase_rad = s.column_double(12);
+    return t;
   });
 }
 
@@ -173,7 +176,7 @@ std::int64_t Store::newest_id(const std::string& table) {
 }
 
 std::int64_t Store::read_xy(std::int64_t run, std::int64_t seq0, bool base_mass, std::vector<float>& x, std::vector<float>& y) {
-  Statement st(db_, base_mass ? "SELECT seq, cmd, disp FROM samples WHERE run_id = ? AND seq >= ? ORDER BY seq"
+  Statement st(db_, base_mass ? "SELECT seq, base_displacement_mm, mass_displacement_mm FROM shaker_samples WHERE run_id = ? AND seq >= ? ORDER BY seq"
                               : "SELECT seq, disp, force FROM samples WHERE run_id = ? AND seq >= ? ORDER BY seq");
   st.bind(1, run);
   st.bind(2, seq0);

@@ -24,6 +24,10 @@ ShakerSim::ShakerSim(const models::HysteresisModel& spring, ShakerParams params)
     (p_.springs * s->step(mid) < p_.mass_kg * kG ? lo : hi) = mid;
   }
   preload_mm_ = 0.5 * (lo + hi);
+  weight_N_ = p_.mass_kg * kG;
+  if (p_.servo_hz < 0 || (p_.servo_hz > 0 && !(p_.table_mass_kg > 0)) || p_.servo_damping < 0)
+    throw std::invalid_argument("shaker: servo_hz ≥ 0, servo_damping ≥ 0 and table_mass_kg > 0");
+  if (2 * std::numbers::pi * p_.servo_hz * p_.dt_s > 0.5) throw std::invalid_argument("shaker: time step too large for the servo (dt·ω > 0.5)");
   for (int k = 0; k < p_.springs; ++k) {
     springs_.push_back(spring.clone());
     springs_.back()->reset();
@@ -65,22 +69,32 @@ void ShakerSim::publish_status() noexcept {
 void ShakerSim::integrate_once() noexcept {
   const double dt = p_.dt_s;
   const double w = 2 * std::numbers::pi * cmd_.frequency_hz;
-  // Off, faulted or e-stopped: the drive goes to zero amplitude.
+  // Off, faulted or e-stopped: the drive goes to zero amplitude (the table comes to rest).
   const bool on = ctl_.drive_on();
   const double amplitude_m = cmd_.amplitude_mm * 1e-3;
   if (on) phase_ += w * dt;
-  const double y = on ? amplitude_m * std::sin(phase_) : 0.0;
-  const double yd = on ? amplitude_m * w * std::cos(phase_) : 0.0;
-  const double ydd = on ? -amplitude_m * w * w * std::sin(phase_) : 0.0;
-  const double compression_mm = preload_mm_ - (x_ - y) * 1e3;
+  const double u = on ? amplitude_m * std::sin(phase_) : 0.0;
+  const double compression_mm = preload_mm_ - (x_ - y_) * 1e3;
   double force = 0;
   for (auto& s : springs_) force += s->step(compression_mm);
-  const double a = (force - p_.mass_kg * kG - p_.damping_N_s_per_m * (v_ - yd)) / p_.mass_kg;
+  const double push = force - p_.damping_N_s_per_m * (v_ - yv_);  // springs and damper, up on the mass, down on the table
+  const double a = (push - weight_N_) / p_.mass_kg;
+  double ay = 0;
+  if (p_.servo_hz > 0) {  // the servo pulls the table to the drive; the isolator's dynamic load pushes it back
+    const double ws = 2 * std::numbers::pi * p_.servo_hz;
+    ay = ws * ws * (u - y_) - 2 * p_.servo_damping * ws * yv_ - (push - weight_N_) / p_.table_mass_kg;
+    yv_ += ay * dt;
+    y_ += yv_ * dt;
+  } else {  // an ideal table
+    const double yv = on ? amplitude_m * w * std::cos(phase_) : 0.0;
+    ay = on ? -amplitude_m * w * w * std::sin(phase_) : 0.0;
+    y_ = u, yv_ = yv;
+  }
   v_ += a * dt;  // semi-implicit Euler: velocity first, then position with the new velocity
   x_ += v_ * dt;
-  state_.base_accel_m_s2 = ydd;
+  state_.base_accel_m_s2 = ay;
   state_.mass_accel_m_s2 = a;
-  state_.base_displacement_mm = y * 1e3;
+  state_.base_displacement_mm = y_ * 1e3;
   state_.mass_displacement_mm = x_ * 1e3;
 }
 

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "../drivers/sim_process.hpp"
+#include "campaign_bench.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
@@ -33,88 +34,9 @@
 namespace fs = std::filesystem;
 using namespace hystlab;
 using hystlab::test::SimProcess;
+using namespace hystlab::test;
 
 namespace {
-struct Bench {  // a db file, a writer, and a campaign row
-  Bench(std::size_t capacity = 1U << 17) {
-    char tmpl[] = "/tmp/hystlab-campaign-XXXXXX";
-    dir = mkdtemp(tmpl);
-    path = (dir / "hystlab.db").string();
-    store = std::make_unique<db::Store>(path);
-    writer = std::make_unique<db::SampleWriter>(path, db::WriterOptions{capacity, 0.1, 50'000, true});
-    rig_id = store->upsert_rig("sim", "{}", "t");
-  }
-  ~Bench() {
-    writer.reset();
-    store.reset();
-    fs::remove_all(dir);
-  }
-  std::int64_t submit(const nlohmann::json& plan) { return store->create_campaign(rig_id, daemon::parse_plan(plan).kind, plan.dump(), "t"); }
-  fs::path dir;
-  std::string path;
-  std::unique_ptr<db::Store> store;
-  std::unique_ptr<db::SampleWriter> writer;
-  std::int64_t rig_id = 0;
-  daemon::SteadyClock clock;
-  std::unique_ptr<daemon::Supervisor> sup;  // one per rig, as in the daemon
-};
-
-struct Controls {  // what the HTTP threads will do: queue commands for the acquisition thread
-  std::mutex mu;
-  std::deque<daemon::Control> q;
-  void push(daemon::Control c) {
-    std::lock_guard lk(mu);
-    q.push_back(c);
-  }
-  std::optional<daemon::Control> pop() {
-    std::lock_guard lk(mu);
-    if (q.empty()) return std::nullopt;
-    auto c = q.front();
-    q.pop_front();
-    return c;
-  }
-};
-
-nlohmann::json fot_plan(int n, double rate = 0.1) {
-  return {{"kind", "fot"}, {"range_mm", {0.0, 4.0}}, {"subdivisions", n}, {"ramp_rate_mm_s", rate}, {"sample_rate_hz", 1000},
-          {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 50}}}};
-}
-
-std::unique_ptr<drivers::Rig> tcp_rig(int port) {
-  return drivers::make_rig({{"transport", "modbus-tcp"}, {"port", port}, {"response_timeout_ms", 50}, {"reconnect_min_ms", 10},
-                            {"reconnect_max_ms", 20}, {"stale_after_ms", 5000}});
-}
-
-daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale, bool shaker = false) {
-  b.sup = std::make_unique<daemon::Supervisor>(rig, daemon::SupervisionSettings{}, shaker, [](const daemon::RigTransition& t) {
-    if (std::getenv("HYSTLAB_TRACE"))
-      std::fprintf(stderr, "%.3f %s -> %s: %s\n", t.t, std::string(daemon::to_string(t.from)).c_str(), std::string(daemon::to_string(t.to)).c_str(), t.reason.c_str());
-  });
-  daemon::RunnerContext ctx{rig, *b.sup, *b.writer, b.clock};
-  ctx.time_scale = scale;
-  ctx.now_iso = [] { return std::string("2026-11-23T00:00:00Z"); };
-  if (c) ctx.next_control = [c] { return c->pop(); };
-  return ctx;
-}
-// Limits for the envelope tests: -1..5 mm, 100 N, and the rate limit given.
-daemon::Limits envelope_limits(double rate_mm_s) {
-  daemon::Limits l;
-  l.displacement_min_mm = -1;
-  l.displacement_max_mm = 5;
-  l.force_max_N = 100;
-  l.rate_max_mm_s = rate_mm_s;
-  return l;
-}
-
-// A campaign as the daemon hands it over: the plan within the rig's envelope (the defaults).
-daemon::RunnerResult run(std::int64_t id, const daemon::Plan& plan, daemon::RunnerContext& ctx) {
-  daemon::CampaignJob j;
-  j.id = id;
-  j.plan = plan;
-  j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, plan.kind == db::CampaignKind::sine);
-  return daemon::run_campaign(j, ctx);
-}
-std::string end_of(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }
 
 // Runs a campaign while another thread sends the simulator faults: (wait in ms, command) in turn,
 // counted from the campaign's "running" (arming takes a database round trip first, and a starved
@@ -419,39 +341,6 @@ TEST_CASE("plans: an error names the field and the reason") {
   } catch (const daemon::PlanError& e) {
     CHECK(std::string(e.what()).find("ramp_rate_mm_s 30 exceeds the rig's maximum speed 20 mm/s") != std::string::npos);
   }
-}
-
-TEST_CASE("sine campaign on the simulated shaker: transmissibility per frequency, stored as it comes") {
-  // In slow motion (time scale 0.25): polled at 1 kHz, a starved 2-core VM leaves gaps of
-  // 50-600 ms, and at 10 Hz in real time every window had over half of it in gaps (the campaign
-  // then fails, rightly). Slowed down, a quarter cycle at 10 Hz is 100 ms of wall time.
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"});
-  Bench b;
-  auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", sim.modbus_port}, {"rig", "shaker"}, {"stale_after_ms", 5000}});
-  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {10, 40, 60}}, {"amplitude_mm", 0.2},
-                                        {"settle_cycles", 10}, {"measured_cycles", 10}, {"sample_rate_hz", 1000}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 0.25, true);
-  const auto r = run(id, plan, ctx);
-  CAPTURE(r.reason);
-  REQUIRE(end_of(r) == "completed");
-  db::Statement st(b.store->database(), "SELECT frequency_hz, ratio FROM transmissibility WHERE run_id = ? ORDER BY frequency_hz");
-  st.bind(1, r.run_id);
-  std::vector<double> ratio;
-  while (st.step()) ratio.push_back(st.column_double(1));
-  REQUIRE(ratio.size() == 3);
-  // Mass on 4 springs of 40 N/mm (austenite, small motion): f_n ≈ 90 Hz; T = 1 / (1 - (f/f_n)²).
-  CHECK(ratio[0] == doctest::Approx(1.0 / (1 - std::pow(10.0 / 90.0, 2))).epsilon(0.05));
-  CHECK(ratio[1] == doctest::Approx(1.0 / (1 - std::pow(40.0 / 90.0, 2))).epsilon(0.08));
-  CHECK(ratio[2] > ratio[1]);
-  // A load frame cannot run it: refused with the reason.
-  SimProcess frame({"--port", "0"});
-  auto frame_rig = tcp_rig(frame.modbus_port);
-  const auto id2 = b.submit(plan.source);
-  auto ctx2 = context(*frame_rig, b, nullptr, 1.0, true);
-  const auto r2 = run(id2, plan, ctx2);
-  CHECK(end_of(r2) == "failed");
-  CHECK(r2.reason.find("not one") != std::string::npos);
 }
 
 TEST_CASE("daemon config: acquisition settings and the simulator's priority, with errors that name the field") {

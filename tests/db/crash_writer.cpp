@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
   auto next_print = std::chrono::steady_clock::now();
   for (;;) {
     for (int k = 0; k < 200; ++k, ++seq)
-      w.try_push({run, seq, static_cast<double>(seq) * 5e-5, 0.0, std::sin(static_cast<double>(seq) * 1e-3), 1.0, 1});
+      w.try_push(hystlab::db::SampleRow{run, seq, static_cast<double>(seq) * 5e-5, 0.0, std::sin(static_cast<double>(seq) * 1e-3), 1.0, 1});
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     if (std::chrono::steady_clock::now() >= next_print) {
       std::printf("ack %lld\n", static_cast<long long>(w.stats().acknowledged_seq));

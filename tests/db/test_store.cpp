@@ -172,7 +172,7 @@ TEST_CASE("writer: batches committed off the caller's thread; a full ring is cou
   }
   {
     SampleWriter w(t.path, WriterOptions{1U << 12, 0.05, 1000, true});
-    for (std::int64_t k = 0; k < 3000; ++k) REQUIRE(w.try_push({run, k, static_cast<double>(k), 0, 0, 0, 0}));
+    for (std::int64_t k = 0; k < 3000; ++k) REQUIRE(w.try_push(SampleRow{run, k, static_cast<double>(k), 0, 0, 0, 0}));
     w.flush();
     const WriterStats st = w.stats();
     CHECK(st.written == 3000);
@@ -181,7 +181,7 @@ TEST_CASE("writer: batches committed off the caller's thread; a full ring is cou
     CHECK(st.dropped_full == 0);
     // Far more than the ring holds, faster than any disk: the overflow is counted.
     std::int64_t accepted = 0;
-    for (std::int64_t k = 3000; k < 3000 + 200'000; ++k) accepted += w.try_push({run, k, static_cast<double>(k), 0, 0, 0, 0}) ? 1 : 0;
+    for (std::int64_t k = 3000; k < 3000 + 200'000; ++k) accepted += w.try_push(SampleRow{run, k, static_cast<double>(k), 0, 0, 0, 0}) ? 1 : 0;
     w.flush();
     const WriterStats after = w.stats();
     CHECK(after.dropped_full > 0);

@@ -365,7 +365,8 @@ TEST_CASE("shaker over modbus: base excitation moves the mass") {
     mass_max = std::max(mass_max, std::fabs(s.mass_displacement_mm));
     sleep_ms(2);
   }
-  CHECK(base_max == doctest::Approx(0.5).epsilon(0.05));
+  CHECK(base_max > 0.45);  // the drive's 0.5 mm through the table (see below)
+  CHECK(base_max < 0.7);
   CHECK(mass_max > 0.1);
   RigSample r;
   CHECK(rig.read_sample(steady_now(), r) == RigError::unsupported);
@@ -373,9 +374,9 @@ TEST_CASE("shaker over modbus: base excitation moves the mass") {
   // The operator's e-stop: zero amplitude, enable ignored, until reset_faults and a new enable.
   REQUIRE(sim.control("fault estop").rfind("ok", 0) == 0);
   REQUIRE_FALSE(rig.command_shaker(10.0, 0.5, true));
-  sleep_ms(30);
+  sleep_ms(300);  // the table coasts to rest (a servo-driven mass, drivers/SIM.md)
   REQUIRE_FALSE(rig.read_shaker(steady_now(), s));
-  CHECK(s.base_displacement_mm == 0.0);
+  CHECK(std::fabs(s.base_displacement_mm) < 0.01);
   CHECK(s.fault_code == 3);
   CHECK(rig.fault_text(s.fault_code) == "e-stop pressed");
   CHECK((s.status_word & protocols::status::estop) != 0);
@@ -389,7 +390,10 @@ TEST_CASE("shaker over modbus: base excitation moves the mass") {
       base_max = std::max(base_max, std::fabs(s.base_displacement_mm));
     }
   CHECK(good > 50);
-  CHECK(base_max == doctest::Approx(0.5).epsilon(0.05));
+  // Open loop, from rest: the table's response at 10 Hz under the isolator's load, with its
+  // starting transient (the daemon closes the loop on the measured base; this is the drive alone).
+  CHECK(base_max > 0.45);
+  CHECK(base_max < 0.7);
   CHECK(s.fault_code == 0);
 }
 

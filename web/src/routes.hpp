@@ -12,6 +12,9 @@ void add_status_routes(httplib::Server& s, ApiContext& c);    // status, rigs
 void add_campaign_routes(httplib::Server& s, ApiContext& c);  // campaigns, commands, events, nodes, runs
 void add_data_routes(httplib::Server& s, ApiContext& c);      // samples, tables, exports, evaluation
 void add_loop_routes(httplib::Server& s, ApiContext& c);      // runs' x-y paths, plan previews
+void add_sweep_routes(httplib::Server& s, ApiContext& c);     // a sine campaign's points, resonances, jumps
+
+db::CampaignRow campaign_or_404(db::Store& store, std::int64_t id);
 
 json campaign_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row, bool details);
 json node_json(const db::NodeInfo& n);

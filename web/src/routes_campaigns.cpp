@@ -1,5 +1,4 @@
-// Campaigns: submit, list, get, commands; their events, FOT nodes (coverage), runs and
-// transmissibility.
+// Campaigns: submit, list, get, commands; their events, FOT nodes (coverage) and runs.
 #include <set>
 
 #include "hystlab/models/grid.hpp"
@@ -7,12 +6,13 @@
 #include "routes.hpp"
 
 namespace hystlab::web {
-namespace {
 db::CampaignRow campaign_or_404(db::Store& store, std::int64_t id) {
   auto row = store.campaign(id);
   if (!row) throw ApiError(404, "not found", "no campaign " + std::to_string(id));
   return *row;
 }
+
+namespace {
 
 json runs_of(db::Store& store, std::int64_t campaign) {
   json runs = json::array();
@@ -161,15 +161,6 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/campaigns/(\d+)/runs)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
     send_json(res, runs_of(store, campaign_or_404(store, path_id(req)).id));
-  }));
-  s.Get(R"(/api/campaigns/(\d+)/transmissibility)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    const auto row = campaign_or_404(store, path_id(req));
-    json out = json::array();
-    for (const db::TransmissibilityInfo& t : store.transmissibility(row.id))
-      out.push_back({{"id", t.id}, {"run", t.run}, {"frequency_hz", t.frequency_hz}, {"base_amplitude_mm", t.base_amplitude_mm},
-                     {"mass_amplitude_mm", t.mass_amplitude_mm}, {"ratio", t.ratio}, {"phase_rad", t.phase_rad}});
-    send_json(res, out);
   }));
 }
 

@@ -8,6 +8,7 @@
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/table_export.hpp"
 #include "hystlab/models/table_score.hpp"
+#include "hystlab/db/signals.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
 
@@ -41,31 +42,54 @@ std::unique_ptr<models::HysteresisModel> model_of(const json& body, db::Store& s
   return std::make_unique<models::SimplifiedSmaModel>(models::params_from_json(body["params"].dump()));
 }
 
-void stream_csv(httplib::Response& res, const std::string& db_path, std::int64_t run) {
-  res.set_header("Content-Disposition", "attachment; filename=\"run-" + std::to_string(run) + ".csv\"");
-  auto next = std::make_shared<std::int64_t>(-1);  // -1: the header is still to be sent
-  res.set_chunked_content_provider("text/csv", [db_path, run, next](std::size_t, httplib::DataSink& sink) {
-    if (*next < 0) {
-      const std::string head = "seq,t_s,command_mm,displacement_mm,force_N,status\n";
-      *next = 0;
-      return sink.write(head.data(), head.size());
-    }
-    std::string chunk;
-    std::int64_t rows = 0;
-    reader(db_path).for_each_sample(run, *next, *next + kCsvChunk - 1, [&](const db::SampleRow& r) {
-      char line[200];
-      const int n = std::snprintf(line, sizeof line, "%lld,%.9g,%.9g,%.9g,%.9g,%lld\n", static_cast<long long>(r.seq), r.t, r.cmd,
-                                  r.disp, r.force, static_cast<long long>(r.status));
+// One chunk of a run's rows as CSV lines; rows: how many there were.
+std::string csv_chunk(db::Store& store, std::int64_t run, bool shaker, std::int64_t seq0, std::int64_t& rows) {
+  std::string chunk;
+  char line[320];
+  if (shaker) {
+    store.for_each_shaker_sample(run, seq0, seq0 + kCsvChunk - 1, [&](const db::ShakerRow& r) {
+      const int n = std::snprintf(line, sizeof line, "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%lld\n", static_cast<long long>(r.seq), r.t, r.v[0],
+                                  r.v[1], r.v[2], r.v[3], r.v[4], r.v[5], static_cast<long long>(r.status));
       chunk.append(line, static_cast<std::size_t>(n));
       ++rows;
     });
+    return chunk;
+  }
+  store.for_each_sample(run, seq0, seq0 + kCsvChunk - 1, [&](const db::SampleRow& r) {
+    const int n = std::snprintf(line, sizeof line, "%lld,%.9g,%.9g,%.9g,%.9g,%lld\n", static_cast<long long>(r.seq), r.t, r.cmd, r.disp, r.force,
+                                static_cast<long long>(r.status));
+    chunk.append(line, static_cast<std::size_t>(n));
+    ++rows;
+  });
+  return chunk;
+}
+
+// The columns are the rig kind's signals (db/signals.hpp): a shaker's are its own, not the load frame's.
+void stream_csv(httplib::Response& res, const std::string& db_path, std::int64_t run, bool shaker) {
+  res.set_header("Content-Disposition", "attachment; filename=\"run-" + std::to_string(run) + ".csv\"");
+  auto next = std::make_shared<std::int64_t>(-1);  // -1: the header is still to be sent
+  res.set_chunked_content_provider("text/csv", [db_path, run, next, shaker](std::size_t, httplib::DataSink& sink) {
+    if (*next < 0) {
+      const std::string head = shaker ? db::csv_header(db::kShakerSignals) : db::csv_header(db::kFrameSignals);
+      *next = 0;
+      return sink.write(head.data(), head.size());
+    }
+    std::int64_t rows = 0;
+    db::Store& store = reader(db_path);
+    const std::string chunk = csv_chunk(store, run, shaker, *next, rows);
     *next += kCsvChunk;
-    if (rows == 0 && *next > reader(db_path).max_seq(run)) {
+    if (rows == 0 && *next > (shaker ? store.max_shaker_seq(run) : store.max_seq(run))) {
       sink.done();
       return true;
     }
     return chunk.empty() || sink.write(chunk.data(), chunk.size());
   });
+}
+
+// A shaker's run (its campaign is a sine sweep).
+bool shaker_run(db::Store& store, const db::RunInfo& r) {
+  const auto c = store.campaign(r.campaign);
+  return c && c->kind == db::CampaignKind::sine;
 }
 }  // namespace
 
@@ -85,18 +109,23 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
     const double t0 = query_number(req, "t0", lo, -1e12, 1e12), t1 = query_number(req, "t1", hi, -1e12, 1e12);
     if (t1 < t0) throw ApiError(400, "invalid parameter", "t1 must not be before t0");
     const int points = static_cast<int>(query_number(req, "points", 1000, 1, 100000));
+    const bool shaker = shaker_run(store, r);
     json t_min, t_max, d_min, d_max, f_min, f_max, n;
-    for (const db::Bucket& b : store.overview(r.id, t0, t1, points)) {
+    for (const db::Bucket& b : store.overview(r.id, t0, t1, points, shaker)) {
       t_min.push_back(b.t_min), t_max.push_back(b.t_max), d_min.push_back(b.disp_min), d_max.push_back(b.disp_max);
       f_min.push_back(b.force_min), f_max.push_back(b.force_max), n.push_back(b.n);
     }
-    send_json(res, {{"run", r.id}, {"t0", t0}, {"t1", t1}, {"buckets", n.size()},
-                    {"t_min", t_min}, {"t_max", t_max}, {"displacement_min_mm", d_min}, {"displacement_max_mm", d_max},
-                    {"force_min_N", f_min}, {"force_max_N", f_max}, {"n", n}});
+    // Each bucket's min and max: a shaker's base and mass displacement (its envelope over the
+    // bucket), a load frame's displacement and force.
+    const std::string a = shaker ? "base_displacement" : "displacement", b = shaker ? "mass_displacement" : "force";
+    const std::string bu = shaker ? "_mm" : "_N";
+    send_json(res, {{"run", r.id}, {"t0", t0}, {"t1", t1}, {"buckets", n.size()}, {"t_min", t_min}, {"t_max", t_max},
+                    {a + "_min_mm", d_min}, {a + "_max_mm", d_max}, {b + "_min" + bu, f_min}, {b + "_max" + bu, f_max}, {"n", n}});
   }));
   s.Get(R"(/api/runs/(\d+)/samples\.csv)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    const db::RunInfo r = run_or_404(reader(c.db_path), path_id(req));
-    stream_csv(res, c.db_path, r.id);
+    auto& store = reader(c.db_path);
+    const db::RunInfo r = run_or_404(store, path_id(req));
+    stream_csv(res, c.db_path, r.id, shaker_run(store, r));
   }));
   s.Get("/api/tables", guarded([&c](const httplib::Request&, httplib::Response& res) {
     json out = json::array();

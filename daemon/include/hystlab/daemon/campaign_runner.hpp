@@ -15,6 +15,7 @@
 
 #include "hystlab/daemon/clock.hpp"
 #include "hystlab/db/campaign_enums.hpp"
+#include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/supervisor.hpp"
@@ -47,6 +48,7 @@ struct RunSeries {  // the measured loop, kept for the fits (about 16 bytes per 
 struct CampaignJob {
   std::int64_t id = 0;
   Plan plan;
+  std::shared_ptr<const IsolatorModel> isolator;  // a shaker's, when the daemon has a model of it (sine)
   std::vector<models::FotNode> prior_nodes;
   RunSeries prior_series;
 };
@@ -78,6 +80,8 @@ struct FinishJob {
   std::size_t rows_begin = 0;  // series[rows_begin..] came after training (loops before it are training loops)
   RunSeries validation;        // the validation run's samples: every table is scored on them
   std::string training_summary;  // what training came to (empty: no training)
+  std::shared_ptr<const IsolatorModel> isolator;  // sine: predict each point with it
+  std::vector<std::pair<std::int64_t, PredictStep>> sine_steps;  // sine: each stored point's step number and what to predict
 };
 
 struct RunnerContext {

@@ -22,6 +22,7 @@
 #include "hystlab/control/values.hpp"
 #include "hystlab/control/http_config.hpp"
 #include "hystlab/daemon/envelope.hpp"
+#include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/realtime.hpp"
@@ -54,6 +55,8 @@ struct RigEntry {
   SimulatorOptions sim;
   RigEnvelope envelope;             // "envelope": what the rig can do (plans are checked against it)
   SupervisionSettings supervision;  // "supervision": dead band, lag, settle, mode, heartbeat, ...
+  // "isolator" (a shaker's; a simulated shaker's is the simulator's own): sine points are predicted with it
+  std::shared_ptr<const IsolatorModel> isolator;
 };
 
 using control::HttpConfig;

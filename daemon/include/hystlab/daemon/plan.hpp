@@ -15,8 +15,8 @@
 //    "nodes_mm": [0, 1, 1.5, 1.75, 2, 2.25, 2.5, 3, 4] instead of range_mm and subdivisions: a grid
 //      of its own, refined where accuracy is needed (table format version 2)
 //   {"kind": "waveform", "points_mm": [0, 2, 1, 3, 0], "ramp_rate_mm_s": 0.5, ...}
-//   {"kind": "sine", "frequencies_hz": [5, 10, 20], "amplitude_mm": 0.2, "settle_cycles": 10, "measured_cycles": 10}
-//   {"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "steps": 12, "spacing": "log"}, "amplitude_mm": 0.2}
+//   {"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "steps": 24}, "direction": "up-down", "amplitudes_mm": [0.01, 0.1]}
+//     (the whole form in sine_plan.hpp)
 // Times are rig time (a simulated rig's time scale is applied by the daemon).
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "hystlab/control/values.hpp"
+#include "hystlab/daemon/sine_plan.hpp"
 #include "hystlab/db/campaign_enums.hpp"
 #include "hystlab/models/grid.hpp"
 
@@ -70,10 +71,8 @@ struct Plan {
   std::vector<double> plateaus_mm;
   // waveform
   std::vector<double> points_mm;
-  // sine (shaker dwell or stepped sweep)
-  std::vector<double> frequencies_hz;
-  double amplitude_mm = 0;
-  int settle_cycles = 10, measured_cycles = 10;
+  // sine (shaker: stepped or continuous sweeps, closed-loop base amplitude)
+  SinePlan sine;
   // common
   double ramp_rate_mm_s = 0.5, dwell_s = 0.0, sample_rate_hz = 1000.0;
   Limits limits;

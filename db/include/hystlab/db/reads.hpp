@@ -1,6 +1,7 @@
 #pragma once
 // The rows the API and the CLI read, as value types: what they query lives here, in db/, and
 // nowhere else holds SQL.
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -37,6 +38,17 @@ struct NodeInfo {
 struct TransmissibilityInfo {
   std::int64_t id = 0, run = 0;
   double frequency_hz = 0, base_amplitude_mm = 0, mass_amplitude_mm = 0, ratio = 0, phase_rad = 0;
+  // Since schema 5 (a sweep of several amplitudes and directions): 0, "" and NaN in older rows.
+  std::int64_t step = 0;
+  double demand_mm = 0;
+  std::string direction, detail;  // detail: the step's whole record (JSON), "" when none
+  double predicted_ratio = NAN, predicted_phase_rad = NAN;
+};
+
+struct SinePointRow {
+  std::int64_t step = 0;
+  double frequency_hz = 0, demand_mm = 0, base_amplitude_mm = 0, mass_amplitude_mm = 0, ratio = 0, phase_rad = 0;
+  std::string direction, detail;
 };
 
 // An event with its campaign (the event stream reads them across campaigns).

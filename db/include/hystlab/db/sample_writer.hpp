@@ -43,7 +43,9 @@ class SampleWriter {
   SampleWriter& operator=(const SampleWriter&) = delete;
 
   // Acquisition thread only (single producer). Never blocks; false when the ring is full.
-  bool try_push(const SampleRow& row) noexcept {
+  bool try_push(const SampleRow& row) noexcept { return try_push(AnyRow(row)); }
+  bool try_push(const ShakerRow& row) noexcept { return try_push(AnyRow(row)); }
+  bool try_push(const AnyRow& row) noexcept {
     if (ring_.try_push(row)) {
       pushed_.fetch_add(1, std::memory_order_relaxed);
       return true;
@@ -86,11 +88,11 @@ class SampleWriter {
 
  private:
   void run();
-  bool write_batch(std::vector<SampleRow>& batch, Store& store);
+  bool write_batch(std::vector<AnyRow>& batch, Store& store);
 
   WriterOptions opt_;
   std::string path_;
-  SpscRing<SampleRow> ring_;
+  SpscRing<AnyRow> ring_;
   std::atomic<std::uint64_t> pushed_{0}, dropped_{0}, written_{0}, commits_{0}, errors_{0};
   std::atomic<std::int64_t> ack_run_{0}, ack_seq_{-1};
   std::atomic<double> max_commit_ms_{0};

@@ -7,6 +7,8 @@
 #include <span>
 #include <string>
 #include <tuple>
+#include <variant>
+#include <array>
 #include <vector>
 
 #include "hystlab/db/campaign_enums.hpp"
@@ -17,11 +19,20 @@ namespace hystlab::db {
 
 inline constexpr std::int64_t kBlockSize = 1024;  // samples per summary block
 
-struct SampleRow {
+struct SampleRow {  // a load frame's sample
   std::int64_t run_id = 0, seq = 0;
   double t = 0, cmd = 0, disp = 0, force = 0;
   std::int64_t status = 0;
 };
+
+struct ShakerRow {  // a shaker's sample: its signals in the order of kShakerSignals (signals.hpp)
+  std::int64_t run_id = 0, seq = 0;
+  double t = 0;
+  std::array<double, 6> v{};
+  std::int64_t status = 0;
+};
+
+using AnyRow = std::variant<SampleRow, ShakerRow>;
 
 struct Bucket {  // min/max of one stretch of a run: no peak is lost by decimation
   double t_min = 0, t_max = 0, disp_min = 0, disp_max = 0, force_min = 0, force_max = 0;
@@ -96,6 +107,11 @@ class Store {
     // "recommendation" event naming the new table's id, before the campaign's last state.
     std::optional<std::size_t> recommended;
     std::string recommendation;
+    struct Prediction {
+      std::int64_t step = 0;
+      double ratio = 0, phase_rad = 0;
+    };
+    std::vector<Prediction> predictions;  // sine: beside the run's points of these step numbers
   };
   // Ends a run (and its validation run) and its campaign in one transaction: the tables, the loop
   // figures, the runs' state, the campaign's state with its transition event. When the campaign
@@ -110,8 +126,10 @@ class Store {
   [[nodiscard]] std::vector<std::int64_t> queued_campaigns(std::int64_t rig_id);
   [[nodiscard]] std::vector<std::tuple<double, double, double, double>> fot_nodes_of_campaign(std::int64_t campaign_id);
 
-  // Inserts rows and their block summaries; the caller holds the transaction.
+  // Inserts rows and their block summaries; the caller holds the transaction. A shaker run's
+  // block summaries hold its base (disp_*) and mass (force_*) displacement: an index for overviews.
   void insert_samples(std::span<const SampleRow> rows);
+  void insert_rows(std::span<const AnyRow> rows);
 
   [[nodiscard]] std::optional<CampaignRow> campaign(std::int64_t id);
   [[nodiscard]] std::vector<CampaignRow> campaigns();
@@ -120,9 +138,15 @@ class Store {
   [[nodiscard]] std::int64_t max_seq(std::int64_t run_id);  // -1 when none
   // Decimated overview of [t0, t1] in at most `buckets` buckets (blocks when the range is long,
   // raw samples when it is short).
-  [[nodiscard]] std::vector<Bucket> overview(std::int64_t run_id, double t0, double t1, int buckets);
+  // A shaker run's buckets hold base (disp_*) and mass (force_*) displacement.
+  [[nodiscard]] std::vector<Bucket> overview(std::int64_t run_id, double t0, double t1, int buckets, bool shaker = false);
   void for_each_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1,
                        const std::function<void(const SampleRow&)>& f);
+  void for_each_shaker_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1, const std::function<void(const ShakerRow&)>& f);
+  [[nodiscard]] std::int64_t max_shaker_seq(std::int64_t run_id);  // -1 when none
+  // A sine step's result: the columns the sweep plots need, and the whole record as JSON.
+  std::int64_t add_sine_point(std::int64_t run, const SinePointRow& p);
+  void set_prediction(std::int64_t point_id, double ratio, double phase_rad);
   [[nodiscard]] std::string integrity_check();
 
   // ---- reads for the API and the CLI (store_reads.cpp) ----
@@ -157,6 +181,7 @@ class Store {
   void transition_in(std::int64_t campaign_id, CampaignState to, const std::string& reason, const std::string& now);
   Database db_;
   Statement insert_sample_, upsert_block_;
+  Statement insert_shaker_;  // after the others: the first one's initializer migrates the file
 };
 
 }  // namespace hystlab::db

@@ -1,0 +1,78 @@
+#pragma once
+// A sine plan as vibration engineers write one (docs/DAEMON.md, "sine"):
+//   {"kind": "sine",
+//    "sweep": {"from_hz": 5, "to_hz": 80, "steps": 24, "spacing": "log"}     stepped (or "frequencies_hz": [...])
+//          or {"from_hz": 5, "to_hz": 80, "rate_oct_min": 2}                continuous (or "rate_hz_s")
+//    "direction": "up" | "down" | "up-down",
+//    "amplitudes_mm": [0.01, 0.1]        base amplitudes (peak), each swept in turn ("amplitude_mm": one)
+//    "settle_cycles": 10                  or "settle": {"change": "2 %", "consecutive": 2, "max_cycles": 400}
+//    "measured_cycles": 10,
+//    "control": {"tolerance": "5 %", "warning": "10 %", "abort": "30 %", "gain": 0.7, "window_cycles": 4,
+//                "max_windows": 12, "max_drive_ratio": 4} or false (open loop: the drive is the demand)
+//    "jump_threshold": "10 %"}            up and down differing by more than this is a jump
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace hystlab::daemon {
+
+enum class SweepDirection : std::uint8_t { up, down, up_down };
+[[nodiscard]] const char* to_string(SweepDirection d) noexcept;
+
+// Closed-loop base amplitude, as a sine controller holds it: after each window of window_cycles
+// cycles the measured base amplitude is compared with the demand, and the drive is corrected by
+// gain × the relative error (gain 1: at once; below 1: the compression of a controller's loop).
+struct SineControl {
+  bool closed = true;
+  double tolerance_pct = 5, warning_pct = 10, abort_pct = 30, gain = 0.7;
+  int window_cycles = 4;
+  int max_windows = 12;         // control windows per step; then it is measured anyway, with a warning
+  double max_drive_ratio = 4;   // the drive never exceeds this times the demand
+};
+
+// When a step's response has settled: after `cycles` cycles at the step's final drive, or (until)
+// once the mass amplitude changes by less than change_pct between `consecutive` + 1 successive
+// windows, within max_cycles.
+struct SineSettle {
+  int cycles = 10;
+  bool until = false;
+  double change_pct = 2;
+  int consecutive = 2, max_cycles = 400;
+};
+
+struct SinePlan {
+  std::vector<double> frequencies_hz;  // stepped: the frequencies, ascending
+  bool continuous = false;
+  double from_hz = 0, to_hz = 0, rate_oct_min = 0, rate_hz_s = 0;  // continuous: one of the two rates
+  SweepDirection direction = SweepDirection::up;
+  std::vector<double> amplitudes_mm;
+  SineSettle settle;
+  int measured_cycles = 10;
+  SineControl control;
+  double jump_threshold_pct = 10;
+  [[nodiscard]] double max_amplitude_mm() const;
+  [[nodiscard]] double lowest_hz() const { return continuous ? from_hz : frequencies_hz.front(); }
+  [[nodiscard]] double highest_hz() const { return continuous ? to_hz : frequencies_hz.back(); }
+};
+
+// One pass of a sweep: one amplitude, one direction.
+struct SweepPass {
+  double amplitude_mm = 0;
+  bool up = true;
+};
+[[nodiscard]] std::vector<SweepPass> sweep_passes(const SinePlan& p);
+// A stepped pass's frequencies in the order they are driven.
+[[nodiscard]] std::vector<double> pass_frequencies(const SinePlan& p, const SweepPass& pass);
+// Nominal duration (s): every step's control, settle and measurement at its nominal length (a
+// continuous pass: its frequency span at its rate, plus the first settle).
+[[nodiscard]] double nominal_duration_s(const SinePlan& p);
+// The number of steps (points) of the plan: stepped: every frequency of every pass; continuous:
+// about one point per measured window.
+[[nodiscard]] std::size_t step_count(const SinePlan& p);
+
+// Parses the sine fields of a plan (throws PlanError naming the field); sample_rate_hz bounds
+// the frequencies (at least 8 samples a cycle).
+[[nodiscard]] SinePlan parse_sine_plan(const nlohmann::json& j, double sample_rate_hz);
+
+}  // namespace hystlab::daemon

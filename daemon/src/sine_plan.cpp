@@ -1,0 +1,183 @@
+#include "hystlab/daemon/sine_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plan_fields.hpp"
+
+namespace hystlab::daemon {
+using nlohmann::json;
+
+const char* to_string(SweepDirection d) noexcept {
+  switch (d) {
+    case SweepDirection::up: return "up";
+    case SweepDirection::down: return "down";
+    case SweepDirection::up_down: return "up-down";
+  }
+  return "?";
+}
+
+double SinePlan::max_amplitude_mm() const { return amplitudes_mm.empty() ? 0.0 : *std::max_element(amplitudes_mm.begin(), amplitudes_mm.end()); }
+
+namespace {
+std::vector<double> frequency_list(const json& a) {
+  if (!a.is_array() || a.empty() || a.size() > 1000) fields::fail("frequencies_hz", "must be an array of 1 to 1000 frequencies");
+  std::vector<double> out;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (!a[k].is_number() || !(a[k].get<double>() > 0) || a[k].get<double>() > 1000)
+      fields::fail("frequencies_hz[" + std::to_string(k) + "]", "must be a frequency above 0 and at most 1000 Hz");
+    out.push_back(a[k].get<double>());
+  }
+  std::sort(out.begin(), out.end());  // the direction says the order
+  if (std::adjacent_find(out.begin(), out.end()) != out.end()) fields::fail("frequencies_hz", "must not repeat a frequency");
+  return out;
+}
+
+void parse_sweep(const json& s, SinePlan& p) {
+  if (!s.is_object()) fields::fail("sweep", "must be an object: {\"from_hz\": 5, \"to_hz\": 80, \"steps\": 24} or {..., \"rate_oct_min\": 2}");
+  fields::only(s, "sweep.", {"from_hz", "to_hz", "steps", "spacing", "rate_oct_min", "rate_hz_s"});
+  if (!s.contains("from_hz") || !s.contains("to_hz")) fields::fail("sweep", "needs from_hz and to_hz");
+  p.from_hz = fields::number(s, "from_hz", 0, 1e-3, 1000, "sweep.");
+  p.to_hz = fields::number(s, "to_hz", 0, 1e-3, 1000, "sweep.");
+  if (!(p.to_hz > p.from_hz)) fields::fail("sweep.to_hz", "must be above sweep.from_hz");
+  const bool rate = s.contains("rate_oct_min") || s.contains("rate_hz_s");
+  if (rate) {
+    if (s.contains("rate_oct_min") && s.contains("rate_hz_s")) fields::fail("sweep.rate_hz_s", "and sweep.rate_oct_min: give one rate");
+    if (s.contains("steps") || s.contains("spacing")) fields::fail("sweep.steps", "is for a stepped sweep; a continuous one has a rate only");
+    p.continuous = true;
+    p.rate_oct_min = fields::number(s, "rate_oct_min", 0, 1e-3, 100, "sweep.");
+    p.rate_hz_s = fields::number(s, "rate_hz_s", 0, 1e-4, 100, "sweep.");
+    return;
+  }
+  const int n = fields::integer(s, "steps", 24, 2, 1000, "sweep.");
+  const std::string spacing = s.value("spacing", std::string("log"));
+  if (spacing != "log" && spacing != "linear") fields::fail("sweep.spacing", "must be \"log\" or \"linear\"");
+  for (int k = 0; k < n; ++k) {
+    const double u = k / double(n - 1);
+    p.frequencies_hz.push_back(spacing == "log" ? p.from_hz * std::pow(p.to_hz / p.from_hz, u) : p.from_hz + (p.to_hz - p.from_hz) * u);
+  }
+}
+
+std::vector<double> amplitudes(const json& j) {
+  if (j.contains("amplitude_mm") == j.contains("amplitudes_mm")) fields::fail("amplitudes_mm", "or amplitude_mm: exactly one is required (the base amplitude, peak, mm)");
+  if (j.contains("amplitude_mm")) return {fields::number(j, "amplitude_mm", 0, 1e-4, 100)};
+  const json& a = j["amplitudes_mm"];
+  if (!a.is_array() || a.empty() || a.size() > 20) fields::fail("amplitudes_mm", "must be an array of 1 to 20 base amplitudes (mm)");
+  std::vector<double> out;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (!a[k].is_number() || !(a[k].get<double>() >= 1e-4) || a[k].get<double>() > 100)
+      fields::fail("amplitudes_mm[" + std::to_string(k) + "]", "must be an amplitude from 0.0001 to 100 mm");
+    out.push_back(a[k].get<double>());
+  }
+  return out;
+}
+
+SineSettle parse_settle(const json& j) {
+  SineSettle s;
+  if (j.contains("settle") && j.contains("settle_cycles")) fields::fail("settle", "and settle_cycles: give one of them");
+  if (!j.contains("settle")) {
+    s.cycles = fields::integer(j, "settle_cycles", 10, 0, 100000);
+    return s;
+  }
+  const json& b = j["settle"];
+  if (!b.is_object()) fields::fail("settle", "must be an object: {\"change\": \"2 %\", \"consecutive\": 2, \"max_cycles\": 400}");
+  fields::only(b, "settle.", {"change", "consecutive", "max_cycles"});
+  s.until = true;
+  s.cycles = 0;
+  s.change_pct = fields::percent(b, "change", s.change_pct, "settle.");
+  s.consecutive = fields::integer(b, "consecutive", s.consecutive, 1, 100, "settle.");
+  s.max_cycles = fields::integer(b, "max_cycles", s.max_cycles, 1, 100000, "settle.");
+  return s;
+}
+
+SineControl parse_control(const json& j) {
+  SineControl c;
+  if (!j.contains("control")) return c;
+  const json& b = j["control"];
+  if (b.is_boolean()) {
+    c.closed = b.get<bool>();
+    return c;
+  }
+  if (!b.is_object()) fields::fail("control", "must be an object ({\"tolerance\": \"5 %\", ...}) or false (open loop)");
+  fields::only(b, "control.", {"tolerance", "warning", "abort", "gain", "window_cycles", "max_windows", "max_drive_ratio"});
+  c.tolerance_pct = fields::percent(b, "tolerance", c.tolerance_pct, "control.");
+  c.warning_pct = fields::percent(b, "warning", std::max(c.warning_pct, c.tolerance_pct), "control.", 1000);
+  c.abort_pct = fields::percent(b, "abort", std::max(c.abort_pct, c.warning_pct), "control.", 1000);
+  if (c.warning_pct < c.tolerance_pct) fields::fail("control.warning", "must be at least control.tolerance");
+  if (c.abort_pct <= c.warning_pct) fields::fail("control.abort", "must be above control.warning");
+  c.gain = fields::number(b, "gain", c.gain, 0.05, 1, "control.");
+  c.window_cycles = fields::integer(b, "window_cycles", c.window_cycles, 1, 1000, "control.");
+  c.max_windows = fields::integer(b, "max_windows", c.max_windows, 1, 1000, "control.");
+  c.max_drive_ratio = fields::number(b, "max_drive_ratio", c.max_drive_ratio, 1, 100, "control.");
+  return c;
+}
+}  // namespace
+
+SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
+  SinePlan p;
+  if (j.contains("frequencies_hz") && j.contains("sweep")) fields::fail("frequencies_hz", "or sweep: give one of them");
+  if (!j.contains("frequencies_hz") && !j.contains("sweep")) fields::fail("sweep", "is required (or frequencies_hz): {\"from_hz\": 5, \"to_hz\": 80, \"steps\": 24}");
+  if (j.contains("frequencies_hz")) p.frequencies_hz = frequency_list(j["frequencies_hz"]);
+  else parse_sweep(j["sweep"], p);
+  if (j.contains("direction")) {
+    const json& d = j["direction"];
+    const std::string v = d.is_string() ? d.get<std::string>() : "";
+    if (v == "up") p.direction = SweepDirection::up;
+    else if (v == "down") p.direction = SweepDirection::down;
+    else if (v == "up-down") p.direction = SweepDirection::up_down;
+    else fields::fail("direction", "must be \"up\", \"down\" or \"up-down\"");
+  }
+  p.amplitudes_mm = amplitudes(j);
+  p.settle = parse_settle(j);
+  p.measured_cycles = fields::integer(j, "measured_cycles", 10, 1, 100000);
+  p.control = parse_control(j);
+  p.jump_threshold_pct = fields::percent(j, "jump_threshold", p.jump_threshold_pct, "");
+  if (p.highest_hz() > sample_rate_hz / 8)
+    fields::fail(p.continuous || j.contains("sweep") ? "sweep.to_hz" : "frequencies_hz",
+         "must stay below sample_rate_hz / 8 (at least 8 samples a cycle): " + plan_number(p.highest_hz()) + " Hz at " + plan_number(sample_rate_hz) + " Hz");
+  return p;
+}
+
+std::vector<SweepPass> sweep_passes(const SinePlan& p) {
+  std::vector<SweepPass> out;
+  for (const double a : p.amplitudes_mm) {
+    if (p.direction != SweepDirection::down) out.push_back({a, true});
+    if (p.direction != SweepDirection::up) out.push_back({a, false});
+  }
+  return out;
+}
+
+std::vector<double> pass_frequencies(const SinePlan& p, const SweepPass& pass) {
+  std::vector<double> f = p.frequencies_hz;
+  if (!pass.up) std::reverse(f.begin(), f.end());
+  return f;
+}
+
+namespace {
+// Seconds a continuous pass takes to sweep from a to b.
+double continuous_seconds(const SinePlan& p) {
+  if (p.rate_oct_min > 0) return std::log2(p.to_hz / p.from_hz) / p.rate_oct_min * 60.0;
+  return (p.to_hz - p.from_hz) / p.rate_hz_s;
+}
+}  // namespace
+
+double nominal_duration_s(const SinePlan& p) {
+  const auto passes = sweep_passes(p);
+  const int control = p.control.closed ? p.control.window_cycles + 1 : 0;  // one window and a cycle of transient, when it is on target at once
+  const int settle = p.settle.until ? (p.settle.consecutive + 1) * std::max(1, p.control.window_cycles) : p.settle.cycles;
+  if (p.continuous) return static_cast<double>(passes.size()) * (continuous_seconds(p) + (control + settle) / p.from_hz);
+  double per_pass = 0;
+  for (const double f : p.frequencies_hz) per_pass += (control + settle + p.measured_cycles) / f;
+  return static_cast<double>(passes.size()) * per_pass;
+}
+
+std::size_t step_count(const SinePlan& p) {
+  const std::size_t passes = sweep_passes(p).size();
+  if (!p.continuous) return passes * p.frequencies_hz.size();
+  // cycles in a pass: ∫ f dt over the pass
+  const double cycles = p.rate_oct_min > 0 ? (p.to_hz - p.from_hz) * 60.0 / (p.rate_oct_min * std::log(2.0))
+                                           : (p.to_hz * p.to_hz - p.from_hz * p.from_hz) / (2 * p.rate_hz_s);
+  return passes * static_cast<std::size_t>(std::max(1.0, std::floor(cycles / p.measured_cycles)));
+}
+
+}  // namespace hystlab::daemon

@@ -1,0 +1,153 @@
+// Sine campaigns on the simulated shaker (a real hystlab-sim over Modbus TCP): closed-loop base
+// amplitude, the abort band, results per step, the prediction beside the measurement, and the
+// shaker's samples in their own columns.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "../drivers/sim_process.hpp"
+#include "campaign_bench.hpp"
+#include "hystlab/daemon/isolator.hpp"
+#include "hystlab/db/signals.hpp"
+#include "hystlab/models/sdof.hpp"
+
+using namespace hystlab;
+using namespace hystlab::test;
+
+namespace {
+std::unique_ptr<drivers::Rig> shaker_rig(int port) {
+  return drivers::make_rig({{"transport", "modbus-tcp"}, {"port", port}, {"rig", "shaker"}, {"stale_after_ms", 5000}});
+}
+
+std::vector<nlohmann::json> points_of(db::Store& store, std::int64_t campaign) {
+  std::vector<nlohmann::json> out;
+  for (const db::TransmissibilityInfo& t : store.transmissibility(campaign)) {
+    nlohmann::json j = nlohmann::json::parse(t.detail);
+    j["predicted_ratio"] = t.predicted_ratio;
+    out.push_back(j);
+  }
+  return out;
+}
+
+std::int64_t rows_in(db::Store& store, const char* table, std::int64_t run) {
+  db::Statement st(store.database(), std::string("SELECT count(*) FROM ") + table + " WHERE run_id = ?");
+  st.bind(1, run);
+  st.step();
+  return st.column_int(0);
+}
+}  // namespace
+
+TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in closed loop, transmissibility and prediction per step") {
+  // In slow motion (time scale 0.25): polled at 1 kHz, a starved 2-core VM leaves gaps of
+  // 50-600 ms, and at 10 Hz in real time every window had over half of it in gaps.
+  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"});
+  Bench b;
+  auto rig = shaker_rig(sim.modbus_port);
+  // The isolator rings at 17.7 Hz for 1/(ζω_n) = 0.45 s after each change: the settle criterion
+  // waits until the mass amplitude stops changing (a fixed 10 cycles at 60 Hz measured a 16 %
+  // high ratio with 9 % "distortion": the free vibration beating with the response).
+  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {12, 30, 60}}, {"amplitude_mm", 0.005},
+                                        {"settle", {{"change", "1 %"}, {"consecutive", 3}}}, {"measured_cycles", 8}, {"sample_rate_hz", 1000},
+                                        {"control", {{"tolerance", "3 %"}, {"window_cycles", 3}}}});
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 0.25, true);
+  daemon::CampaignJob job;
+  job.id = id;
+  job.plan = plan;
+  job.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, true);
+  job.isolator = std::make_shared<const daemon::IsolatorModel>(daemon::simulated_isolator());
+  const auto r = daemon::run_campaign(job, ctx);
+  CAPTURE(r.reason);
+  REQUIRE(end_of(r) == "completed");
+  b.writer->flush();
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 3);
+  // The simulator's isolator, linearised: 13 kg on 4 springs of 40 N/mm, 58 N·s/m.
+  const double fn = std::sqrt(4 * 40e3 / 13.0) / (2 * std::numbers::pi), zeta = 58 / (2 * std::sqrt(4 * 40e3 * 13.0));
+  bool loop_had_work = false;
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    const double f = p["frequency_hz"];
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 3.0);  // within tolerance at every step
+    CHECK(p["band"] == "within tolerance");
+    loop_had_work = loop_had_work || std::fabs(p["drive_mm"].get<double>() / 0.005 - 1) > 0.05;
+    const double ratio = p["ratio"].get<double>();
+    CHECK(std::fabs(ratio / models::linear_transmissibility(f / fn, zeta) - 1) < 0.05);
+    CHECK(p["thd"].get<double>() < 0.02);  // a small motion: the springs stay on their elastic line
+    // The prediction (the same isolator simulated) beside the measurement, within 5 %.
+    CHECK(std::fabs(p["predicted_ratio"].get<double>() / ratio - 1) < 0.05);
+  }
+  CHECK(loop_had_work);  // the table's response is not 1: the drive differed from the demand
+  // The shaker's samples are stored in their own columns, not the load frame's.
+  CHECK(rows_in(*b.store, "shaker_samples", r.run_id) > 1000);
+  CHECK(rows_in(*b.store, "samples", r.run_id) == 0);
+  double drive_min = 1;  // the drive column: what the loop commanded (below the demand: the table gains above 1 here)
+  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30, [&](const db::ShakerRow& row) { drive_min = std::min(drive_min, row.v[db::shaker_signal::drive_amplitude]); });
+  CHECK(drive_min < 0.005 * 0.95);
+}
+
+TEST_CASE("sine campaign: beyond the abort band the shaker is stopped, at zero drive, and the reason stored") {
+  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"});
+  Bench b;
+  auto rig = shaker_rig(sim.modbus_port);
+  // 110 Hz is beyond the table's servo (60 Hz): the base follows a third of the drive, and the
+  // plan allows the drive only 1.5 times the demand, so the base stays about 45 % short.
+  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {110}}, {"amplitude_mm", 0.005}, {"sample_rate_hz", 1000},
+                                        {"control", {{"abort", "30 %"}, {"max_drive_ratio", 1.5}}}});
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 0.25, true);
+  const auto r = run(id, plan, ctx);
+  CAPTURE(r.reason);
+  CHECK(end_of(r) == "aborted");
+  CHECK(r.reason.find("control abort") != std::string::npos);
+  CHECK(r.reason.find("abort band ±30 %") != std::string::npos);
+  b.writer->flush();
+  CHECK(b.store->event_details(id, "control_abort").size() == 1);
+  // The shaker is left without drive: its base comes to rest.
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  double base = 0;
+  for (int k = 0; k < 50; ++k) {
+    drivers::ShakerSample s;
+    if (!rig->read_shaker(0, s)) base = std::max(base, std::fabs(s.base_displacement_mm));
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  CHECK(base < 2e-4);
+}
+
+TEST_CASE("sine plans: sweeps, directions, amplitudes, settle and control, with errors that name the field") {
+  const auto p = daemon::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60, "steps": 12},
+      "direction": "up-down", "amplitudes_mm": [0.005, 0.05], "settle": {"change": "2 %"}, "control": {"tolerance": 4}})"));
+  CHECK(p.sine.frequencies_hz.size() == 12);
+  CHECK(p.sine.frequencies_hz.front() == doctest::Approx(5));
+  CHECK(p.sine.frequencies_hz.back() == doctest::Approx(60));
+  const auto passes = daemon::sweep_passes(p.sine);
+  REQUIRE(passes.size() == 4);
+  CHECK((passes[0].up && !passes[1].up && passes[2].amplitude_mm == 0.05));
+  CHECK(daemon::pass_frequencies(p.sine, passes[1]).front() == doctest::Approx(60));
+  CHECK(daemon::step_count(p.sine) == 48);
+  CHECK(p.sine.settle.until);
+  CHECK(p.sine.control.tolerance_pct == 4);
+  const auto c = daemon::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "rate_oct_min": 2}, "amplitude_mm": 0.01})"));
+  CHECK(c.sine.continuous);
+  CHECK(daemon::nominal_duration_s(c.sine) > 120);  // 4 octaves at 2 oct/min
+  auto bad = [](const char* text, const char* what) {
+    CAPTURE(text);
+    try {
+      (void)daemon::parse_plan(nlohmann::json::parse(text));
+      FAIL("accepted");
+    } catch (const daemon::PlanError& e) {
+      CHECK(std::string(e.what()).find(what) != std::string::npos);
+    }
+  };
+  bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60}, "direction": "sideways", "amplitude_mm": 0.1})", "direction must be");
+  bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60, "steps": 5, "rate_oct_min": 1}, "amplitude_mm": 0.1})", "sweep.steps is for a stepped sweep");
+  bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60}, "amplitudes_mm": [0.1, -1]})", "amplitudes_mm[1] must be");
+  bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60}, "amplitude_mm": 0.1, "control": {"warning": "20 %", "abort": "10 %"}})",
+      "control.abort must be above control.warning");
+  bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60}, "amplitude_mm": 0.1, "settle": {"change": "2 %"}, "settle_cycles": 4})",
+      "settle and settle_cycles");
+  bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 600}, "amplitude_mm": 0.1})", "sweep.to_hz must stay below sample_rate_hz / 8");
+  bad(R"({"kind": "sine", "frequencies_hz": [5, 5], "amplitude_mm": 0.1})", "must not repeat");
+}
