@@ -90,8 +90,13 @@ void check_http_security(HttpConfig& http, const char* env_token) {
 DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
   DaemonConfig c;
   c.base_dir = base_dir;
-  if (j.is_null()) {  // embedded defaults: one simulated load frame
+  if (j.is_null()) {  // embedded defaults: a simulated load frame and a simulated shaker (in real time)
     c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}, nullptr});
+    SimulatorOptions shaker;
+    shaker.rig = "shaker";
+    shaker.time_scale = 1.0;
+    c.rigs.push_back(RigEntry{"simulated shaker", json::object(), 1.0, true, shaker, RigEnvelope{}, SupervisionSettings{},
+                              std::make_shared<const IsolatorModel>(simulated_isolator())});
     return c;
   }
   if (!j.is_object()) fail("", "must be a JSON object");

@@ -79,6 +79,7 @@ std::optional<Resonance> find_resonance(std::span<const SweepPoint> points) {
   if (r.lower_hz > 0 && r.upper_hz > 0) {
     r.bandwidth_hz = r.upper_hz - r.lower_hz;
     r.q = r.frequency_hz / r.bandwidth_hz;
+    r.resolved = s[top - 1].ratio > half && s[top + 1].ratio > half;
   }
   return r;
 }

@@ -87,6 +87,14 @@ TEST_CASE("resonance: the linear curve's peak, half-power points and Q = 1/(2ζ)
     CHECK(r->frequency_hz == doctest::Approx(20 * rp).epsilon(0.003));
     CHECK(r->peak_ratio == doctest::Approx(linear_transmissibility(rp, zeta)).epsilon(0.02));  // a parabola over 3 points of a sharp peak
     CHECK(r->q == doctest::Approx(1 / (2 * zeta)).epsilon(0.05 + zeta));  // Q ≈ 1/(2ζ) for light damping
+    CHECK(r->resolved);
+    // Steps of 30 %: the peak falls between points; the bandwidth is an upper bound, and said to be.
+    std::vector<SweepPoint> coarse;
+    for (const double f : log_steps(5, 80, 12)) coarse.push_back({f, linear_transmissibility(f / 20.0, zeta), 0});
+    const auto c = find_resonance(coarse);
+    REQUIRE(c);
+    CHECK_FALSE(c->resolved);
+    CHECK(c->q < 1 / (2 * zeta));
   }
   // The peak at the sweep's end: said, and no bandwidth.
   std::vector<SweepPoint> rising;

@@ -51,7 +51,7 @@ json resonance_json(const std::optional<models::Resonance>& r) {
   if (!r) return nullptr;
   return {{"frequency_hz", r->frequency_hz}, {"peak_ratio", r->peak_ratio}, {"lower_hz", r->lower_hz > 0 ? json(r->lower_hz) : json()},
           {"upper_hz", r->upper_hz > 0 ? json(r->upper_hz) : json()}, {"bandwidth_hz", r->bandwidth_hz > 0 ? json(r->bandwidth_hz) : json()},
-          {"q", r->q > 0 ? json(r->q) : json()}, {"at_edge", r->at_edge}};
+          {"q", r->q > 0 ? json(r->q) : json()}, {"at_edge", r->at_edge}, {"resolved", r->resolved}};
 }
 
 json report_json(const std::vector<db::TransmissibilityInfo>& rows, double threshold, bool predicted) {

@@ -18,6 +18,9 @@ struct Resonance {
   double lower_hz = 0, upper_hz = 0;        // half-power points (ratio = peak/√2), 0 when the sweep ends before one
   double bandwidth_hz = 0, q = 0;           // upper − lower and f/bandwidth, 0 unless both points are inside the sweep
   bool at_edge = false;                     // the highest point is the sweep's first or last: the peak may lie beyond
+  // A point on each side of the peak above the half-power level: the bandwidth is measured. Not
+  // resolved (steps coarser than the peak), the bandwidth is at most what is given and Q at least.
+  bool resolved = false;
 };
 
 // The highest point of the sweep (points in any order; none: fewer than 3 points or a ratio that
