@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli_support.hpp"
+#include "hystlab/db/signals.hpp"
 #include "commands.hpp"
 #include "daemon_client.hpp"
 #include "hystlab/db/store.hpp"
@@ -37,7 +38,9 @@ const char* kTablesHelp = R"(usage: hystlab tables list [--db hystlab.db]
 )";
 const char* kRunsHelp = R"(usage: hystlab runs export RUN_ID [-o X.csv] [--db hystlab.db]
 
-Writes the run's samples as CSV: time_s,command_mm,displacement_mm,force_N,status.
+Writes the run's samples as CSV: a load frame's time_s,command_mm,displacement_mm,force_N,status;
+a shaker's time_s,drive_frequency_hz,drive_amplitude_mm,base_displacement_mm,mass_displacement_mm,
+base_accel_m_s2,mass_accel_m_s2,status.
 )";
 
 std::int64_t id_arg(const Args& args, std::size_t k, const char* what) {
@@ -258,8 +261,22 @@ int run_runs_cmd(const Args& args) {
   const std::int64_t id = id_arg(args, 1, "run ID");
   const Options opt(rest(args, 2), {"db", "output"}, {});
   db::Store store = open_store(opt);
-  if (store.max_seq(id) < 0) throw CliError("no samples for run " + std::to_string(id));
-  std::string out = "time_s,command_mm,displacement_mm,force_N,status\n";
+  const bool shaker = store.max_seq(id) < 0 && store.max_shaker_seq(id) >= 0;  // a shaker's run: its own columns
+  if (store.max_seq(id) < 0 && !shaker) throw CliError("no samples for run " + std::to_string(id));
+  std::string out;
+  if (shaker) {
+    out = "time_s";
+    for (const db::SignalName& n : db::kShakerSignals) out += std::string(",") + n.name;
+    out += ",status\n";
+    store.for_each_shaker_sample(id, 0, std::int64_t{1} << 50, [&](const db::ShakerRow& r) {
+      out += format_number(r.t);
+      for (const double v : r.v) out += "," + format_number(v);
+      out += "," + std::to_string(r.status) + "\n";
+    });
+    write_output(opt.get("output"), out);
+    return 0;
+  }
+  out = "time_s,command_mm,displacement_mm,force_N,status\n";
   store.for_each_sample(id, 0, std::int64_t{1} << 50, [&](const db::SampleRow& r) {
     out += format_number(r.t) + "," + format_number(r.cmd) + "," + format_number(r.disp) + "," + format_number(r.force) + "," +
            std::to_string(r.status) + "\n";
