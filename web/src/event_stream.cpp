@@ -5,6 +5,7 @@
 #include <memory>
 #include <thread>
 
+#include "hystlab/db/signals.hpp"
 #include "hystlab/db/sqlite.hpp"
 #include "routes.hpp"
 
@@ -71,8 +72,10 @@ std::string samples(const control::DaemonInterface& d, StreamState& st) {
     if (got.empty()) continue;
     json t, cmd, disp, force;
     for (const auto& s : got) t.push_back(s.t), cmd.push_back(s.cmd), disp.push_back(s.disp), force.push_back(s.force);
-    out += frame("samples", {{"rig", d.rig_info(st.rigs[k]).name}, {"run", got.back().run}, {"t", t}, {"cmd", cmd}, {"disp", disp},
-                             {"force", force}, {"status", got.back().status}, {"mono_s", got.back().mono_s}});
+    const control::RigInfo info = d.rig_info(st.rigs[k]);
+    const auto& names = info.kind == "shaker" ? db::kLiveShakerSignals : db::kLiveFrameSignals;  // what cmd, disp, force hold
+    out += frame("samples", {{"rig", info.name}, {"run", got.back().run}, {"t", t}, {"cmd", cmd}, {"disp", disp}, {"force", force},
+                             {"signals", names}, {"status", got.back().status}, {"mono_s", got.back().mono_s}});
   }
   return out;
 }

@@ -6,6 +6,7 @@
 
 #include "hystlab/protocols/signals.hpp"
 #include "request_guard.hpp"
+#include "hystlab/db/signals.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
@@ -54,9 +55,7 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
   if (h > 0) (void)d.read_live(k, h - 1, 1, last);
   if (!last.empty()) {
     const control::LiveSample& s = last.back();
-    const char* names[] = {"command_mm", "displacement_mm", "force_N"};
-    const char* shaker[] = {"base_displacement_mm", "mass_displacement_mm", "mass_accel_m_s2"};
-    const char** n = info.kind == "shaker" ? shaker : names;
+    const auto& n = info.kind == "shaker" ? db::kLiveShakerSignals : db::kLiveFrameSignals;
     j["sample"] = {{"t", s.t}, {n[0], s.cmd}, {n[1], s.disp}, {n[2], s.force}, {"status", s.status}, {"run", s.run}};
   }
   return j;

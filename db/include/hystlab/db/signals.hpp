@@ -28,6 +28,11 @@ inline constexpr std::size_t drive_frequency = 0, drive_amplitude = 1, base_disp
                              mass_accel = 5;
 }  // namespace shaker_signal
 
+// The three values a rig's live sample carries (control::LiveSample's cmd, disp, force), named
+// for the rig panel and the event stream.
+inline constexpr std::array<const char*, 3> kLiveFrameSignals{"command_mm", "displacement_mm", "force_N"};
+inline constexpr std::array<const char*, 3> kLiveShakerSignals{"base_displacement_mm", "mass_displacement_mm", "mass_accel_m_s2"};
+
 // "seq,t_s,<names>,status"
 template <std::size_t N>
 std::string csv_header(const std::array<SignalName, N>& s) {
