@@ -1,5 +1,6 @@
 // hystlab campaign / tables / runs. Submitting and commanding a campaign go to the running
 // hystlabd over its HTTP API (daemon_client.hpp); its records are read from the database file.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -10,7 +11,9 @@
 #include "daemon_client.hpp"
 #include "hystlab/db/store.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/sweep_analysis.hpp"
 #include "hystlab/models/table_export.hpp"
+#include "hystlab/daemon/plan.hpp"
 
 namespace hystlab::cli {
 namespace {
@@ -121,6 +124,42 @@ int print_preview(const nlohmann::json& p) {
   return 0;
 }
 
+// A sine campaign's points and its resonance table (measured, and predicted where it was).
+void print_sweep(db::Store& store, const db::CampaignRow& row) {
+  const auto rows = store.transmissibility(row.id);
+  if (rows.empty()) return;
+  double threshold = 0.10, worst = 0;
+  try {
+    threshold = daemon::parse_plan(nlohmann::json::parse(row.plan)).sine.jump_threshold_pct / 100;
+  } catch (const std::exception&) {  // a plan of an older hystlab: the default threshold
+  }
+  std::vector<models::SweepCurvePoint> measured, predicted;
+  for (const auto& t : rows) {
+    const auto d = nlohmann::json::parse(t.detail.empty() ? "{}" : t.detail, nullptr, false);
+    if (d.is_object()) worst = std::max(worst, std::fabs(d.value("control_error_pct", 0.0)));
+    const double a = t.demand_mm > 0 ? t.demand_mm : t.base_amplitude_mm;
+    const bool up = t.direction != "down";
+    measured.push_back({a, up, {t.frequency_hz, t.ratio, t.phase_rad}});
+    if (std::isfinite(t.predicted_ratio)) predicted.push_back({a, up, {t.frequency_hz, t.predicted_ratio, t.predicted_phase_rad}});
+  }
+  std::cout << "  sweep: " << rows.size() << " points, the worst control error " << round_g(worst) << " %\n";
+  for (const auto& [what, pts] : {std::pair{"measured", &measured}, std::pair{"predicted", &predicted}}) {
+    const models::SweepReport r = models::analyse_sweep(*pts, threshold);
+    for (const auto& c : r.curves) {
+      if (!c.resonance) continue;
+      const auto& z = *c.resonance;
+      std::cout << "    " << what << " " << round_g(c.amplitude_mm) << " mm " << (c.up ? "up" : "down") << ": resonance " << round_g(z.frequency_hz)
+                << " Hz, peak " << round_g(z.peak_ratio);
+      if (z.q > 0) std::cout << ", Q " << (z.resolved ? "" : ">= ") << round_g(z.q);
+      std::cout << (z.at_edge ? " (at the sweep's edge)" : "") << "\n";
+    }
+    for (const auto& a : r.jumps)
+      for (const auto& j : a.jumps)
+        std::cout << "    " << what << " " << round_g(a.amplitude_mm) << " mm: up and down differ by up to " << round_g(100 * j.max_difference)
+                  << " % between " << round_g(j.lo_hz) << " and " << round_g(j.hi_hz) << " Hz\n";
+  }
+}
+
 int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
   const auto runs = store.runs(row.id);
   const auto tables = store.tables(row.id);
@@ -157,6 +196,7 @@ int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
   }
   if (const auto loops = store.loops(row.id); !loops.empty())
     std::cout << "  " << loops.size() << " closed cycle(s) with their figures (--json, or hystlab loops on a run's CSV)\n";
+  print_sweep(store, row);
   std::cout << "  events (newest last):\n";
   for (const auto& e : store.events(row.id)) {
     if (e.kind == "gap") continue;  // one per hole: the "gaps" summary says it in one line

@@ -17,7 +17,7 @@ const char* to_string(ControlBand b) noexcept {
 
 double BaseControl::start(double demand) const noexcept {
   if (!c_.closed) return demand;
-  return std::min(demand / response_, c_.max_drive_ratio * demand);
+  return std::min(c_.start_level * demand / response_, c_.max_drive_ratio * demand);
 }
 
 ControlBand BaseControl::band_of(double e) const noexcept {

@@ -99,7 +99,7 @@ SineControl parse_control(const json& j) {
     return c;
   }
   if (!b.is_object()) fields::fail("control", "must be an object ({\"tolerance\": \"5 %\", ...}) or false (open loop)");
-  fields::only(b, "control.", {"tolerance", "warning", "abort", "gain", "window_cycles", "max_windows", "max_drive_ratio"});
+  fields::only(b, "control.", {"tolerance", "warning", "abort", "gain", "window_cycles", "max_windows", "max_drive_ratio", "start_level", "abort_windows"});
   c.tolerance_pct = fields::percent(b, "tolerance", c.tolerance_pct, "control.");
   c.warning_pct = fields::percent(b, "warning", std::max(c.warning_pct, c.tolerance_pct), "control.", 1000);
   c.abort_pct = fields::percent(b, "abort", std::max(c.abort_pct, c.warning_pct), "control.", 1000);
@@ -109,6 +109,8 @@ SineControl parse_control(const json& j) {
   c.window_cycles = fields::integer(b, "window_cycles", c.window_cycles, 1, 1000, "control.");
   c.max_windows = fields::integer(b, "max_windows", c.max_windows, 1, 1000, "control.");
   c.max_drive_ratio = fields::number(b, "max_drive_ratio", c.max_drive_ratio, 1, 100, "control.");
+  c.start_level = fields::number(b, "start_level", c.start_level, 0.05, 1, "control.");
+  c.abort_windows = fields::integer(b, "abort_windows", c.abort_windows, 1, 100, "control.");
   return c;
 }
 }  // namespace

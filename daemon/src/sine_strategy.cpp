@@ -41,6 +41,9 @@ class SineStrategy final : public Strategy {
     return on_window(L, s.time_s);
   }
 
+  // Held (zero drive) while paused: the samples say so.
+  void on_pause(Loop& L, double) override { L.drive_mm = 0; }
+
   // The step is taken again from its start (a pause, a held link): the response has changed.
   void on_resume(Loop& L, double t, bool) override {
     w_.restart(t);
@@ -68,7 +71,7 @@ class SineStrategy final : public Strategy {
   bool begin_step(Loop& L, double t) {
     f_ = s_.continuous ? (up() ? s_.from_hz : s_.to_hz) : pass_frequencies(s_, passes_[pass_])[step_];
     drive_ = control_.start(demand());
-    control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false;
+    control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false, established_ = !s_.control.closed;
     prev_mass_ = NAN;
     if (!L.command_drive(t, f_, drive_)) return false;
     L.event("sine_step", {{"k", points_ + 1}, {"of", total_}, {"pass", pass_ + 1}, {"passes", passes_.size()}, {"frequency_hz", f_},
@@ -120,20 +123,27 @@ class SineStrategy final : public Strategy {
     return true;
   }
 
-  // Warning and abort bands: a warning is said once per step; two windows in a row beyond the
-  // abort band (or one while measuring) stop the drive and end the campaign with the reason.
+  // Warning and abort bands. Too much motion counts at once; too little only once the loop has
+  // had its chance (the step's base reached tolerance once, or the drive is at its cap, or the
+  // step is being measured): each step starts below its target on purpose (BaseControl::start).
+  // A warning is said once per step; control.abort_windows windows in a row beyond the abort
+  // band (one while measuring) stop the drive and end the campaign with the reason.
   bool check_band(Loop& L, double t, const ControlVerdict& v, double base) {
-    if (v.band == ControlBand::abort && (++abort_windows_ >= 2 || mode_ == Mode::measure || mode_ == Mode::sweep)) {
+    const bool measuring = mode_ == Mode::measure || mode_ == Mode::sweep;
+    const bool counts = v.error_pct > 0 || established_ || v.limited || measuring || std::isnan(v.error_pct);
+    if (v.band == ControlBand::within) established_ = true;
+    if (counts && v.band == ControlBand::abort && (++abort_windows_ >= s_.control.abort_windows || measuring)) {
       char buf[240];
       std::snprintf(buf, sizeof buf, "control abort: the base amplitude was %.4g mm against the demand %.4g mm (error %+.1f %%, abort band ±%g %%) at %.4g Hz",
                     base, demand(), v.error_pct, s_.control.abort_pct, f_);
       L.event("control_abort", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"base_mm", base}, {"error_pct", v.error_pct}, {"drive_mm", drive_}});
       L.ctx.supervisor.hold(t, "control abort: no drive");
+      L.drive_mm = 0;
       L.end(CampaignEnd::aborted, buf);
       return false;
     }
-    if (v.band != ControlBand::abort) abort_windows_ = 0;
-    if ((v.band == ControlBand::warning || v.band == ControlBand::abort) && !warned_) {
+    if (!counts || v.band != ControlBand::abort) abort_windows_ = 0;
+    if (counts && (v.band == ControlBand::warning || v.band == ControlBand::abort) && !warned_) {
       warned_ = true;
       ++warnings_;
       L.event("control_warning", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"base_mm", base}, {"error_pct", v.error_pct}, {"band", to_string(v.band)}});
@@ -252,7 +262,7 @@ class SineStrategy final : public Strategy {
   static constexpr int kMaxRetakes = 3;
   Mode mode_ = Mode::control;
   SineWindow w_;
-  bool started_ = false, sweep_over_ = false, warned_ = false;
+  bool started_ = false, sweep_over_ = false, warned_ = false, established_ = false;
   double t0_ = 0, last_t_ = 0, f_ = 0, drive_ = 0, prev_mass_ = NAN, next_cycle_ = 0;
   int control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warnings_ = 0;
 };

@@ -22,7 +22,7 @@ struct ControlVerdict {
 class BaseControl {
  public:
   explicit BaseControl(const SineControl& c) noexcept : c_(c) {}
-  // The drive to start a step at (the demand over the response last learnt; open loop: the demand).
+  // The drive to start a step at: start_level × the demand over the response last learnt (open loop: the demand).
   [[nodiscard]] double start(double demand_mm) const noexcept;
   // A window measured at `drive` gave `measured`: its band and the drive for the next window.
   ControlVerdict update(double demand_mm, double drive_mm, double measured_mm) noexcept;

@@ -8,7 +8,8 @@
 //    "settle_cycles": 10                  or "settle": {"change": "2 %", "consecutive": 2, "max_cycles": 400}
 //    "measured_cycles": 10,
 //    "control": {"tolerance": "5 %", "warning": "10 %", "abort": "30 %", "gain": 0.7, "window_cycles": 4,
-//                "max_windows": 12, "max_drive_ratio": 4} or false (open loop: the drive is the demand)
+//                "max_windows": 12, "max_drive_ratio": 4, "start_level": 0.5,
+//                "abort_windows": 3} or false (open loop: the drive is the demand)
 //    "jump_threshold": "10 %"}            up and down differing by more than this is a jump
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -29,6 +30,16 @@ struct SineControl {
   int window_cycles = 4;
   int max_windows = 12;         // control windows per step; then it is measured anyway, with a warning
   double max_drive_ratio = 4;   // the drive never exceeds this times the demand
+  // Each step starts at this fraction of the drive the last response learnt asks for (-6 dB):
+  // from below, as controllers start a level, since the table's response can change several
+  // fold between steps (it dips where the isolator resonates and loads it) and an overshoot is
+  // what trips abort bands and what can harm a specimen.
+  double start_level = 0.5;
+  // Windows in a row beyond the abort band that trip it (one while measuring). A lightly damped
+  // isolator rings at its own frequency after every change, and the table moves with it: at
+  // 16 Hz after 18 Hz the simulated one's base read +40 % and +34 % in its first two 4-cycle
+  // windows (the ringing at 17.7 Hz inside the fit's resolution), then settled.
+  int abort_windows = 3;
 };
 
 // When a step's response has settled: after `cycles` cycles at the step's final drive, or (until)
