@@ -13,7 +13,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "../drivers/sim_process.hpp"
+#include "realtime_bench.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
@@ -100,33 +100,24 @@ int main(int argc, char** argv) {
   double seconds = 60;
   for (int k = 1; k + 1 < argc; k += 2)
     if (!std::strcmp(argv[k], "--seconds")) seconds = std::atof(argv[k + 1]);
-  const daemon::AcquisitionSettings settings;  // the daemon's defaults
-  test::SimProcess sim({"--port", "0", "--noise", "0.05", "--realtime", std::to_string(settings.priority - 1)});
-  if (!daemon::pin_process(sim.pid(), daemon::resolve_cpu(settings.cpu))) std::printf("the simulator is not pinned\n");
-  char tmpl[] = "/tmp/hystlab-acq-XXXXXX";
-  const std::filesystem::path dir = mkdtemp(tmpl);
-  const std::string path = (dir / "hystlab.db").string();
-  db::Store store(path);
-  // As in hystlabd: the writer's thread starts at normal priority, off the acquisition's CPU.
-  const bool moved = daemon::avoid_cpu(daemon::resolve_cpu(settings.cpu));
-  db::SampleWriter writer(path);
-  if (moved) (void)daemon::avoid_cpu(-1);
-  std::printf("this thread: %s\n", daemon::enter_acquisition_thread(settings).c_str());
+  test::RealtimeBench bench({"--port", "0", "--noise", "0.05"});
+  db::Store& store = bench.store;
+  db::SampleWriter& writer = *bench.writer;
+  const std::string& path = bench.path;
   // The baseline runs as long as the acquisition, half before it and half after, so that both
   // see the same share of the machine's noise and their missed deadlines compare one to one.
   long base_missed = 0;
   std::vector<float> base = sleep_loop(seconds / 2, base_missed);
 
-  const auto polled = acquire(false, sim.modbus_port, seconds, store, writer, path);
+  const auto polled = acquire(false, bench.sim.modbus_port, seconds, store, writer, path);
   std::vector<float> after = sleep_loop(seconds / 2, base_missed);
   base.insert(base.end(), after.begin(), after.end());
-  const auto blocks = acquire(true, sim.modbus_port, seconds, store, writer, path);
+  const auto blocks = acquire(true, bench.sim.modbus_port, seconds, store, writer, path);
   report("baseline: bare 1 kHz sleep loop (half before polling, half between)", std::move(base), base_missed);
   std::printf("polling: missed deadlines (late periods) %ld, bare loop %ld over the same time: %+ld beyond the baseline\n",
               static_cast<long>(polled.missed_deadlines), base_missed, static_cast<long>(polled.missed_deadlines) - base_missed);
   std::printf("block reads (as hystlabd reads a controller in real time): missed deadlines (samples lost) %ld, "
               "late wake-ups %ld (target: p99.9 within 1 ms, no missed deadlines)\n",
               static_cast<long>(blocks.missed_deadlines), static_cast<long>(blocks.late_wakeups));
-  std::filesystem::remove_all(dir);
   return polled.end == daemon::CampaignEnd::completed && blocks.end == daemon::CampaignEnd::completed ? 0 : 1;
 }

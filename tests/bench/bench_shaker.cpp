@@ -13,7 +13,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "../drivers/sim_process.hpp"
+#include "realtime_bench.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/realtime.hpp"
@@ -75,21 +75,13 @@ int main(int argc, char** argv) {
   int steps = 12;
   for (int k = 1; k + 1 < argc; k += 2)
     if (!std::strcmp(argv[k], "--steps")) steps = std::atoi(argv[k + 1]);
-  const daemon::AcquisitionSettings settings;
-  test::SimProcess sim({"--rig", "shaker", "--port", "0", "--realtime", std::to_string(settings.priority - 1)});
-  if (!daemon::pin_process(sim.pid(), daemon::resolve_cpu(settings.cpu))) std::printf("the simulator is not pinned\n");
-  char tmpl[] = "/tmp/hystlab-shaker-XXXXXX";
-  const std::filesystem::path dir = mkdtemp(tmpl);
-  const std::string path = (dir / "hystlab.db").string();
-  db::Store store(path);
-  const bool moved = daemon::avoid_cpu(daemon::resolve_cpu(settings.cpu));
-  db::SampleWriter writer(path);
-  if (moved) (void)daemon::avoid_cpu(-1);
-  std::printf("this thread: %s\n", daemon::enter_acquisition_thread(settings).c_str());
+  test::RealtimeBench bench({"--rig", "shaker", "--port", "0"});
+  db::Store& store = bench.store;
+  db::SampleWriter& writer = *bench.writer;
 
   const auto plan = daemon::parse_plan({{"kind", "sine"}, {"sweep", {{"from_hz", 5}, {"to_hz", 100}, {"steps", steps}}}, {"direction", "up-down"},
                                         {"amplitudes_mm", {0.005, 0.05}}, {"settle_cycles", 10}, {"measured_cycles", 10}, {"sample_rate_hz", 1000}});
-  auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", sim.modbus_port}, {"rig", "shaker"}});
+  auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", bench.sim.modbus_port}, {"rig", "shaker"}});
   const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), db::CampaignKind::sine, plan.source.dump(), "t");
   daemon::SteadyClock clock;
   daemon::Supervisor supervisor(*rig, daemon::SupervisionSettings{}, true);
@@ -115,7 +107,5 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(r.late_wakeups), static_cast<unsigned long long>(r.gaps), r.longest_gap_s * 1e3, base_missed, base_s,
               60.0 * static_cast<double>(base_missed) / base_s);
   std::printf("wall time %.1f s against the plan's nominal %.1f s: ratio %.2f (the nominal counts one control window a step)\n", wall, nominal, wall / nominal);
-  const int rc = report_points(store, id, plan.sine, r.end == daemon::CampaignEnd::completed);
-  std::filesystem::remove_all(dir);
-  return rc;
+  return report_points(store, id, plan.sine, r.end == daemon::CampaignEnd::completed);
 }
