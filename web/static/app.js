@@ -1,29 +1,35 @@
 // hystlab's page: follows the daemon over its API and its event stream (docs/API.md).
 // The pieces: the rig panel (rigs.js), the form (form.js), data quality (quality.js), the
-// plots (plots.js); this file holds the campaign being shown and the live stream.
+// plots (plots.js), a shaker's sine sweep (shaker.js); this file holds the campaign being shown
+// and the live stream.
 import { api, post, token } from './api.js';
 import { XYPlot, TimePlot, TriangleHeatmap } from './plots.js';
+import { SweepView, describeSweepEvent } from './shaker.js';
 import { RigPanel } from './rigs.js';
 import { PlanForm } from './form.js';
 import { showQuality } from './quality.js';
 import { tableLines, ShakedownPlot, shakedownCaption, loopRows } from './identification.js';
-import { count, num, round2, roughly, localTime, el } from './fmt.js';
+import { count, num, round2, roughly, localTime, el, plural } from './fmt.js';
 
 const $ = id => document.getElementById(id);
 const KEEP = 20000;         // live samples kept per plot
 const LOOP_POINTS = 2000;   // the completed loop, from the server (shape-preserving)
+const SHAKER_LOOP_KEEP = 4000;  // a shaker's live loop: its newest cycles (the stream brings up to 1000 samples/s)
+const FRAME_RATE = 50;      // samples/s asked of the stream for a load frame
+const SINE_EVENTS = ['sine_step', 'control_warning', 'control_abort', 'control_unreached', 'unsettled', 'retake', 'gap', 'gaps', 'quality', 'sweep_done'];
 
 const S = {
   campaigns: [], selected: null, follow: true, detail: null, runId: null, events: [],
-  trans: [], lastEventId: '', es: null, online: false, warnings: [], loopInfo: null,
+  lastEventId: '', es: null, streamRate: FRAME_RATE, online: false, warnings: [], loopInfo: null,
 };
 
 const loop = new XYPlot($('loop-plot'), 'displacement (mm)', 'force (N)',
   [{ label: 'measured', color: '#1565c0', width: 1.2 }, { label: 'identified model', color: '#ef6c00', width: 2 }]);
 const heat = new TriangleHeatmap($('heatmap-plot'));
 const timeplot = new TimePlot($('time-plot'), ['displacement (mm)', 'force (N)']);
-const trans = new XYPlot($('trans-plot'), 'frequency (Hz)', 'mass / base amplitude', [{ label: 'transmissibility', color: '#6a1b9a', points: true }],
-  { aspect: 0.5, maxHeight: 420 });
+const sweep = new SweepView({ trans: $('trans-plot'), time: $('shaker-time-plot'), table: $('resonance'), status: $('sweep-status') });
+$('time-mode').addEventListener('change', e => { sweep.time.setMode(e.target.value); sweep.time.redraw(); });
+const isSine = () => !!S.detail && S.detail.kind === 'sine';
 const shakedown = new ShakedownPlot($('shakedown-plot'));
 const rigPanel = new RigPanel($('rigs'), { onChange: rigs => planForm.setRigs(rigs) });
 // In the chain with the stream's handlers: a select() running beside them would reset what
@@ -37,7 +43,13 @@ window.hystlab = {
   loopPath: () => loop.path(0), modelPath: () => loop.path(1), loopInfo: () => S.loopInfo,
   loadLoop: points => new Promise((resolve, reject) => serial(() => loadLoop(points).then(resolve, reject))()),
   heatmapIdentified: () => heat.identified(), heatmapRequired: () => heat.required(), heatmapLimits: () => heat.limits(),
-  transmissibilityPoints: () => trans.points(0), online: () => S.online,
+  // A sweep: the first curve's points (as the one curve of before), every curve, the scales.
+  transmissibilityPoints: () => sweep.plot.firstCurvePoints(), online: () => S.online,
+  transmissibilityCurves: () => sweep.plot.curves(), transmissibilityScales: () => sweep.plot.scales(),
+  sineStatus: () => (isSine() ? sweep.status(S.detail) : null), streamRate: () => S.streamRate,
+  resonanceRows: () => [...document.querySelectorAll('#resonance tbody tr')].map(tr => [...tr.cells].map(c => c.textContent)),
+  jumps: () => [...document.querySelectorAll('#resonance .jumps li')].map(li => li.textContent),
+  timeAxes: () => (isSine() ? sweep.time.axes() : timeplot.axes()),
   rigs: () => rigPanel.rigs(), warnings: () => S.warnings.slice(),
   shakedownPoints: () => shakedown.points(), loopRows: () => $('loops').querySelectorAll('tbody tr').length,
   heldOut: () => [...document.querySelectorAll('#accuracy .heldout')].map(e => e.textContent),
@@ -63,13 +75,12 @@ async function refreshList() {
 async function select(id) {
   S.selected = id;
   for (const li of $('campaigns').children) li.className = Number(li.dataset.id) === id ? 'selected' : '';
-  S.trans = []; S.loopInfo = null;
+  S.loopInfo = null;
   loop.set(0, [], []); loop.set(1, [], []); timeplot.clear();
+  sweep.reset(id);
   heat.setGrid(null);
-  await refreshDetail();  // for a FOT campaign, with its nodes
-  const d = S.detail;
-  if (d.kind === 'sine') { S.trans = await api(`/api/campaigns/${id}/transmissibility`); drawTrans(); }
-  if (S.runId) { await loadRun(S.runId); await loadLoop(LOOP_POINTS); }
+  await refreshDetail();  // for a FOT campaign, with its nodes; for a sweep, its points
+  if (S.runId) await loadRunAndLoop();
   redraw();
 }
 
@@ -108,17 +119,22 @@ async function refreshDetail() {
   const cycles = d.shakedown || [];
   $('shakedown-fig').hidden = !cycles.length;
   if (cycles.length) { shakedown.set(cycles); $('shakedown-caption').textContent = shakedownCaption(d); }
-  document.querySelector('.sine-only').hidden = d.kind !== 'sine';
   const shaker = d.kind === 'sine';
-  timeplot.setLabels(shaker ? ['base displacement (mm)', 'mass displacement (mm)'] : ['displacement (mm)', 'force (N)']);
-  $('time-caption').textContent = shaker ? 'Base and mass displacement against time' : 'Displacement and force against time';
+  for (const e of document.querySelectorAll('.sine-only')) e.hidden = !shaker;
+  $('time-fig').hidden = shaker;  // a shaker's signals have a plot of their own (one displacement axis)
+  // A sweep's mass-base loop is its newest cycles, live: the whole run's would pile up every
+  // frequency and amplitude into one unreadable knot.
+  $('loop-fig').hidden = shaker && d.final;
+  $('shaker-time-fig').classList.toggle('wide', !!d.final);  // alone on its row then
   loop.relabel(shaker ? 'base displacement (mm)' : 'displacement (mm)', shaker ? 'mass displacement (mm)' : 'force (N)');
   showLoopCaption();
   showAccuracy(d);
-  S.warnings = showQuality(d, $('quality'), $('warnings'));
+  S.events = await api(`/api/campaigns/${d.id}/events`);
+  if (S.selected !== d.id) return;
+  if (shaker) { sweep.setEvents(S.events); useStreamRate(sineStreamRate(d)); await sweep.refresh(d); } else useStreamRate(FRAME_RATE);
+  S.warnings = showQuality(d, $('quality'), $('warnings'), shaker ? sweepWarnings(d) : []);
   showDownloads(d);
   await showLoops(d);
-  S.events = await api(`/api/campaigns/${d.id}/events`);
   showProgress(d);
   $('events').replaceChildren(...S.events.slice(-50).reverse().map(e =>
     el('li', { text: `${localTime(e.at)} ${e.kind}${e.to ? ' → ' + e.to : ''}: ${describe(e)}` })));
@@ -129,8 +145,8 @@ function describe(e) {
   if (typeof d === 'string') return d;
   if (!d) return '';
   if (e.kind === 'fit' && d.accuracy) return `partial table of ${d.nodes}/${d.required} nodes: RMS ${round2(d.accuracy.overall.rms_N)} N over the samples so far`;
-  if (e.kind === 'transmissibility') return `${num(d.frequency_hz)} Hz: ratio ${num(d.ratio)}`;
-  if (e.kind === 'gap') return `no samples for ${num(d.length_ms / 1000, 2)} s of rig time (from ${num(d.from_s)} s)`;
+  const sweepText = describeSweepEvent(e);
+  if (sweepText) return sweepText;
   if (e.kind === 'gaps') return `${d.count} holes in the time axis, ${num(d.total_ms / 1000, 2)} s in all, the longest ${num(d.longest_ms / 1000, 2)} s`;
   if (e.kind === 'quality') return `run #${d.run}: ${d.samples} samples at ${num(d.rate_hz, 3)} Hz of rig time, ${d.missed_deadlines} missed deadlines, ` +
     `${d.lost_samples} lost samples, ${d.io_errors} I/O errors, ${d.gaps} gaps`;
@@ -157,6 +173,7 @@ function activeSeconds(events, now) {
 }
 
 function showProgress(d) {
+  if (d.kind === 'sine') { const s = sweep.showStatus(d); $('progress').textContent = s.progress; $('eta').textContent = s.eta; return; }
   if (!d.progress) { $('progress').textContent = ''; $('eta').textContent = ''; return; }
   const k = d.progress.nodes, n = d.progress.required;
   $('progress').textContent = `node ${k} of ${n}`;
@@ -183,18 +200,40 @@ async function showLoops(d) {
     Object.entries(phases).map(([k, v]) => `${v} ${k}`).join(', ') + ')';
 }
 
-function link(href, text) { return el('a', { href, download: true, text }); }
+function link(href, text, name = true) { return el('a', { href, download: name, text }); }
 function showDownloads(d) {
   const links = [];
   for (const t of d.tables)
     for (const f of ['json', 'csv', 'm']) links.push(link(`/api/tables/${t.id}/export?format=${f}`, `table #${t.id} (${t.method}) .${f}`));
+  if (d.kind === 'sine') {
+    links.push(link(`/api/campaigns/${d.id}/sweep.csv`, 'sweep points .csv', `sweep-${d.id}.csv`));
+    links.push(link(`/api/campaigns/${d.id}/sweep`, 'sweep points and resonances .json', `sweep-${d.id}.json`));
+  }
   for (const r of d.runs) links.push(link(`/api/runs/${r.id}/samples.csv`, `run #${r.id} samples .csv`));
   $('downloads').replaceChildren(...links);
 }
 
+// The sweep's own warnings beside the runs' and tables': its events in words, and the
+// acquisition's missed deadlines (each a sample taken late) when the run's quality has any.
+function sweepWarnings(d) {
+  const out = sweep.warnings();
+  for (const r of d.runs) {
+    const q = r.quality;
+    if (q && q.missed_deadlines > 0 && !(q.warnings || []).some(w => /deadline/.test(w)))
+      out.push(`run #${r.id}: ${plural(q.missed_deadlines, 'missed deadline')} of the acquisition (samples taken late)`);
+  }
+  return out;
+}
+
+// The run from the store: its history against time and, for a load frame, its whole loop.
+async function loadRunAndLoop() {
+  await loadRun(S.runId);
+  if (!isSine()) await loadLoop(LOOP_POINTS);
+}
+
 // The run's history against time, decimated by the server (min and max per bucket, both drawn).
 async function loadRun(runId) {
-  if (S.detail.kind === 'sine') return;  // the sweep's signals come live; its history is the .csv
+  if (S.detail.kind === 'sine') return loadShakerRun(runId, S.detail.final);
   const s = await api(`/api/runs/${runId}/samples?points=3000`);
   if (runId !== S.runId) return;
   timeplot.setBuckets(s, s.displacement_min_mm, s.displacement_max_mm, s.force_min_N, s.force_max_N);
@@ -226,19 +265,46 @@ async function loadLoop(points = LOOP_POINTS) {
 
 function showLoopCaption() {
   const shaker = S.detail && S.detail.kind === 'sine', i = S.loopInfo;
-  let text = shaker ? 'Mass against base displacement' : 'Force–displacement';
+  let text = shaker ? 'Mass against base displacement: the newest cycles' : 'Force–displacement';
   if (i) text += ` — ${count(i.samples)} samples, ${count(i.reversals)} reversals (drawn with ${count(i.points)} points)` +
     (i.table ? `; orange: table #${i.table}` : '');
   $('loop-caption').textContent = text;
 }
 
-function drawTrans() {
-  const pts = S.trans.slice().sort((p, q) => p.frequency_hz - q.frequency_hz);
-  trans.set(0, pts.map(p => p.frequency_hz), pts.map(p => p.ratio));
-  trans.redraw();
+// A shaker run's history as an envelope: the whole run once it has ended (the live samples go),
+// else its newest seconds, which the live samples then continue.
+async function loadShakerRun(runId, whole) {
+  let q = 'points=2000';
+  if (!whole) {
+    const span = await api(`/api/runs/${runId}/samples?points=1`);
+    if (!(span.t1 > 0)) return;
+    q = `t0=${Math.max(0, span.t1 - 10)}&t1=${span.t1}&points=600`;
+  }
+  const s = await api(`/api/runs/${runId}/samples?${q}`);
+  if (runId !== S.runId) return;
+  if (whole) sweep.time.clear();
+  sweep.time.setHistory(s);
+  sweep.time.redraw();
 }
 
-function redraw() { loop.redraw(); timeplot.redraw(); heat.redraw(); }
+function redraw() { loop.redraw(); timeplot.redraw(); heat.redraw(); if (isSine()) sweep.time.redraw(); }
+
+// The stream's sample rate: for a running sweep, 20 samples a cycle of its highest frequency
+// (the time plot then draws a trace; above, each cycle's envelope), at most the plan's sample
+// rate and the stream's 1000/s. The stream decimates by keeping every n-th sample (web/src/
+// event_stream.cpp), so asking less than the rig samples would alias a fast sine.
+function sineStreamRate(d) {
+  if (d.final) return FRAME_RATE;
+  const p = d.plan || {}, sw = p.sweep || {};
+  const fmax = Math.max(Number(sw.to_hz) || 0, ...(Array.isArray(p.frequencies_hz) ? p.frequencies_hz : []).map(Number));
+  const cap = Math.min(1000, Number(p.sample_rate_hz) || 1000);
+  return Math.round(Math.min(cap, Math.max(FRAME_RATE, 20 * (fmax || 50))));
+}
+function useStreamRate(rate) {
+  if (rate === S.streamRate) return;
+  S.streamRate = rate;
+  if (S.es) { S.es.close(); S.es = null; connect(); }  // resumes after the last record seen
+}
 
 // Handlers that refresh from the API run one after another, so an older answer never
 // overwrites a newer one.
@@ -248,7 +314,7 @@ const serial = fn => (...args) => { chain = chain.then(() => fn(...args)).catch(
 // ---- live: the event stream (reconnects by itself, resuming after the last record seen) ----
 function connect() {
   const t = token();
-  const url = '/api/stream?rate=50' + (S.lastEventId ? '&last_event_id=' + encodeURIComponent(S.lastEventId) : '') +
+  const url = `/api/stream?rate=${S.streamRate}` + (S.lastEventId ? '&last_event_id=' + encodeURIComponent(S.lastEventId) : '') +
     (t ? '&token=' + encodeURIComponent(t) : '');
   const es = S.es = new EventSource(url);
   es.addEventListener('hello', serial(async () => {
@@ -260,8 +326,9 @@ function connect() {
   on('campaign', serial(onCampaign));
   on('node', onNode);
   on('table', serial(onTable));
-  for (const k of ['fit', 'transmissibility', 'command', 'shakedown', 'training', 'validation']) on(k, serial(r => onRecord(k, r)));
+  for (const k of ['fit', 'transmissibility', 'command', 'shakedown', 'training', 'validation', ...SINE_EVENTS]) on(k, serial(r => onRecord(k, r)));
   es.onerror = () => {
+    if (S.es !== es) return;  // replaced (a new rate): not an outage
     setOnline(false);
     if (es.readyState === EventSource.CLOSED) { es.close(); setTimeout(connect, 2000); }  // the browser gave up: start again
   };
@@ -281,17 +348,31 @@ async function refreshStatus() {
 
 function onSamples(m) {
   if (!S.detail || m.run !== S.runId) return;
-  if (S.detail.kind === 'sine') { timeplot.push(m.t, m.cmd, m.disp, KEEP); loop.append(0, m.cmd, m.disp); }
-  else { timeplot.push(m.t, m.disp, m.force, KEEP); loop.append(0, m.disp, m.force); }
-  if (loop.points(0) > KEEP * 2) loop.trim(0, KEEP);
+  if (isSine()) {
+    const base = signal(m, 'base_displacement_mm', 'cmd'), mass = signal(m, 'mass_displacement_mm', 'disp');
+    sweep.time.push(m.t, base, mass, signal(m, 'mass_accel_m_s2', 'force'));
+    loop.append(0, base, mass);
+    if (loop.points(0) > SHAKER_LOOP_KEEP * 1.5) loop.trim(0, SHAKER_LOOP_KEEP);
+  } else {
+    timeplot.push(m.t, m.disp, m.force, KEEP);
+    loop.append(0, m.disp, m.force);
+    if (loop.points(0) > KEEP * 2) loop.trim(0, KEEP);
+  }
   scheduleRedraw();
+}
+
+// A live signal by its name: the stream says what its cmd, disp and force hold (`signals`); an
+// older daemon does not, and a shaker's are base, mass and mass acceleration there.
+function signal(m, name, fallback) {
+  const k = Array.isArray(m.signals) ? m.signals.indexOf(name) : -1;
+  return k >= 0 ? m[['cmd', 'disp', 'force'][k]] : m[fallback];
 }
 
 let redrawPending = false;
 function scheduleRedraw() {
   if (redrawPending) return;
   redrawPending = true;
-  requestAnimationFrame(() => { redrawPending = false; loop.redraw(); timeplot.redraw(); });
+  requestAnimationFrame(() => { redrawPending = false; loop.redraw(); if (isSine()) sweep.time.redraw(); else timeplot.redraw(); });
 }
 
 async function onCampaign(ev) {
@@ -303,7 +384,7 @@ async function onCampaign(ev) {
     // then: selecting again would throw away the live samples already drawn.
     if (S.runId !== before) await select(ev.campaign);
     // Ended: the whole run from the store (a sine sweep makes no table to trigger it).
-    else if (ev.final && S.runId) { await loadRun(S.runId); await loadLoop(LOOP_POINTS); redraw(); }
+    else if (ev.final && S.runId) { await loadRunAndLoop(); redraw(); }
   } else if (S.follow && ev.to === 'arming') await select(ev.campaign);
 }
 function onNode(n) {
@@ -315,12 +396,16 @@ function onNode(n) {
 async function onTable(t) {
   if (t.campaign !== S.selected) return;
   await refreshDetail();
-  if (S.runId) { await loadRun(S.runId); await loadLoop(LOOP_POINTS); }  // the whole run, with the model
+  if (S.runId) await loadRunAndLoop();  // the whole run, with the model
   redraw();
 }
 async function onRecord(kind, r) {
   if (r.campaign !== S.selected) return;
-  if (kind === 'transmissibility') { S.trans.push({ frequency_hz: r.detail.frequency_hz, ratio: r.detail.ratio }); drawTrans(); }
+  if (isSine()) {
+    sweep.onRecord(kind, r);
+    // A step begins: the header says so now; the next poll brings the rest.
+    if (kind === 'sine_step') { showProgress(S.detail); return; }
+  }
   await refreshDetail();
 }
 

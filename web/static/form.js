@@ -18,10 +18,21 @@ const FIELDS = [
   { name: 'reversals', group: 'fot', label: 'validation reversals (0: none)', value: '12', int: true, min: 0, max: 10000, plan: 'validation.reversals' },
   { name: 'plateaus', group: 'fot', label: 'plateau forces at', unit: 'mm', value: '', optional: true, list: true, placeholder: 'none', min: -1e4, max: 1e4, plan: 'plateaus_mm', type: 'text' },
   { name: 'repeats', group: 'fot', label: 'repeats', value: '1', int: true, min: 1, max: 100, plan: 'repeats' },
-  { name: 'freqs', group: 'sine', label: 'frequencies', unit: 'Hz', value: '2, 4, 6, 8, 10, 12', list: true, min: 1e-3, max: 1000, plan: 'frequencies_hz', type: 'text' },
-  { name: 'amp', group: 'sine', label: 'amplitude', unit: 'mm', value: '0.5', min: 1e-4, max: 100, plan: 'amplitude_mm' },
-  { name: 'settle', group: 'sine', label: 'settle cycles', value: '10', int: true, min: 0, max: 100000, plan: 'settle_cycles' },
-  { name: 'measured', group: 'sine', label: 'measured cycles', value: '5', int: true, min: 1, max: 100000, plan: 'measured_cycles' },
+  // A sine sweep: log-spaced steps from … to, or a list of its own; each amplitude swept in the
+  // direction(s) given. Defaults that show the simulated isolator's resonance (17.7 Hz) and its
+  // amplitude dependence in about 4 minutes.
+  { name: 'fromhz', group: 'sine', label: 'sweep from', unit: 'Hz', value: '5', min: 1e-3, max: 1000, plan: 'sweep.from_hz', sweep: true },
+  { name: 'tohz', group: 'sine', label: 'sweep to', unit: 'Hz', value: '60', min: 1e-3, max: 1000, plan: 'sweep.to_hz', sweep: true },
+  { name: 'steps', group: 'sine', label: 'steps (log spaced)', value: '24', int: true, min: 2, max: 1000, plan: 'sweep.steps', sweep: true },
+  { name: 'freqs', group: 'sine', label: 'or these frequencies', unit: 'Hz', value: '', optional: true, list: true, placeholder: 'the steps above', min: 1e-3, max: 1000, plan: 'frequencies_hz', type: 'text' },
+  { name: 'direction', group: 'sine', label: 'direction', value: 'up-down', options: [['up', 'up'], ['down', 'down'], ['up-down', 'up-down']], plan: 'direction' },
+  { name: 'amps', group: 'sine', label: 'base amplitudes (peak)', unit: 'mm', value: '0.005, 0.05', list: true, min: 1e-4, max: 100, plan: 'amplitudes_mm', type: 'text' },
+  { name: 'settlechange', group: 'sine', label: 'settle until the response changes less than', unit: '%', value: '2', optional: true, placeholder: 'settle cycles', min: 0.01, max: 100, plan: 'settle.change' },
+  { name: 'settle', group: 'sine', label: 'or settle cycles (instead)', value: '', optional: true, int: true, placeholder: 'until settled', min: 0, max: 100000, plan: 'settle_cycles' },
+  { name: 'measured', group: 'sine', label: 'measured cycles', value: '10', int: true, min: 1, max: 100000, plan: 'measured_cycles' },
+  { name: 'tol', group: 'sine', label: 'control tolerance', unit: '%', value: '5', min: 0.01, max: 100, plan: 'control.tolerance' },
+  { name: 'warn', group: 'sine', label: 'control warning beyond', unit: '%', value: '', optional: true, placeholder: "daemon's: 10", min: 0.01, max: 1000, plan: 'control.warning' },
+  { name: 'abortpct', group: 'sine', label: 'control abort beyond', unit: '%', value: '', optional: true, placeholder: "daemon's: 30", min: 0.01, max: 1000, plan: 'control.abort' },
   { name: 'hz', group: 'common', label: 'sample rate', unit: 'Hz', value: '1000', min: 1, max: 10000, plan: 'sample_rate_hz' },
   { name: 'dlo', group: 'limits', label: 'lower displacement limit', unit: 'mm', value: '', optional: true, placeholder: 'δmin − 0.5', min: -1e4, max: 1e4, plan: 'limits.displacement_mm' },
   { name: 'dhi', group: 'limits', label: 'upper displacement limit', unit: 'mm', value: '', optional: true, placeholder: 'δmax + 0.5', min: -1e4, max: 1e4, plan: 'limits.displacement_mm' },
@@ -30,7 +41,9 @@ const FIELDS = [
 ];
 const GROUP_TITLES = { fot: null, sine: null, common: null, limits: 'Limits (blank: the rig’s own)' };
 // The server's field names, as the form says them (for its messages).
-const WORDS = [['limits.displacement_mm', 'displacement limits'], ['limits.safe_position_mm', 'safe position'],
+const WORDS = [['sweep.from_hz', 'sweep from'], ['sweep.to_hz', 'sweep to'], ['sweep.steps', 'steps'], ['frequencies_hz', 'frequencies'],
+  ['amplitudes_mm', 'amplitudes'], ['settle.change', 'settle change'], ['settle_cycles', 'settle cycles'], ['control.tolerance', 'control tolerance'],
+  ['control.warning', 'control warning'], ['control.abort', 'control abort'], ['limits.displacement_mm', 'displacement limits'], ['limits.safe_position_mm', 'safe position'],
   ['limits.force_N', 'force limit'], ['limits.rate_mm_s', 'rate limit'], ['range_mm', 'δmin … δmax'],
   ['training.until.energy_change', 'energy change per cycle'], ['training.until.consecutive', 'cycles in a row'],
   ['training.max_cycles', 'training cycles'], ['validation.reversals', 'validation reversals'], ['validation.rate_mm_s', 'validation rate'],
@@ -65,8 +78,10 @@ export class PlanForm {
       if (GROUP_TITLES[g]) box.append(el('legend', { text: GROUP_TITLES[g] }));
       for (const f of FIELDS.filter(x => x.group === g)) {
         const id = 'f-' + f.name;
-        const input = el('input', { id, name: f.name, type: f.type || 'text', inputmode: f.type ? null : 'decimal',
-                                    value: f.value, placeholder: f.placeholder || null, 'aria-describedby': id + '-msg', autocomplete: 'off' });
+        const input = f.options ? el('select', { id, name: f.name, 'aria-describedby': id + '-msg' }, ...f.options.map(([v, text]) => el('option', { value: v, text })))
+          : el('input', { id, name: f.name, type: f.type || 'text', inputmode: f.type ? null : 'decimal',
+                          value: f.value, placeholder: f.placeholder || null, 'aria-describedby': id + '-msg', autocomplete: 'off' });
+        if (f.options) input.value = f.value;
         box.append(el('div', { class: 'field' },
           el('label', { for: id, text: f.label + (f.unit ? ` (${f.unit})` : '') }), input,
           el('span', { class: 'msg', id: id + '-msg', 'aria-live': 'polite' })));
@@ -93,6 +108,9 @@ export class PlanForm {
     if (names !== this.rigNames) {
       this.rigNames = names;
       this.form.rig.replaceChildren(...rigs.map(r => el('option', { value: r.name, 'data-kind': r.kind, text: `${r.name} (${r.kind === 'shaker' ? 'shaker' : 'load frame'})` })));
+      // Rigs of one kind only (a daemon with a shaker alone): the form offers what they can run.
+      const kinds = new Set(rigs.map(r => (r.kind === 'shaker' ? 'sine' : 'fot')));
+      if (kinds.size === 1 && !kinds.has(this.form.kind.value)) { this.form.kind.value = [...kinds][0]; this.showKind(); }
       if (chosen && rigs.some(r => r.name === chosen)) this.form.rig.value = chosen; else this.pickRigFor(this.form.kind.value);
       this.schedulePreview();
     }
@@ -111,13 +129,18 @@ export class PlanForm {
     const key = String(field || '').replace(/^plan\./, '').replace(/\[\d+\]$/, '');
     if (key === 'range_mm') return ['lo', 'hi'];
     if (key === 'limits.displacement_mm' || key === 'limits.safe_position_mm') return ['dlo', 'dhi'];
-    if (key === 'sweep' || key.startsWith('sweep.')) return ['freqs'];
+    const f = FIELDS.find(x => x.plan === key && !this.inputOf(x.name).closest('fieldset').hidden);
+    if (f) return [f.name];
+    // Fields without an input of their own: the nearest input that sets them.
+    if (key === 'sweep' || key.startsWith('sweep.')) return [this.inputOf('freqs').value.trim() ? 'freqs' : 'fromhz'];
+    if (key === 'amplitude_mm') return ['amps'];
+    if (key.startsWith('settle')) return ['settlechange'];
+    if (key.startsWith('control')) return ['tol'];
     if (key === 'limits') return ['force'];
     if (key.startsWith('training.until')) return ['stable'];
     if (key.startsWith('training')) return ['training'];
     if (key.startsWith('validation')) return ['reversals'];
-    const f = FIELDS.find(x => x.plan === key && !this.inputOf(x.name).closest('fieldset').hidden);
-    return f ? [f.name] : [];
+    return [];
   }
   inputOf(name) { return this.form.querySelector(`#f-${name}`); }
   mark(name, message) {
@@ -158,9 +181,11 @@ export class PlanForm {
     const sine = form.kind.value === 'sine';
     const groups = sine ? ['sine', 'common'] : ['fot', 'common', 'limits'];
     const errors = [], v = {};
-    for (const f of FIELDS.filter(x => groups.includes(x.group))) {
+    const list = sine && this.inputOf('freqs').value.trim() !== '';  // a list of frequencies: the steps' fields are not used
+    for (const f of FIELDS.filter(x => groups.includes(x.group) && !(list && x.sweep))) {
       const raw = this.inputOf(f.name).value.trim();
       const what = f.label;
+      if (f.options) { v[f.name] = raw; continue; }
       if (raw === '') { if (!f.optional) errors.push([f.name, `${what} is required`]); continue; }
       const parts = f.list ? raw.split(/[,;\s]+/).filter(Boolean) : [raw];
       const vals = parts.map(p => Number(p.replace(',', '.')));
@@ -177,10 +202,9 @@ export class PlanForm {
       if (v.dhi != null && v.hi != null && v.dhi < v.hi) errors.push(['dhi', 'the upper displacement limit must be at or above δmax']);
       if ((v.dlo == null) !== (v.dhi == null)) errors.push([v.dlo == null ? 'dlo' : 'dhi', 'give both displacement limits, or neither']);
     }
+    if (sine) errors.push(...sineErrors(v));
     if (errors.length) return { errors };
-    if (sine) {
-      return { plan: { kind: 'sine', frequencies_hz: v.freqs, amplitude_mm: v.amp, settle_cycles: v.settle, measured_cycles: v.measured, sample_rate_hz: v.hz } };
-    }
+    if (sine) return { plan: sinePlan(v) };
     const limits = {};
     if (v.dlo != null) limits.displacement_mm = [v.dlo, v.dhi];
     if (v.force != null) limits.force_N = v.force;
@@ -243,10 +267,37 @@ export class PlanForm {
   }
 }
 
-// "about 2 min 10 s · 45 nodes · peak speed 0.5 mm/s · peak force ≈ 380 N (from table #3)"
+// A sine plan's own checks (the daemon's, daemon/src/sine_plan.cpp), in the form's words.
+function sineErrors(v) {
+  const errors = [], highest = v.freqs ? Math.max(...v.freqs) : v.tohz;
+  if (!v.freqs && v.fromhz != null && v.tohz != null && !(v.tohz > v.fromhz)) errors.push(['tohz', 'sweep to must be above sweep from']);
+  if (v.freqs && new Set(v.freqs).size !== v.freqs.length) errors.push(['freqs', 'frequencies must not repeat']);
+  if (v.hz != null && highest > v.hz / 8)
+    errors.push([v.freqs ? 'freqs' : 'tohz', `at most ${num(v.hz / 8)} Hz: 8 samples a cycle at the sample rate of ${num(v.hz)} Hz`]);
+  if (v.amps && v.amps.length > 20) errors.push(['amps', 'at most 20 amplitudes']);
+  if (v.warn != null && v.tol != null && v.warn < v.tol) errors.push(['warn', 'the control warning must be at least the tolerance']);
+  if (v.abortpct != null && !(v.abortpct > Math.max(v.warn ?? 10, v.tol ?? 0))) errors.push(['abortpct', `the control abort must be above the warning (${num(v.warn ?? 10)} %)`]);
+  return errors;
+}
+
+// The plan from the checked values: a settle criterion unless settle cycles are given; the
+// control's warning and abort bands left to the daemon when blank.
+function sinePlan(v) {
+  const plan = { kind: 'sine', direction: v.direction, amplitudes_mm: v.amps, measured_cycles: v.measured, sample_rate_hz: v.hz };
+  if (v.freqs) plan.frequencies_hz = v.freqs; else plan.sweep = { from_hz: v.fromhz, to_hz: v.tohz, steps: v.steps, spacing: 'log' };
+  if (v.settle != null) plan.settle_cycles = v.settle;
+  else if (v.settlechange != null) plan.settle = { change: `${v.settlechange} %` };
+  plan.control = { tolerance: `${v.tol} %` };
+  if (v.warn != null) plan.control.warning = `${v.warn} %`;
+  if (v.abortpct != null) plan.control.abort = `${v.abortpct} %`;
+  return plan;
+}
+
+// "about 2 min 10 s · 45 nodes · peak speed 0.5 mm/s · peak force ≈ 380 N (from table #3)"; a sweep: steps and peak acceleration.
 export function previewText(p) {
   const parts = [`about ${duration(p.duration_s)}`];
-  if (p.nodes != null) parts.push(`${count(p.nodes)} nodes`);
+  if (p.nodes != null) parts.push(`${count(p.nodes)} ${p.kind === 'sine' ? 'steps' : 'nodes'}`);
+  if (p.peak_accel_m_s2 != null) parts.push(`peak acceleration ${num(p.peak_accel_m_s2, 2)} m/s² (${num(p.peak_accel_m_s2 / 9.80665, 2)} g)`);
   if (p.samples != null) parts.push(`${count(p.samples)} samples`);
   if (p.peak_speed_mm_s != null) parts.push(`peak speed ${num(p.peak_speed_mm_s, 2)} mm/s`);
   if (p.peak_force_N != null) parts.push(`peak force ≈ ${round2(p.peak_force_N)} N${p.force_source ? ` (from ${p.force_source})` : ''}`);

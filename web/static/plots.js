@@ -15,7 +15,7 @@ function extent(arrays, fallback) {
 }
 
 // Calls fn(width) when the element's width changes (not its height: that is ours to set).
-function onWidth(el, fn) {
+export function onWidth(el, fn) {
   let last = 0;
   new ResizeObserver(entries => {
     const w = Math.floor(entries[0].contentRect.width);
@@ -111,11 +111,8 @@ export class TimePlot {
       series: [{}, { label: labels[0], scale: 'a', stroke: '#1565c0' }, { label: labels[1], scale: 'b', stroke: '#c62828' }],
     }, [this.t, this.a, this.b], this.el);
   }
-  setLabels(labels) {
-    if (this.labels[0] === labels[0] && this.labels[1] === labels[1]) return;
-    this.u.destroy();
-    this.build(labels);
-  }
+  // For the tests: its y axes (two: displacement and force) and what is drawn.
+  axes() { return { yAxes: this.u.axes.filter(a => a.scale !== 'x').length, label: this.labels.join(' / '), legend: this.labels.slice(), points: this.t.length }; }
   clear() { this.t = []; this.a = []; this.b = []; }
   push(t, a, b, keep) {
     for (let k = 0; k < t.length; k++) {

@@ -17,7 +17,8 @@ const figure = (n, one, many) => el('span', { class: n ? 'bad' : '', text: plura
 function runLine(r) {
   const q = r.quality;
   const li = el('li', {}, `run #${r.id}: `);
-  if (!q) { li.append(`${plural(r.samples || 0, 'sample')} (this daemon gives no quality figures)`); return li; }
+  // A run's figures are stored at its end; before that, only its samples.
+  if (!q) { li.append(`${plural(r.samples || 0, 'sample')}` + (r.state === 'running' ? ' so far (its quality figures come at its end)' : ' (this daemon gives no quality figures)')); return li; }
   const parts = [plural(q.samples ?? r.samples ?? 0, 'sample'), rateText(q),
     figure(q.missed_deadlines, 'missed deadline'), figure(q.lost_samples, 'lost sample'), figure(q.io_errors, 'I/O error')];
   const gaps = q.gaps || 0;
@@ -27,13 +28,15 @@ function runLine(r) {
   return li;
 }
 
-// Fills the quality list and the warning box; returns the warnings shown.
-export function showQuality(d, listEl, boxEl) {
+// Fills the quality list and the warning box; returns the warnings shown. `extra`: the
+// campaign's own warnings in words (a sweep's control warnings, say), after the runs' and tables'.
+export function showQuality(d, listEl, boxEl, extra = []) {
   const runs = (d && d.runs) || [], tables = (d && d.tables) || [];
   listEl.replaceChildren(...runs.map(runLine));
   const warnings = [];
   for (const r of runs) for (const w of (r.quality && r.quality.warnings) || []) warnings.push(`run #${r.id}: ${w}`);
   for (const t of tables) for (const w of t.warnings || []) warnings.push(`table #${t.id}: ${w}`);
+  warnings.push(...extra);
   boxEl.replaceChildren(...(warnings.length ? [el('strong', { text: `Check before trusting this campaign (${plural(warnings.length, 'warning')}):` }),
     el('ul', {}, ...warnings.map(w => el('li', { text: w })))] : []));
   boxEl.hidden = warnings.length === 0;
