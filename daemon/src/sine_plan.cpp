@@ -80,13 +80,15 @@ SineSettle parse_settle(const json& j) {
     return s;
   }
   const json& b = j["settle"];
-  if (!b.is_object()) fields::fail("settle", "must be an object: {\"change\": \"2 %\", \"consecutive\": 2, \"max_cycles\": 400}");
-  fields::only(b, "settle.", {"change", "consecutive", "max_cycles"});
+  if (!b.is_object()) fields::fail("settle", "must be an object: {\"change\": \"2 %\", \"consecutive\": 2, \"min_cycles\": 30, \"max_cycles\": 400}");
+  fields::only(b, "settle.", {"change", "consecutive", "min_cycles", "max_cycles"});
   s.until = true;
   s.cycles = 0;
   s.change_pct = fields::percent(b, "change", s.change_pct, "settle.");
   s.consecutive = fields::integer(b, "consecutive", s.consecutive, 1, 100, "settle.");
+  s.min_cycles = fields::integer(b, "min_cycles", s.min_cycles, 0, 100000, "settle.");
   s.max_cycles = fields::integer(b, "max_cycles", s.max_cycles, 1, 100000, "settle.");
+  if (s.max_cycles < s.min_cycles) fields::fail("settle.max_cycles", "must be at least settle.min_cycles");
   return s;
 }
 
@@ -163,13 +165,17 @@ double continuous_seconds(const SinePlan& p) {
 }
 }  // namespace
 
+double step_nominal_s(const SinePlan& p, double f) {
+  const int control = p.control.closed ? p.control.window_cycles + 1 : 0;  // one window and a cycle of transient, when it is on target at once
+  const int settle = p.settle.until ? p.settle.min_cycles + (p.settle.consecutive + 1) * std::max(1, p.control.window_cycles) : p.settle.cycles;
+  return (control + settle + p.measured_cycles) / f;
+}
+
 double nominal_duration_s(const SinePlan& p) {
   const auto passes = sweep_passes(p);
-  const int control = p.control.closed ? p.control.window_cycles + 1 : 0;  // one window and a cycle of transient, when it is on target at once
-  const int settle = p.settle.until ? (p.settle.consecutive + 1) * std::max(1, p.control.window_cycles) : p.settle.cycles;
-  if (p.continuous) return static_cast<double>(passes.size()) * (continuous_seconds(p) + (control + settle) / p.from_hz);
+  if (p.continuous) return static_cast<double>(passes.size()) * (continuous_seconds(p) + step_nominal_s(p, p.from_hz) - p.measured_cycles / p.from_hz);
   double per_pass = 0;
-  for (const double f : p.frequencies_hz) per_pass += (control + settle + p.measured_cycles) / f;
+  for (const double f : p.frequencies_hz) per_pass += step_nominal_s(p, f);
   return static_cast<double>(passes.size()) * per_pass;
 }
 

@@ -98,12 +98,14 @@ class SineStrategy final : public Strategy {
     return open(Mode::sweep, 0, s_.measured_cycles);
   }
 
-  // Seconds left at the pace so far (the plan's nominal time, stretched by how much longer the
-  // steps done took than theirs).
+  // Seconds left at the pace so far: the plan's nominal time not yet done, stretched by how much
+  // longer the steps done took than theirs (per step: a 5 Hz step is ten times a 50 Hz one, and
+  // counting steps alike put the default sweep's first estimate at 513 s for 282 s).
   double eta(double t) const {
-    const double nominal = nominal_duration_s(s_), done_fraction = total_ > 0 ? static_cast<double>(points_) / static_cast<double>(total_) : 0;
-    const double elapsed = t - t0_, pace = done_fraction > 0 ? std::max(1.0, elapsed / (nominal * done_fraction)) : 1.0;
-    return nominal * (1 - done_fraction) * pace;
+    const double nominal = nominal_duration_s(s_);
+    const double done = s_.continuous ? (total_ > 0 ? nominal * static_cast<double>(points_) / static_cast<double>(total_) : 0.0) : nominal_done_;
+    const double pace = done > 0 ? std::max(1.0, (t - t0_) / done) : 1.0;
+    return std::max(0.0, nominal - done) * pace;
   }
 
   bool on_window(Loop& L, double t) {
@@ -177,7 +179,7 @@ class SineStrategy final : public Strategy {
     if (!s_.settle.until) return to_measure();
     settled_cycles_ += s_.control.window_cycles;
     const double change = std::fabs(mass - prev_mass_) / std::max(prev_mass_, 1e-12) * 100;
-    stable_ = change < s_.settle.change_pct ? stable_ + 1 : 0;
+    stable_ = change < s_.settle.change_pct && settled_cycles_ >= s_.settle.min_cycles ? stable_ + 1 : 0;
     prev_mass_ = mass;
     if (stable_ >= s_.settle.consecutive) return to_measure();
     if (settled_cycles_ >= s_.settle.max_cycles) {
@@ -236,12 +238,13 @@ class SineStrategy final : public Strategy {
     const double phase = std::remainder(m.fundamental.phase_rad - b.fundamental.phase_rad, kTwoPi);
     const double f = s_.continuous ? w_.mean_frequency() : f_;
     ++points_;
+    if (!s_.continuous) nominal_done_ += step_nominal_s(s_, f_);
     const nlohmann::json rec{{"k", points_}, {"of", total_}, {"pass", pass_ + 1}, {"frequency_hz", f}, {"amplitude_mm", demand()},
                              {"direction", up() ? "up" : "down"}, {"drive_mm", drive_}, {"base_amplitude_mm", b.fundamental.amplitude},
                              {"base_phase_rad", b.fundamental.phase_rad}, {"mass_amplitude_mm", m.fundamental.amplitude},
                              {"mass_phase_rad", m.fundamental.phase_rad}, {"ratio", ratio}, {"phase_rad", phase}, {"thd", m.thd},
                              {"harmonics", m.harmonics}, {"control_error_pct", v.error_pct}, {"band", to_string(v.band)},
-                             {"control_windows", control_windows_}, {"settle_cycles", settled_cycles_}, {"t_s", t}, {"eta_s", eta(t)}};
+                             {"control_windows", control_windows_}, {"settle_cycles", s_.settle.until ? settled_cycles_ : s_.settle.cycles}, {"t_s", t}, {"eta_s", eta(t)}};
     steps_.push_back({points_, PredictStep{f, b.fundamental.amplitude, settled_cycles_ + s_.settle.cycles, s_.measured_cycles}});
     db::SinePointRow row{points_, f, demand(), b.fundamental.amplitude, m.fundamental.amplitude, ratio, phase, up() ? "up" : "down", rec.dump()};
     const auto run = L.result.run_id, id = L.job.id;
@@ -263,7 +266,7 @@ class SineStrategy final : public Strategy {
   Mode mode_ = Mode::control;
   SineWindow w_;
   bool started_ = false, sweep_over_ = false, warned_ = false, established_ = false;
-  double t0_ = 0, last_t_ = 0, f_ = 0, drive_ = 0, prev_mass_ = NAN, next_cycle_ = 0;
+  double t0_ = 0, last_t_ = 0, f_ = 0, drive_ = 0, prev_mass_ = NAN, next_cycle_ = 0, nominal_done_ = 0;
   int control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warnings_ = 0;
 };
 }  // namespace

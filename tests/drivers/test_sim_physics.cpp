@@ -434,3 +434,4 @@ TEST_CASE("shakedown specimen: the upper plateau comes down cycle by cycle and s
   CHECK(models::transitions(s.parameters_of(3)).As.force == doctest::Approx(models::transitions(settled).As.force));
 }
 
+

@@ -14,7 +14,7 @@ struct SweepPoint {
 };
 
 struct Resonance {
-  double frequency_hz = 0, peak_ratio = 0;  // at the sweep's highest point, refined by a parabola in log-log
+  double frequency_hz = 0, peak_ratio = 0;  // the sweep's highest point (refined by a parabola in log-log when resolved)
   double lower_hz = 0, upper_hz = 0;        // half-power points (ratio = peak/√2), 0 when the sweep ends before one
   double bandwidth_hz = 0, q = 0;           // upper − lower and f/bandwidth, 0 unless both points are inside the sweep
   bool at_edge = false;                     // the highest point is the sweep's first or last: the peak may lie beyond
