@@ -166,7 +166,12 @@ double continuous_seconds(const SinePlan& p) {
 }  // namespace
 
 double step_nominal_s(const SinePlan& p, double f) {
-  const int control = p.control.closed ? p.control.window_cycles + 1 : 0;  // one window and a cycle of transient, when it is on target at once
+  // The control windows (each with its cycle of transient) from the start level down to the
+  // tolerance when the table's response is as learnt: the error shrinks by (1 − gain) a window.
+  const SineControl& c = p.control;
+  const double e0 = std::fabs(c.start_level - 1), tol = c.tolerance_pct / 100;
+  const int windows = e0 <= tol ? 1 : 1 + static_cast<int>(std::ceil(std::log(tol / e0) / std::log(std::max(1e-9, 1 - c.gain))));
+  const int control = c.closed ? std::min(windows, c.max_windows) * (c.window_cycles + 1) : 0;
   const int settle = p.settle.until ? p.settle.min_cycles + (p.settle.consecutive + 1) * std::max(1, p.control.window_cycles) : p.settle.cycles;
   return (control + settle + p.measured_cycles) / f;
 }

@@ -22,6 +22,7 @@
 #include "can_endpoint.hpp"
 #include "control_channel.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/linear_spring.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/simplified_sma.hpp"
 #include "hystlab/protocols/default_maps.hpp"
@@ -47,6 +48,7 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --sample-rate HZ               simulated samples per simulated second (default 1000)
   --seed N  --noise N  --drift N_PER_S      load cell noise (1 sigma, N) and drift
   --params P.json | --table T.json          the specimen (default: Table 1, corners smoothed)
+  --linear K                     a linear spring of K N/mm instead (the reference a hysteretic isolator is compared with)
   --corner-width MM              corner smoothing width of the specimen (default 0.05; 0: none)
   --shakedown EXTRA,TAU          an untrained specimen (simplified model only): its upper plateau starts EXTRA N
                                  higher and settles by exp(-N/TAU) over transformation cycles N (see SIM.md)
@@ -75,6 +77,7 @@ struct Args {
   double time_scale = 1, sample_rate = 1000, can_rate = 1000, noise = 0.05, drift = 0, corner = 0.05, duration = 0;
   double deadband_mm = 0, host_timeout_ms = 0, mode = 1;
   double shakedown_N = 0, shakedown_tau = 0;  // 0: a trained specimen
+  double linear = 0;                           // > 0: a linear spring of this stiffness (N/mm)
   bool exit_with_parent = false;
   std::uint64_t seed = 1;
   std::vector<std::string> faults;
@@ -124,6 +127,7 @@ Args parse(int argc, char** argv) {
     else if (o == "--drift") a.drift = num();
     else if (o == "--params") a.params = v;
     else if (o == "--table") a.table = v;
+    else if (o == "--linear") a.linear = num();
     else if (o == "--corner-width") a.corner = num();
     else if (o == "--shakedown") {
       const auto comma = v.find(',');
@@ -153,10 +157,13 @@ Args parse(int argc, char** argv) {
   if (!(a.deadband_mm >= 0) || !std::isfinite(a.deadband_mm)) throw std::runtime_error("--deadband-mm must be a number >= 0");
   if (!(a.host_timeout_ms >= 0) || !std::isfinite(a.host_timeout_ms)) throw std::runtime_error("--host-timeout-ms must be a number >= 0");
   if (a.mode < 0 || a.mode > 65535 || a.mode != std::floor(a.mode)) throw std::runtime_error("--mode must be a whole number from 0 to 65535");
+  if (a.linear != 0 && (!(a.linear > 0) || a.linear > 1e6 || !a.params.empty() || !a.table.empty() || a.shakedown_N > 0))
+    throw std::runtime_error("--linear K: a stiffness above 0 and at most 1e6 N/mm, without --params, --table or --shakedown");
   return a;
 }
 
 std::unique_ptr<models::HysteresisModel> specimen(const Args& a) {
+  if (a.linear > 0) return std::make_unique<models::LinearSpring>(a.linear);
   if (!a.table.empty()) {
     if (a.shakedown_N > 0) throw std::runtime_error("option --shakedown needs the simplified model (not --table)");
     return std::make_unique<models::PreisachModel>(models::table_from_json(read_file(a.table)).table);

@@ -88,6 +88,36 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   CHECK(drive_min < 0.005 * 0.95);
 }
 
+TEST_CASE("sine campaign with linear springs: the transmissibility of the analytic linear isolator, at an amplitude that would transform SMA springs") {
+  // hystlab-sim --linear 40: the same isolator (13 kg, 4 springs, 58 N·s/m) on linear springs of
+  // the SMA springs' elastic stiffness. At 0.05 mm and 16 Hz the relative motion (0.22 mm) would
+  // pass the SMA springs' Ms; linear springs keep the curve analytic there.
+  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25", "--linear", "40"});
+  Bench b;
+  auto rig = shaker_rig(sim.modbus_port);
+  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {12, 16, 30}}, {"amplitude_mm", 0.05},
+                                        {"settle", {{"change", "1 %"}, {"consecutive", 3}}}, {"measured_cycles", 8}, {"sample_rate_hz", 1000}});
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 0.25, true);
+  const auto r = run(id, plan, ctx);
+  CAPTURE(r.reason);
+  REQUIRE(end_of(r) == "completed");
+  b.writer->flush();
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 3);
+  const double fn = std::sqrt(4 * 40e3 / 13.0) / (2 * std::numbers::pi), zeta = 58 / (2 * std::sqrt(4 * 40e3 * 13.0));
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    const double f = p["frequency_hz"];
+    CHECK(std::fabs(p["ratio"].get<double>() / models::linear_transmissibility(f / fn, zeta) - 1) < 0.03);
+    // The phase of X/Y = (k + icω)/(k − mω² + icω), in the fit's convention (mass minus base).
+    const double w = 2 * std::numbers::pi * f, k = 4 * 40e3, c = 58, m = 13;
+    const double expected = std::atan2(c * w, k) - std::atan2(c * w, k - m * w * w);
+    CHECK(std::fabs(std::remainder(p["phase_rad"].get<double>() - expected, 2 * std::numbers::pi)) < 0.05);
+    CHECK(p["thd"].get<double>() < 0.01);
+  }
+}
+
 TEST_CASE("sine campaign: beyond the abort band the shaker is stopped, at zero drive, and the reason stored") {
   SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"});
   Bench b;

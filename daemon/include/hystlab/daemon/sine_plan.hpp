@@ -81,8 +81,9 @@ struct SweepPass {
 // Nominal duration (s): every step's control, settle and measurement at its nominal length (a
 // continuous pass: its frequency span at its rate, plus the first settle).
 [[nodiscard]] double nominal_duration_s(const SinePlan& p);
-// One stepped step's nominal seconds at f: a control window (with its cycle of transient), the
-// settle (its minimum and the criterion's windows, or the fixed cycles) and the measurement.
+// One stepped step's nominal seconds at f: the control windows from the start level to the
+// tolerance (each with its cycle of transient), the settle (its minimum and the criterion's
+// windows, or the fixed cycles) and the measurement.
 [[nodiscard]] double step_nominal_s(const SinePlan& p, double f);
 // The number of steps (points) of the plan: stepped: every frequency of every pass; continuous:
 // about one point per measured window.
