@@ -181,8 +181,12 @@ export class SweepView {
       const cells = !res ? ['–', '–', '–', '–', '–'] : [
         res.at_edge ? 'beyond the sweep' : num(res.frequency_hz),
         (res.at_edge ? '≥ ' : '') + num(res.peak_ratio),
-        halfPower(res), res.bandwidth_hz != null ? num(res.bandwidth_hz) : '–', res.q != null ? num(res.q) : '–'];
-      return el('tr', { class: which, title: res && res.at_edge ? `the highest point (${hz(res.frequency_hz)}) is at the sweep's end: the peak may lie beyond` : '' },
+        // Steps coarser than the peak (resolved false): the bandwidth is at most, and Q at least, what is shown.
+        halfPower(res), res.bandwidth_hz != null ? (res.resolved === false ? '≤ ' : '') + num(res.bandwidth_hz) : '–',
+        res.q != null ? (res.resolved === false ? '≥ ' : '') + num(res.q) : '–'];
+      const why = res && res.at_edge ? `the highest point (${hz(res.frequency_hz)}) is at the sweep's end: the peak may lie beyond`
+        : res && res.resolved === false ? 'the steps are coarser than the peak: its bandwidth is at most, and its Q at least, what is shown' : '';
+      return el('tr', { class: which, title: why },
         el('td', { text: label }), ...cells.map(v => el('td', { text: v })));
     });
     const jumps = ((r && r.measured && r.measured.jumps) || []).map(j => el('li', { text: jumpText(j) }));
