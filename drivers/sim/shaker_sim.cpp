@@ -19,9 +19,9 @@ ShakerSim::ShakerSim(const models::HysteresisModel& spring, ShakerParams params)
     throw std::invalid_argument("shaker: servo_hz ≥ 0, servo_damping ≥ 0 and table_mass_kg > 0");
   if (2 * std::numbers::pi * p_.servo_hz * p_.dt_s > 0.5) throw std::invalid_argument("shaker: time step too large for the servo (dt·ω > 0.5)");
   // Static preload: the compression at which N springs carry the weight (bisection on copies
-  // loaded as the weight loads them, in small steps: a specimen with corner smoothing stepped
-  // from 0 to the preload at once kept a filter state that left the mass resting 0.13 mm low
-  // and the springs 5 % stiffer, 18.2 Hz against the 17.7 Hz of their elastic line).
+  // loaded as the weight loads them, in small steps), and the weight is then what they carry:
+  // stepped from 0 to the preload at once, the springs' force at rest did not balance the
+  // weight, and the mass rested 0.13 mm low (seen on the page's shared displacement axis).
   const auto loaded = [&](double x) {
     auto s = spring.clone();
     s->reset();
