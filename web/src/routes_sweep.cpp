@@ -54,13 +54,14 @@ json resonance_json(const std::optional<models::Resonance>& r) {
           {"q", r->q > 0 ? json(r->q) : json()}, {"at_edge", r->at_edge}, {"resolved", r->resolved}};
 }
 
-json report_json(const std::vector<db::TransmissibilityInfo>& rows, double threshold, bool predicted) {
+// points: point_json of each row, in the same order (each row's detail is parsed once).
+json report_json(const std::vector<db::TransmissibilityInfo>& rows, const json& points, double threshold, bool predicted) {
   std::vector<models::SweepCurvePoint> pts;
-  for (const db::TransmissibilityInfo& t : rows) {
-    const json p = point_json(t);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const db::TransmissibilityInfo& t = rows[k];
     const double ratio = predicted ? t.predicted_ratio : t.ratio, phase = predicted ? t.predicted_phase_rad : t.phase_rad;
     if (!std::isfinite(ratio)) continue;
-    pts.push_back({p["amplitude_mm"].get<double>(), p["direction"] == "up", {t.frequency_hz, ratio, phase}});
+    pts.push_back({points[k]["amplitude_mm"].get<double>(), points[k]["direction"] == "up", {t.frequency_hz, ratio, phase}});
   }
   const models::SweepReport r = models::analyse_sweep(pts, threshold);
   json curves = json::array(), jumps = json::array();
@@ -114,8 +115,8 @@ void add_sweep_routes(httplib::Server& s, ApiContext& c) {
     for (const db::TransmissibilityInfo& t : rows) points.push_back(point_json(t));
     const bool any_prediction = std::any_of(rows.begin(), rows.end(), [](const auto& t) { return std::isfinite(t.predicted_ratio); });
     res.set_header("Content-Disposition", "inline; filename=\"sweep-" + std::to_string(row.id) + ".json\"");
-    send_json(res, {{"campaign", row.id}, {"jump_threshold", threshold}, {"points", points}, {"measured", report_json(rows, threshold, false)},
-                    {"predicted", any_prediction ? report_json(rows, threshold, true) : json()}});
+    send_json(res, {{"campaign", row.id}, {"jump_threshold", threshold}, {"points", points}, {"measured", report_json(rows, points, threshold, false)},
+                    {"predicted", any_prediction ? report_json(rows, points, threshold, true) : json()}});
   }));
   s.Get(R"(/api/campaigns/(\d+)/sweep\.csv)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
