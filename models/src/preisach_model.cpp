@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <limits>
+#include <algorithm>
 #include <stdexcept>
+#include <string>
 
 namespace hystlab::models {
 
@@ -30,6 +32,59 @@ double PreisachModel::base_for(std::size_t len) const noexcept {
   const std::size_t pairs = len / 2;
   if (len & 1U) return closed_[pairs];  // rising from m_N, N = pairs
   return closed_[pairs - 1] + table_->value_in_range(turning_[len - 1], turning_[len - 2]);
+}
+
+}  // namespace hystlab::models
+
+namespace hystlab::models {
+namespace {
+constexpr double kPreisachStateKind = 1.0;
+constexpr std::size_t kPreisachHead = 8;  // kind, len, x, f, base and the three counters
+
+// A count stored as a double: a whole number in [lo, hi], or the error names it.
+std::size_t state_count(double v, double lo, double hi, const char* what) {
+  if (!(v >= lo && v <= hi) || v != std::floor(v))
+    throw std::invalid_argument(std::string("model state: ") + what + " is not a whole number in [" + std::to_string(static_cast<long long>(lo)) +
+                                ", " + std::to_string(static_cast<long long>(hi)) + "]");
+  return static_cast<std::size_t>(v);
+}
+}  // namespace
+
+std::vector<double> PreisachModel::save_state() const {
+  std::vector<double> s{kPreisachStateKind, static_cast<double>(len_), x_, f_, base_, static_cast<double>(saturations_),
+                        static_cast<double>(merges_), static_cast<double>(invalid_)};
+  s.insert(s.end(), turning_.begin(), turning_.begin() + static_cast<std::ptrdiff_t>(len_));
+  s.insert(s.end(), closed_.begin(), closed_.begin() + static_cast<std::ptrdiff_t>(len_ / 2 + 1));
+  return s;
+}
+
+// Every number is checked before any is taken, so a refused state leaves the model as it was.
+void PreisachModel::restore_state(std::span<const double> s) {
+  if (s.size() < kPreisachHead || s[0] != kPreisachStateKind) throw std::invalid_argument("model state: not the state of a Preisach (table) model");
+  const std::size_t len = state_count(s[1], 1, static_cast<double>(options_.max_turning_points), "the number of turning points");
+  if (s.size() != kPreisachHead + len + len / 2 + 1)
+    throw std::invalid_argument("model state: " + std::to_string(s.size()) + " numbers where " + std::to_string(len) + " turning points need " +
+                                std::to_string(kPreisachHead + len + len / 2 + 1));
+  constexpr double kMaxCount = 9007199254740992.0;  // 2^53: counts up to it are exact in a double
+  for (std::size_t k = 5; k < 8; ++k) (void)state_count(s[k], 0, kMaxCount, "a counter");
+  for (std::size_t k = 2; k < s.size(); ++k)
+    if (!std::isfinite(s[k])) throw std::invalid_argument("model state: value " + std::to_string(k) + " is not a finite number");
+  const Grid& g = table_->grid();
+  const std::span<const double> turning = s.subspan(kPreisachHead, len);
+  if (turning[0] != g.lo) throw std::invalid_argument("model state: the first turning point is not the table's lower end (another table's state?)");
+  for (const double t : turning)
+    if (t < g.lo || t > g.hi) throw std::invalid_argument("model state: a turning point lies outside the table's range (another table's state?)");
+  if (s[2] < g.lo || s[2] > g.hi) throw std::invalid_argument("model state: the input lies outside the table's range (another table's state?)");
+  len_ = len;
+  x_ = s[2];
+  f_ = s[3];
+  base_ = s[4];
+  saturations_ = static_cast<std::uint64_t>(s[5]);
+  merges_ = static_cast<std::uint64_t>(s[6]);
+  invalid_ = static_cast<std::uint64_t>(s[7]);
+  std::copy(turning.begin(), turning.end(), turning_.begin());
+  const std::span<const double> closed = s.subspan(kPreisachHead + len);
+  std::copy(closed.begin(), closed.end(), closed_.begin());
 }
 
 }  // namespace hystlab::models

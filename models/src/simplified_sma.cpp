@@ -158,3 +158,33 @@ double SimplifiedSmaModel::step(double x) noexcept {
 }
 
 }  // namespace hystlab::models
+
+namespace hystlab::models {
+namespace {
+constexpr double kSmaStateKind = 2.0;
+constexpr std::size_t kSmaStateSize = 10;
+}  // namespace
+
+std::vector<double> SimplifiedSmaModel::save_state() const {
+  return {kSmaStateKind, static_cast<double>(static_cast<int>(phase_)), d_, f_, xi_, anchor_d_, anchor_f_, k_, entry_d_, entry_xi_};
+}
+
+// Checked before anything is taken: a refused state leaves the model as it was.
+void SimplifiedSmaModel::restore_state(std::span<const double> s) {
+  if (s.size() != kSmaStateSize || s[0] != kSmaStateKind) throw std::invalid_argument("model state: not the state of a simplified SMA model");
+  if (s[1] != 0.0 && s[1] != 1.0 && s[1] != 2.0) throw std::invalid_argument("model state: the phase is not 0, 1 or 2");
+  for (std::size_t k = 2; k < s.size(); ++k)
+    if (!std::isfinite(s[k])) throw std::invalid_argument("model state: value " + std::to_string(k) + " is not a finite number");
+  if (s[4] < 0.0 || s[4] > 1.0 || s[9] < 0.0 || s[9] > 1.0) throw std::invalid_argument("model state: a martensite fraction is outside [0, 1]");
+  phase_ = static_cast<Phase>(static_cast<int>(s[1]));
+  d_ = s[2];
+  f_ = s[3];
+  xi_ = s[4];
+  anchor_d_ = s[5];
+  anchor_f_ = s[6];
+  k_ = s[7];
+  entry_d_ = s[8];
+  entry_xi_ = s[9];
+}
+
+}  // namespace hystlab::models

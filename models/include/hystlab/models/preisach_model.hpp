@@ -41,6 +41,9 @@ class PreisachModel final : public HysteresisModel {
   [[nodiscard]] double input() const noexcept override { return x_; }
   [[nodiscard]] double output() const noexcept override { return f_ + table_->force_offset(); }
   [[nodiscard]] std::uint64_t saturation_count() const noexcept override { return saturations_; }
+  // [kind 1, len, x, f, base, saturations, merges, invalid, turning[0..len), closed[0..len/2]].
+  [[nodiscard]] std::vector<double> save_state() const override;
+  void restore_state(std::span<const double> state) override;
 
   [[nodiscard]] std::uint64_t merge_count() const noexcept { return merges_; }
   [[nodiscard]] std::uint64_t invalid_input_count() const noexcept { return invalid_; }

@@ -49,6 +49,9 @@ class SimplifiedSmaModel final : public HysteresisModel {
   }
   [[nodiscard]] double input() const noexcept override { return d_; }
   [[nodiscard]] double output() const noexcept override { return f_; }
+  // [kind 2, phase, d, f, xi, anchor_d, anchor_f, k, entry_d, entry_xi].
+  [[nodiscard]] std::vector<double> save_state() const override;
+  void restore_state(std::span<const double> state) override;
 
   [[nodiscard]] double martensite_fraction() const noexcept { return xi_; }
   [[nodiscard]] Phase phase() const noexcept { return phase_; }
