@@ -1,4 +1,4 @@
-// hystlab campaign / tables / runs. Submitting and commanding a campaign go to the running
+// hystlab campaign / tables (runs: cmd_runs.cpp). Submitting and commanding a campaign go to the running
 // hystlabd over its HTTP API (daemon_client.hpp); its records are read from the database file.
 #include <cmath>
 #include <cstdio>
@@ -12,6 +12,7 @@
 #include "hystlab/db/store.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
+#include "hystlab/fmu/element_export.hpp"
 #include "hystlab/models/table_export.hpp"
 #include "hystlab/daemon/plan.hpp"
 
@@ -35,15 +36,9 @@ defaults to the only one the daemon has. A waveform plan may give "points_csv": 
 list and show read the daemon's database file, with or without a daemon running.
 )";
 const char* kTablesHelp = R"(usage: hystlab tables list [--db hystlab.db]
-       hystlab tables export ID [--format json|csv|m|h] [-o FILE] [--db hystlab.db]
+       hystlab tables export ID [--format json|csv|m|h|fmu] [-o FILE] [--db hystlab.db]
 
 --db must name hystlabd's database (it is never created here).
-)";
-const char* kRunsHelp = R"(usage: hystlab runs export RUN_ID [-o X.csv] [--db hystlab.db]
-
-Writes the run's samples as CSV: a load frame's time_s,command_mm,displacement_mm,force_N,status;
-a shaker's time_s,drive_frequency_hz,drive_amplitude_mm,base_displacement_mm,mass_displacement_mm,
-base_accel_m_s2,mass_accel_m_s2,status.
 )";
 
 std::int64_t id_arg(const Args& args, std::size_t k, const char* what) {
@@ -274,54 +269,15 @@ int run_tables_cmd(const Args& args) {
   const std::int64_t id = id_arg(args, 1, "table ID");
   const Options opt(rest(args, 2), {"db", "output", "format"}, {});
   const std::string format = opt.get("format", "json");
-  if (format != "json" && format != "csv" && format != "m" && format != "h") throw CliError("--format: '" + format + "' is not json, csv, m or h");
+  if (!fmu::is_export_format(format)) throw CliError("--format: '" + format + "' is not " + std::string(fmu::kExportFormats));
   db::Store store = open_store(opt);
   const auto doc = store.table_document(id);
   if (!doc) throw CliError("no table " + std::to_string(id));
-  if (format == "json") {
+  if (format == "json") {  // the stored document as it is (its provenance and scores included)
     write_output(opt.get("output"), nlohmann::json::parse(*doc).dump(2) + "\n");
     return 0;
   }
-  const models::TableDocument t = models::table_from_json(*doc);
-  const std::string name = "hystlab_table_" + std::to_string(id);
-  write_output(opt.get("output"), format == "csv" ? models::table_to_csv(t.table, t.provenance)
-                                  : format == "m" ? models::table_to_matlab(t.table, t.provenance)
-                                                  : models::table_to_c_header(t.table, t.provenance, name));
-  return 0;
-}
-
-int run_runs_cmd(const Args& args) {
-  if (print_help_if_asked(args, kRunsHelp) || args.empty() || args[0] != "export") {
-    if (args.empty() || args[0] != "export") {
-      std::cout << kRunsHelp;
-      return 2;
-    }
-    return 0;
-  }
-  const std::int64_t id = id_arg(args, 1, "run ID");
-  const Options opt(rest(args, 2), {"db", "output"}, {});
-  db::Store store = open_store(opt);
-  const bool shaker = store.max_seq(id) < 0 && store.max_shaker_seq(id) >= 0;  // a shaker's run: its own columns
-  if (store.max_seq(id) < 0 && !shaker) throw CliError("no samples for run " + std::to_string(id));
-  std::string out;
-  if (shaker) {
-    out = "time_s";
-    for (const db::SignalName& n : db::kShakerSignals) out += std::string(",") + n.name;
-    out += ",status\n";
-    store.for_each_shaker_sample(id, 0, std::int64_t{1} << 50, [&](const db::ShakerRow& r) {
-      out += format_number(r.t);
-      for (const double v : r.v) out += "," + format_number(v);
-      out += "," + std::to_string(r.status) + "\n";
-    });
-    write_output(opt.get("output"), out);
-    return 0;
-  }
-  out = "time_s,command_mm,displacement_mm,force_N,status\n";
-  store.for_each_sample(id, 0, std::int64_t{1} << 50, [&](const db::SampleRow& r) {
-    out += format_number(r.t) + "," + format_number(r.cmd) + "," + format_number(r.disp) + "," + format_number(r.force) + "," +
-           std::to_string(r.status) + "\n";
-  });
-  write_output(opt.get("output"), out);
+  write_export(*doc, format, "hystlab_table_" + std::to_string(id), opt.get("output"));
   return 0;
 }
 

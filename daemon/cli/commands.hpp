@@ -22,6 +22,8 @@ int run_tables_cmd(const Args& args);
 int run_runs_cmd(const Args& args);
 int run_simulate(const Args& args);
 int run_export(const Args& args);
+// Writes a table or parameter document in an export format (hystlab export, tables export).
+void write_export(const std::string& document, const std::string& format, const std::string& name, const std::string& output);
 
 // True (and the help printed) when args ask for it.
 bool print_help_if_asked(const Args& args, const char* text);

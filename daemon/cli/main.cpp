@@ -35,7 +35,7 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
              (over its HTTP API); list and show them from its db file
   rig        estop or reset one of the running hystlabd's rigs (over its HTTP API)
   tables     list and export the tables hystlabd identified
-  runs       export a run's samples as CSV
+  runs       export a run's samples as CSV, or a run or campaign as HDF5
   simulate   the base-excited isolator (sdof): time histories, transmissibility sweeps
   export     a table or parameters as JSON, CSV, MATLAB/Octave or a C header
 )";

@@ -7,9 +7,8 @@
 #include <string>
 
 #include "hystlab/hystlab.h"
+#include "hystlab/models/element.hpp"
 #include "hystlab/models/formats.hpp"
-#include "hystlab/models/preisach_model.hpp"
-#include "hystlab/models/simplified_sma.hpp"
 
 struct hystlab_model {
   std::unique_ptr<hystlab::models::HysteresisModel> model;
@@ -41,17 +40,10 @@ hystlab_status guarded(F&& f) noexcept {
 }
 
 hystlab_status make(const std::string& text, hystlab_model** out) {
-  const auto j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return fail(HYSTLAB_ERROR_FORMAT, "not a JSON object (a table or a parameter set)");
+  hystlab::models::Element e = hystlab::models::element_from_json(text);
   auto m = std::make_unique<hystlab_model>();
-  if (j.contains("format")) {
-    auto doc = hystlab::models::table_from_json(text);
-    m->model = std::make_unique<hystlab::models::PreisachModel>(std::make_shared<const hystlab::models::EverettTable>(std::move(doc.table)));
-    m->kind = 1;
-  } else {
-    m->model = std::make_unique<hystlab::models::SimplifiedSmaModel>(hystlab::models::params_from_json(text));
-    m->kind = 2;
-  }
+  m->model = std::move(e.model);
+  m->kind = static_cast<int>(e.kind);
   *out = m.release();
   return HYSTLAB_OK;
 }

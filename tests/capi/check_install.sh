@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # cmake --install into a temporary prefix: the programs, the library and header, the CMake
 # package, the pkg-config file, the systemd unit and the page are where users expect them; a
-# consumer builds against the package both ways and evaluates a table; the installed daemon
-# serves its page from the installed files.
+# consumer builds against the package both ways and evaluates a table; the Python package imports
+# from where Debian's python3 looks; the installed daemon serves its page from the installed files.
 # usage: check_install.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 build=$1 src=$2
@@ -56,6 +56,25 @@ c=$("$prefix/bin/hystlab" eval --table "$prefix/T.json" --input "$prefix/X.csv" 
 if [ "$a" = "$b" ] && [ -n "$a" ] && [ "$(echo "$a" | wc -l)" = 9 ]; then echo "ok   find_package and pkg-config consumers agree"; else echo "FAIL consumers: [$a] [$b]"; fail=1; fi
 if python3 -c "import sys; a=[float(v) for v in sys.argv[1].split()]; c=[float(v) for v in sys.argv[2].split()]; sys.exit(a != c)" "$a" "$c"; then
   echo "ok   the installed library matches the installed CLI"; else echo "FAIL library [$a] vs CLI [$c]"; fail=1; fi
+
+# The Python package (when the tree built it), where Debian's python3 finds it: under the default
+# prefix /usr/local that is /usr/local/lib/python3.X/dist-packages. Every *.py of the package's
+# source folder is installed (other people's modules too), and the installed module evaluates the
+# table as the installed library does.
+if [ -d "$build/python/hystlab" ] && [ -x /usr/bin/python3 ]; then
+  ver=$(/usr/bin/python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])')
+  pydir="$prefix/lib/python$ver/dist-packages"
+  for f in "$src"/models/python/hystlab/*.py; do
+    [ -e "$pydir/hystlab/$(basename "$f")" ] && echo "ok   python: hystlab/$(basename "$f")" || { echo "FAIL python: hystlab/$(basename "$f") not installed"; fail=1; }
+  done
+  p=$(cd "$prefix" && PYTHONPATH="$pydir" PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -c '
+import sys, hystlab
+assert hystlab.__file__.startswith(sys.argv[2]), hystlab.__file__
+m = hystlab.Model(hystlab.Table.load(sys.argv[1]))
+print("\n".join(repr(f) for f in m.evaluate([k * 0.5 for k in range(9)])))' "$prefix/T.json" "$pydir") || p="(import failed)"
+  if python3 -c "import sys; a=[float(v) for v in sys.argv[1].split()]; p=[float(v) for v in sys.argv[2].split()]; sys.exit(a != p)" "$a" "$p" 2>/dev/null; then
+    echo "ok   the installed Python module matches the installed library"; else echo "FAIL python [$p] vs library [$a]"; fail=1; fi
+fi
 
 # The installed daemon serves the installed page.
 "$prefix/bin/hystlabd" --db "$prefix/d.db" --port 0 > "$prefix/daemon.log" 2>&1 &

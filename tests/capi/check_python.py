@@ -1,15 +1,19 @@
 #!/usr/bin/env python3
-"""The Python example (ctypes over libhystlab.so) against the CLI, to the last digit: a table
-identified by the CLI and the simplified model, on one displacement path; and its errors."""
+"""The C API from Python (ctypes over libhystlab.so, hystlab_ctypes.py beside this file) against
+the CLI, to the last digit: a table identified by the CLI and the simplified model, on one
+displacement path; and its errors.
+
+usage: check_python.py HYSTLAB_CLI LIBHYSTLAB"""
 import os
 import subprocess
 import sys
 import tempfile
 
-cli, lib, example_dir = sys.argv[1:4]
+cli, lib = sys.argv[1:3]
+here = os.path.dirname(os.path.abspath(__file__))
 os.environ["HYSTLAB_LIBRARY"] = lib
-sys.path.insert(0, example_dir)
-from hystlab import HystlabError, Model  # noqa: E402
+sys.path.insert(0, here)
+from hystlab_ctypes import HystlabError, Model  # noqa: E402
 
 failures = 0
 
@@ -42,11 +46,11 @@ with tempfile.TemporaryDirectory() as d:
     for name, args in (("T.json", ["--table", "T.json"]), ("P.json", ["--model", "simplified", "--params", "P.json"])):
         want = columns(subprocess.run([cli, "eval"] + args + ["--input", "X.csv"], cwd=d, check=True,
                                       capture_output=True, text=True).stdout)
-        got = columns(subprocess.run([sys.executable, os.path.join(example_dir, "evaluate.py"), name, "X.csv"], cwd=d,
+        got = columns(subprocess.run([sys.executable, os.path.join(here, "evaluate_ctypes.py"), name, "X.csv"], cwd=d,
                                      check=True, capture_output=True, text=True).stdout)
         check(len(got) == len(want) == len(xs), "%s: %d values" % (name, len(got)))
         same = sum(1 for g, w in zip(got, want) if g == w)  # exact: the same doubles
-        check(same == len(want), "%s: the Python example matches the CLI to the last digit (%d of %d)" % (name, same, len(want)))
+        check(same == len(want), "%s: the C API from Python matches the CLI to the last digit (%d of %d)" % (name, same, len(want)))
 
     with Model(os.path.join(d, "T.json")) as m:
         first = m.evaluate(xs[:100])

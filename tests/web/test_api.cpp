@@ -80,6 +80,15 @@ TEST_CASE("a campaign through the API: submit, follow, nodes, tables and their e
   REQUIRE(r->status == 200);
   CHECK(r->body.find("function f = hystlab_eval(T, x)") != std::string::npos);
   CHECK(r->body.find("T.n = 3;") != std::string::npos);
+  // The FMU: a ZIP archive (its local header's signature) holding the model description and the
+  // runtime (tests/fmu runs what is inside).
+  r = c.Get(("/api/tables/" + std::to_string(table) + "/export?format=fmu").c_str());
+  REQUIRE(r->status == 200);
+  CHECK(r->get_header_value("Content-Type") == "application/zip");
+  CHECK(r->get_header_value("Content-Disposition").find(".fmu") != std::string::npos);
+  CHECK(r->body.rfind("PK\x03\x04", 0) == 0);
+  CHECK(r->body.find("modelDescription.xml") != std::string::npos);
+  CHECK(r->body.find("binaries/linux64/hystlab_element.so") != std::string::npos);
   CHECK(json::parse(c.Get(("/api/tables/" + std::to_string(table)).c_str())->body)["document"]["format"] == "hystlab-everett-table");
   CHECK(json::parse(c.Get("/api/tables")->body).size() == 2);
   CHECK(json::parse(c.Get("/api/campaigns")->body)[0]["tables"] == 2);
@@ -219,6 +228,7 @@ TEST_CASE("every error path answers one JSON error with the right status") {
   check_error(post(c, "/api/evaluate", {{"table_id", 1}, {"displacement_mm", {1.0, "two"}}}), 400, "displacement_mm[1]");
   check_error(post(c, "/api/evaluate", {{"table_id", 1}, {"displacement_mm", json::array()}}), 400, "displacement_mm");
   check_error(c.Get("/api/tables/1/export?format=xls"), 400, "xls");
+  check_error(c.Get("/api/tables/1/export?format=xls"), 400, "json, csv, m, h or fmu");
   check_error(c.Get("/api/runs/1/samples?points=abc"), 400, "points");
   check_error(c.Get("/api/runs/1/samples?points=0"), 400, "points");
   check_error(c.Get("/api/runs/1/samples?t0=5&t1=1"), 400, "t1");

@@ -13,6 +13,7 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c);  // campaigns, comm
 void add_data_routes(httplib::Server& s, ApiContext& c);      // samples, tables, exports, evaluation
 void add_loop_routes(httplib::Server& s, ApiContext& c);      // runs' x-y paths, plan previews
 void add_sweep_routes(httplib::Server& s, ApiContext& c);     // a sine campaign's points, resonances, jumps
+void add_h5_routes(httplib::Server& s, ApiContext& c);        // a run or a campaign as an HDF5 file
 
 db::CampaignRow campaign_or_404(db::Store& store, std::int64_t id);
 

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "hystlab/models/preisach_model.hpp"
+#include "hystlab/fmu/element_export.hpp"
 #include "hystlab/models/table_export.hpp"
 #include "hystlab/models/table_score.hpp"
 #include "hystlab/db/signals.hpp"
@@ -165,16 +166,13 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/tables/(\d+)/export)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     const std::int64_t id = path_id(req);
     const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
-    if (format != "json" && format != "csv" && format != "m" && format != "h")
-      throw ApiError(400, "invalid parameter", "format: '" + format + "' is not json, csv, m or h");
+    if (!fmu::is_export_format(format)) throw ApiError(400, "invalid parameter", "format: '" + format + "' is not " + std::string(fmu::kExportFormats));
     const std::string text = table_document(reader(c.db_path), id);
-    const std::string name = "hystlab_table_" + std::to_string(id) + "." + format;
-    res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
-    if (format == "json") return res.set_content(text, "application/json");
-    const models::TableDocument doc = models::table_from_json(text);
-    if (format == "csv") return res.set_content(models::table_to_csv(doc.table, doc.provenance), "text/csv");
-    if (format == "h") return res.set_content(models::table_to_c_header(doc.table, doc.provenance, "hystlab_table_" + std::to_string(id)), "text/x-c");
-    res.set_content(models::table_to_matlab(doc.table, doc.provenance), "text/x-matlab");
+    const std::string name = "hystlab_table_" + std::to_string(id);
+    res.set_header("Content-Disposition", "attachment; filename=\"" + name + "." + format + "\"");
+    if (format == "json") return res.set_content(text, "application/json");  // the stored document as it is
+    fmu::ExportedFile f = fmu::export_element(text, format, name);
+    res.set_content(std::move(f.bytes), f.media_type);
   }));
   post_route(s, c, "/api/evaluate", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     const json body = body_object(req);

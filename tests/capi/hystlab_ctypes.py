@@ -1,6 +1,7 @@
-"""hystlab's C API from Python, with ctypes only (Debian's python3, no packages).
+"""hystlab's C API from Python, with ctypes only (no packages): what capi_python drives the C
+API with. (It was the Python example; the Python module, docs/PYTHON.md, replaced it there.)
 
-    from hystlab import Model
+    from hystlab_ctypes import Model
     with Model("table.json") as m:          # an Everett table or simplified-model parameters
         forces = m.evaluate([0.0, 1.0, 2.0, 1.5])
 

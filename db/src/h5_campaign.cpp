@@ -1,0 +1,89 @@
+// A campaign's context in a run's HDF5 file: what was planned, on which rig under which envelope,
+// what happened (events), and the FOT nodes measured. JSON stays JSON text (plan, rig config,
+// event details): the file carries it as the store has it.
+#include <nlohmann/json.hpp>
+
+#include <vector>
+
+#include "h5_file.hpp"
+#include "h5_layout.hpp"
+#include "hystlab/db/run_h5.hpp"
+#include "hystlab/db/store.hpp"
+
+namespace hystlab::db::h5_layout {
+namespace {
+using h5::Handle;
+
+// The rig's name and its config as hystlabd stored it (SQL stays in db/).
+std::pair<std::string, std::string> rig_record(Store& store, std::int64_t rig_id) {
+  Statement st(store.database(), "SELECT name, config FROM rigs WHERE id = ?");
+  st.bind(1, rig_id);
+  if (!st.step()) return {"", "{}"};
+  return {st.column_text(0), st.column_text(1)};
+}
+
+void write_campaign_group(Store& store, hid_t file, const CampaignRow& c) {
+  const Handle g = h5::create_group(file, "campaign");
+  h5::attr_int(g.get(), "id", c.id);
+  h5::attr_text(g.get(), "kind", to_string(c.kind));
+  h5::attr_text(g.get(), "state", to_string(c.state));
+  h5::attr_text(g.get(), "created_at", c.created_at);
+  h5::attr_text(g.get(), "updated_at", c.updated_at);
+  const auto [rig, config] = rig_record(store, c.rig_id);
+  h5::attr_text(g.get(), "rig", rig);
+  h5::dataset_text(g.get(), "plan", c.plan);
+  h5::dataset_text(g.get(), "rig_config", config);
+  // The envelope the rig's config sets; "null" when it sets none (hystlabd's defaults applied).
+  const auto j = nlohmann::json::parse(config, nullptr, false);
+  h5::dataset_text(g.get(), "envelope", j.is_object() && j.contains("envelope") ? j["envelope"].dump() : "null");
+  // The limits the campaign ran under (the envelope tightened by the plan's limits), as it recorded them.
+  const auto limits = store.event_details(c.id, "limits");
+  h5::dataset_text(g.get(), "limits", limits.empty() ? "null" : limits.back());
+}
+
+void write_events(Store& store, hid_t file, std::int64_t campaign, int deflate_level) {
+  const Handle g = h5::create_group(file, "events");
+  std::vector<std::int64_t> id;
+  std::vector<std::string> at, kind, from, to, detail;
+  for (EventRow& e : store.events(campaign)) {
+    id.push_back(e.id), at.push_back(std::move(e.at)), kind.push_back(std::move(e.kind));
+    from.push_back(std::move(e.from_state)), to.push_back(std::move(e.to_state)), detail.push_back(std::move(e.detail));
+  }
+  (void)h5::write_column(g.get(), "id", std::span<const std::int64_t>(id), deflate_level);
+  h5::dataset_texts(g.get(), "at", at, deflate_level);
+  h5::dataset_texts(g.get(), "kind", kind, deflate_level);
+  h5::dataset_texts(g.get(), "from_state", from, deflate_level);
+  h5::dataset_texts(g.get(), "to_state", to, deflate_level);
+  h5::dataset_texts(g.get(), "detail", detail, deflate_level);
+}
+
+void write_nodes(Store& store, hid_t file, std::int64_t campaign, int deflate_level) {
+  const Handle g = h5::create_group(file, "fot_nodes");
+  std::vector<std::int64_t> id, run;
+  std::vector<double> alpha, beta, fa, fab, t;
+  for (const NodeInfo& n : store.nodes(campaign)) {
+    id.push_back(n.id), run.push_back(n.run), alpha.push_back(n.alpha), beta.push_back(n.beta);
+    fa.push_back(n.force_alpha), fab.push_back(n.force_alpha_beta), t.push_back(n.t);
+  }
+  (void)h5::write_column(g.get(), "id", std::span<const std::int64_t>(id), deflate_level);
+  (void)h5::write_column(g.get(), "run", std::span<const std::int64_t>(run), deflate_level);
+  const std::pair<const char*, const std::vector<double>*> cols[] = {
+      {"alpha_mm", &alpha}, {"beta_mm", &beta}, {"force_alpha_N", &fa}, {"force_alpha_beta_N", &fab}, {"time_s", &t}};
+  for (const auto& [name, v] : cols) {
+    const Handle d = h5::write_column(g.get(), name, std::span<const double>(*v), deflate_level);
+    const std::string n = name;
+    h5::attr_text(d.get(), "units", n.substr(n.rfind('_') + 1));
+  }
+}
+}  // namespace
+
+std::int64_t write_campaign(Store& store, hid_t file, std::int64_t campaign, int deflate_level) {
+  const auto c = store.campaign(campaign);
+  if (!c) throw H5ExportError(H5ExportError::Kind::not_found, "no campaign " + std::to_string(campaign));
+  write_campaign_group(store, file, *c);
+  write_events(store, file, campaign, deflate_level);
+  write_nodes(store, file, campaign, deflate_level);
+  return write_tables(store, file, campaign, deflate_level);
+}
+
+}  // namespace hystlab::db::h5_layout

@@ -1,0 +1,25 @@
+#pragma once
+// Every export format of a calibrated element (a table or simplified-model parameters), named
+// once for the CLI (`hystlab export`, `hystlab tables export`) and the HTTP API
+// (GET /api/tables/ID/export): json, csv, m, h and fmu. Pure: returns the bytes.
+#include <string>
+#include <string_view>
+
+namespace hystlab::fmu {
+
+struct ExportedFile {
+  std::string bytes;
+  std::string media_type;  // for HTTP
+  bool binary = false;     // not for a terminal
+};
+
+inline constexpr std::string_view kExportFormats = "json, csv, m, h or fmu";
+[[nodiscard]] bool is_export_format(std::string_view format);
+
+// document: a table or parameter set (validated; FormatError names the field). name: the C
+// header's prefix and the FMU's model name. source: written into re-written parameters.
+// Throws std::invalid_argument for an unknown format ("'x' is not json, csv, m, h or fmu").
+[[nodiscard]] ExportedFile export_element(std::string_view document, std::string_view format, const std::string& name,
+                                          const std::string& created = {});
+
+}  // namespace hystlab::fmu
