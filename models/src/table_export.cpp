@@ -79,8 +79,8 @@ function v = hystlab_everett(T, a, b)
     s = (a - T.nodes(i)) / (T.nodes(i + 1) - T.nodes(i)); t = (b - T.nodes(j)) / (T.nodes(j + 1) - T.nodes(j));
     if j == i, t = min(t, s); end
   else
-    h = (T.hi - T.lo) / T.n;
-    u = (a - T.lo) / h; w = (b - T.lo) / h;
+    r = 1 / ((T.hi - T.lo) / T.n);  % as the library: times the reciprocal step, to the last digit
+    u = (a - T.lo) * r; w = (b - T.lo) * r;
     i = min(floor(u) + 1, T.n); j = min(floor(w) + 1, i);
     s = u - (i - 1); t = w - (j - 1);
   end

@@ -408,6 +408,13 @@ try {
     await download.saveAs(file);
     const doc = JSON.parse(fs.readFileSync(file, 'utf8'));
     check(doc.format === 'hystlab-everett-table' && Array.isArray(doc.nodes_mm) && doc.nodes_mm.length === 5, `a table downloads (${download.suggestedFilename()})`);
+    const fmuLink = page.locator('#downloads a', { hasText: '(fot) .fmu' }).first();
+    const [fmu] = await Promise.all([page.waitForEvent('download', { timeout: 20000 }), fmuLink.click()]);
+    const fmuFile = path.join(outDir, 'downloaded-table.fmu');
+    await fmu.saveAs(fmuFile);
+    const fmuBytes = fs.readFileSync(fmuFile);
+    check(fmuBytes.subarray(0, 4).equals(Buffer.from('PK\x03\x04', 'latin1')) && fmuBytes.includes('modelDescription.xml') && fmuBytes.length > 100000,
+          `the table downloads as an FMU (${fmu.suggestedFilename()}, ${fmuBytes.length} bytes)`);
     // Identification: the training curve, each table's held-out error, the recommended table, the loop figures.
     check(await wait(page, () => window.hystlab.shakedownPoints() === 3, null, 'the shakedown curve', 20000), 'the training curve shows its 3 cycles');
     check(await wait(page, () => window.hystlab.heldOut().length === 2, null, 'held-out figures', 20000),

@@ -204,12 +204,15 @@ function link(href, text, name = true) { return el('a', { href, download: name, 
 function showDownloads(d) {
   const links = [];
   for (const t of d.tables)
-    for (const f of ['json', 'csv', 'm']) links.push(link(`/api/tables/${t.id}/export?format=${f}`, `table #${t.id} (${t.method}) .${f}`));
+    for (const f of ['json', 'csv', 'm', 'h', 'fmu']) links.push(link(`/api/tables/${t.id}/export?format=${f}`, `table #${t.id} (${t.method}) .${f}`));
   if (d.kind === 'sine') {
     links.push(link(`/api/campaigns/${d.id}/sweep.csv`, 'sweep points .csv', `sweep-${d.id}.csv`));
     links.push(link(`/api/campaigns/${d.id}/sweep`, 'sweep points and resonances .json', `sweep-${d.id}.json`));
   }
-  for (const r of d.runs) links.push(link(`/api/runs/${r.id}/samples.csv`, `run #${r.id} samples .csv`));
+  for (const r of d.runs) {
+    links.push(link(`/api/runs/${r.id}/samples.csv`, `run #${r.id} samples .csv`));
+    links.push(link(`/api/runs/${r.id}/samples.h5`, `run #${r.id} .h5 (with the campaign)`));
+  }
   $('downloads').replaceChildren(...links);
 }
 
