@@ -4,6 +4,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "hystlab/fmu/element_export.hpp"
+#include "hystlab/models/formats.hpp"
 
 namespace hystlab::cli {
 namespace {
@@ -35,6 +36,9 @@ int run_export(const Args& args) {
   if (!fmu::is_export_format(format)) throw CliError("--format: '" + format + "' is not " + std::string(fmu::kExportFormats));
   const bool table = opt.has("table");
   std::string doc = read_file(opt.get(table ? "table" : "params"));
+  // The kind the user named: a table given as --params (or the reverse) is refused, naming the field.
+  if (table) (void)models::table_from_json(doc);
+  else (void)models::params_from_json(doc);
   write_export(doc, format, opt.get("name", table ? "hystlab_table" : "hystlab_params"), opt.get("output"));
   return 0;
 }

@@ -60,6 +60,10 @@ with tempfile.TemporaryDirectory() as d:
         want = cli_forces(d, args, x)
         with hystlab.fmu.Fmu(os.path.join(d, name + ".fmu")) as f:
             got = f.simulate(x)
+            dyn = subprocess.run(["readelf", "-d", os.path.join(f._dir, "binaries", "linux64", f.identifier + ".so")],
+                                 capture_output=True, text=True).stdout
+            check("libstdc++" not in dyn and "[$ORIGIN]" in dyn,
+                  "%s: the binary carries its C++ runtime (simulation tools load their own libstdc++) and runs from $ORIGIN" % name)
             check(f.model_name in ("hystlab_table", "hystlab_params") and f.identifier == "hystlab_element", "%s: the model description read" % name)
         module = hystlab.Model(load(os.path.join(d, name))).evaluate(np.array(x))
         check(len(got) == len(want) == len(x), "%s: %d forces" % (name, len(got)))
@@ -76,7 +80,9 @@ with tempfile.TemporaryDirectory() as d:
             f.set(x=v)
             f.do_step(1e-3)
             ahead.append(f.get("F"))
+        t_ahead = f.time
         f.set_state(s)
+        check(f.time < t_ahead and f.time == s.time, "set_state takes the time back too (%.3f s)" % f.time)
         again = []
         for v in x[700:]:
             f.set(x=v)

@@ -14,7 +14,7 @@
 namespace hystlab::test {
 namespace fs = std::filesystem;
 inline const std::string kCli = HYSTLAB_CLI;
-inline constexpr fmi2ValueReference kX = 0, kF = 1, kXScale = 2, kForceScale = 4, kSign = 5, kSaturations = 6;
+inline constexpr fmi2ValueReference kX = 0, kF = 1, kXScale = 2, kXOffset = 3, kForceScale = 4, kSign = 5, kSaturations = 6;
 
 struct Workspace {
   fs::path dir;

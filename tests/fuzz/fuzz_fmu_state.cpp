@@ -13,13 +13,14 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace hm = hystlab::models;
   static const hm::EverettTable table(hm::Grid::make(0.0, 4.0, 8));
+  static const hm::EverettTable refined(hm::Grid::refined(0.0, 4.0, 8, 2.0, 1.0));  // a grid of its own: cells by search
   try {
     const hystlab::fmu::StateRecord r = hystlab::fmu::decode_state({reinterpret_cast<const char*>(data), size});
     if (r.numbers.size() < 9) return 0;
     const std::span<const double> model_state = std::span<const double>(r.numbers).subspan(9);
-    hm::PreisachModel p(table);
+    hm::PreisachModel p(table), q(refined);
     hm::SimplifiedSmaModel s(hm::table1_parameters());
-    for (hm::HysteresisModel* m : {static_cast<hm::HysteresisModel*>(&p), static_cast<hm::HysteresisModel*>(&s)}) {
+    for (hm::HysteresisModel* m : {static_cast<hm::HysteresisModel*>(&p), static_cast<hm::HysteresisModel*>(&q), static_cast<hm::HysteresisModel*>(&s)}) {
       try {
         m->restore_state(model_state);
         for (const double x : {0.0, 3.0, 1.0, 2.0}) (void)m->step(x);  // a state taken must step

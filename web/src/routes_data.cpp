@@ -1,5 +1,6 @@
 // Runs and their samples (decimated with min/max per bucket, or full resolution as a streamed
 // CSV), tables (list, get, export) and model evaluation.
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -43,23 +44,36 @@ std::unique_ptr<models::HysteresisModel> model_of(const json& body, db::Store& s
   return std::make_unique<models::SimplifiedSmaModel>(models::params_from_json(body["params"].dump()));
 }
 
+// A number in the shortest form that reads back to the same double (as the CLI's exports and
+// HDF5 hold it: an analyst's arrays are the stored values), then the separator.
+void append_exact(std::string& out, double v, char sep) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+  out.push_back(sep);
+}
+
 // One chunk of a run's rows as CSV lines; rows: how many there were.
 std::string csv_chunk(db::Store& store, std::int64_t run, bool shaker, std::int64_t seq0, std::int64_t& rows) {
   std::string chunk;
-  char line[320];
   if (shaker) {
     store.for_each_shaker_sample(run, seq0, seq0 + kCsvChunk - 1, [&](const db::ShakerRow& r) {
-      const int n = std::snprintf(line, sizeof line, "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%lld\n", static_cast<long long>(r.seq), r.t, r.v[0],
-                                  r.v[1], r.v[2], r.v[3], r.v[4], r.v[5], static_cast<long long>(r.status));
-      chunk.append(line, static_cast<std::size_t>(n));
+      chunk += std::to_string(r.seq);
+      chunk.push_back(',');
+      append_exact(chunk, r.t, ',');
+      for (const double v : r.v) append_exact(chunk, v, ',');
+      chunk += std::to_string(r.status);
+      chunk.push_back('\n');
       ++rows;
     });
     return chunk;
   }
   store.for_each_sample(run, seq0, seq0 + kCsvChunk - 1, [&](const db::SampleRow& r) {
-    const int n = std::snprintf(line, sizeof line, "%lld,%.9g,%.9g,%.9g,%.9g,%lld\n", static_cast<long long>(r.seq), r.t, r.cmd, r.disp, r.force,
-                                static_cast<long long>(r.status));
-    chunk.append(line, static_cast<std::size_t>(n));
+    chunk += std::to_string(r.seq);
+    chunk.push_back(',');
+    for (const double v : {r.t, r.cmd, r.disp, r.force}) append_exact(chunk, v, ',');
+    chunk += std::to_string(r.status);
+    chunk.push_back('\n');
     ++rows;
   });
   return chunk;

@@ -82,9 +82,11 @@ std::string model_description(const models::Element& e, const std::string& guid,
        "    <Category name=\"logStatusFatal\" description=\"out of memory\"/>\n  </LogCategories>\n";
   x += "  <ModelVariables>\n" + variables_xml(e) + "  </ModelVariables>\n";
   // 1-based indices into ModelVariables: x 1, F 2, x_scale_mm 3, x_offset_mm 4, force_scale 5, sign 6, saturations 7.
-  x += "  <ModelStructure>\n    <Outputs>\n      <Unknown index=\"2\" dependencies=\"1\"/>\n      <Unknown index=\"7\" dependencies=\"1\"/>\n"
+  // F follows x at once (read after fmi2SetReal, it is the force there); saturations counts the
+  // inputs taken by steps, so it depends on no input directly (and is 0 until initialization ends).
+  x += "  <ModelStructure>\n    <Outputs>\n      <Unknown index=\"2\" dependencies=\"1\"/>\n      <Unknown index=\"7\" dependencies=\"\"/>\n"
        "    </Outputs>\n    <InitialUnknowns>\n      <Unknown index=\"2\" dependencies=\"1 3 4 5 6\"/>\n"
-       "      <Unknown index=\"7\" dependencies=\"1 3 4\"/>\n    </InitialUnknowns>\n  </ModelStructure>\n";
+       "      <Unknown index=\"7\" dependencies=\"\"/>\n    </InitialUnknowns>\n  </ModelStructure>\n";
   return x + "</fmiModelDescription>\n";
 }
 

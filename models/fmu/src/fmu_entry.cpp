@@ -143,36 +143,35 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference[], size_t n, 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* s) {
   return guard(c, "fmi2GetFMUstate", [&](FmuInstance& i) {
     if (!s) throw FmuError("a null FMUstate pointer");
-    auto* saved = new FmuInstance::Saved(i.save());
-    delete static_cast<FmuInstance::Saved*>(*s);  // a state given back to be overwritten
-    *s = saved;
+    if (*s) i.owned(*s) = i.save();  // a state this instance gave, to be overwritten
+    else *s = i.keep(i.save());
     return fmi2OK;
   });
 }
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s) {
   return guard(c, "fmi2SetFMUstate", [&](FmuInstance& i) {
     if (!s) throw FmuError("a null FMUstate");
-    i.restore(*static_cast<const FmuInstance::Saved*>(s));
+    i.restore(i.owned(s));
     return fmi2OK;
   });
 }
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* s) {
-  return guard(c, "fmi2FreeFMUstate", [&](FmuInstance&) {
-    if (s) delete static_cast<FmuInstance::Saved*>(*s), *s = nullptr;
+  return guard(c, "fmi2FreeFMUstate", [&](FmuInstance& i) {
+    if (s && *s) i.release(*s), *s = nullptr;
     return fmi2OK;
   });
 }
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t* size) {
   return guard(c, "fmi2SerializedFMUstateSize", [&](FmuInstance& i) {
     if (!s || !size) throw FmuError("a null FMUstate or size");
-    *size = i.serialize(*static_cast<const FmuInstance::Saved*>(s)).size();
+    *size = i.serialize(i.owned(s)).size();
     return fmi2OK;
   });
 }
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte bytes[], size_t size) {
   return guard(c, "fmi2SerializeFMUstate", [&](FmuInstance& i) {
     if (!s || !bytes) throw FmuError("a null FMUstate or buffer");
-    const std::vector<char> b = i.serialize(*static_cast<const FmuInstance::Saved*>(s));
+    const std::vector<char> b = i.serialize(i.owned(s));
     if (size < b.size()) throw FmuError("the buffer holds " + std::to_string(size) + " bytes; the state needs " + std::to_string(b.size()));
     std::memcpy(bytes, b.data(), b.size());
     return fmi2OK;
@@ -181,9 +180,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte bytes
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate* s) {
   return guard(c, "fmi2DeSerializeFMUstate", [&](FmuInstance& i) {
     if (!s || (!bytes && size > 0)) throw FmuError("a null buffer or FMUstate pointer");
-    auto* saved = new FmuInstance::Saved(i.deserialize(std::span<const char>(bytes, size)));
-    delete static_cast<FmuInstance::Saved*>(*s);
-    *s = saved;
+    *s = i.keep(i.deserialize(std::span<const char>(bytes, size)));  // *s is output only: never read
     return fmi2OK;
   });
 }

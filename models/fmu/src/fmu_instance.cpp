@@ -5,6 +5,7 @@
 #include <climits>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "fmu_guid.hpp"
@@ -13,6 +14,9 @@
 
 namespace hystlab::fmu {
 namespace {
+// The input the model was driven to, before it was: F is then read at the input as set (peek), so
+// it already follows x and the parameters in initialization mode.
+constexpr double kNotDriven = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t kInstanceNumbers = 9;  // time, x, committed, d1, d2, x_scale, x_offset, force_scale, sign
 
 std::string text(double v) {
@@ -73,7 +77,8 @@ FmuInstance::FmuInstance(std::string name, std::string guid, const std::string& 
   if (own != guid_) throw FmuError("GUID " + guid_ + " does not match the FMU's resources (" + own + "): binary and resources from different FMUs");
   element_ = models::element_from_json(doc);
   table_ = dynamic_cast<models::PreisachModel*>(element_.model.get());
-  x_ = committed_x_ = element_.rest_input_mm;
+  x_ = element_.rest_input_mm;
+  committed_x_ = kNotDriven;
   refresh();
 }
 
@@ -83,19 +88,19 @@ void FmuInstance::log(fmi2Status status, const char* category, const std::string
 }
 
 void FmuInstance::setup(double start_time) {
-  if (mode_ != Mode::Instantiated) throw FmuError("fmi2SetupExperiment: only before initialization");
-  if (!std::isfinite(start_time)) throw FmuError("fmi2SetupExperiment: startTime is not a finite number");
+  if (mode_ != Mode::Instantiated) throw FmuError("only before initialization");
+  if (!std::isfinite(start_time)) throw FmuError("startTime is not a finite number");
   time_ = start_time;
 }
 
 void FmuInstance::enter_initialization() {
-  if (mode_ != Mode::Instantiated) throw FmuError("fmi2EnterInitializationMode: the instance is not freshly instantiated (call fmi2Reset)");
+  if (mode_ != Mode::Instantiated) throw FmuError("the instance is not freshly instantiated (call fmi2Reset)");
   mode_ = Mode::Initialization;
 }
 
 // The parameters are checked as a set (x_scale_mm non-zero), then the element is driven to the input.
 void FmuInstance::exit_initialization() {
-  if (mode_ != Mode::Initialization) throw FmuError("fmi2ExitInitializationMode: not in initialization mode");
+  if (mode_ != Mode::Initialization) throw FmuError("not in initialization mode");
   if (x_scale_ == 0.0) throw FmuError("x_scale_mm: 0 would make every input the same displacement");
   drive_to(to_mm(x_));
   committed_x_ = x_;
@@ -107,7 +112,8 @@ void FmuInstance::reset() {
   element_.model->reset();
   mode_ = Mode::Instantiated;
   time_ = d1_ = d2_ = x_offset_ = 0.0;
-  x_ = committed_x_ = element_.rest_input_mm;
+  x_ = element_.rest_input_mm;
+  committed_x_ = kNotDriven;
   x_scale_ = force_scale_ = 1.0;
   sign_ = 1;
   warned_saturation_ = false;
@@ -167,6 +173,7 @@ int FmuInstance::get_integer(fmi2ValueReference vr) const {
 }
 
 void FmuInstance::set_input_derivative(fmi2ValueReference vr, int order, double v) {
+  if (mode_ != Mode::Initialization && mode_ != Mode::Stepping) throw FmuError("input derivatives: only in initialization mode or between steps");
   if (vr != kX) throw FmuError("input derivatives: value reference " + std::to_string(vr) + " is not the input x");
   if (order != 1 && order != 2) throw FmuError("input derivatives: order " + std::to_string(order) + " (this FMU takes orders 1 and 2)");
   if (!std::isfinite(v)) throw FmuError("input derivatives: " + text(v) + " is not a finite number");
@@ -197,8 +204,9 @@ void FmuInstance::drive_to(double x_mm) noexcept {
 
 // Every call inlined (the table's step among them): the step an importer makes per input.
 [[gnu::flatten]] bool FmuInstance::try_step(double t, double h) noexcept {
-  if (!plain_ || !(h > 0.0 && h < 1e300)) return false;
-  drive_to(to_mm(x_));
+  const double mm = to_mm(x_);
+  if (!plain_ || !(h > 0.0 && h < 1e300) || !(t > -1e300 && t < 1e300) || !(mm > -1e300 && mm < 1e300)) return false;
+  drive_to(mm);
   committed_x_ = x_;
   time_ = t + h;
   force_ = gain_ * model_output();
@@ -209,14 +217,18 @@ void FmuInstance::drive_to(double x_mm) noexcept {
 // A held input (or a linear one) is a single move to the end; a quadratic one may turn inside the
 // step, and then the turning point is visited first.
 fmi2Status FmuInstance::do_step(double t, double h) {
-  if (mode_ != Mode::Stepping) throw FmuError("fmi2DoStep: the instance is not initialized (or is terminated)");
-  if (!(h > 0.0) || !std::isfinite(h) || !std::isfinite(t)) throw FmuError("fmi2DoStep: communicationStepSize " + text(h) + " is not a positive finite number");
+  if (mode_ != Mode::Stepping) throw FmuError("the instance is not initialized (or is terminated)");
+  if (!(h > 0.0) || !std::isfinite(h) || !std::isfinite(t)) throw FmuError("communicationStepSize " + text(h) + " is not a positive finite number");
+  // Both points in mm, checked, before the memory moves: a refused step leaves the instance as it was.
+  double turn_mm = std::numeric_limits<double>::quiet_NaN();
   if (d2_ != 0.0) {
     const double tau = -d1_ / d2_;
-    if (tau > 0.0 && tau < h) drive_to(to_mm(x_ + d1_ * tau + 0.5 * d2_ * tau * tau));
+    if (tau > 0.0 && tau < h) turn_mm = to_mm(x_ + d1_ * tau + 0.5 * d2_ * tau * tau);
   }
   const double end = (d1_ == 0.0 && d2_ == 0.0) ? x_ : x_ + d1_ * h + 0.5 * d2_ * h * h;
-  if (!std::isfinite(end)) throw FmuError("fmi2DoStep: the input's derivatives take it beyond a finite number");
+  if (!std::isfinite(end) || !std::isfinite(to_mm(end)) || (!std::isnan(turn_mm) && !std::isfinite(turn_mm)))
+    throw FmuError("the input (with its derivatives, scale and offset) goes beyond a finite number within the step");
+  if (!std::isnan(turn_mm)) drive_to(turn_mm);
   drive_to(to_mm(end));
   x_ = committed_x_ = end;
   d1_ = d2_ = 0.0;
@@ -225,9 +237,14 @@ fmi2Status FmuInstance::do_step(double t, double h) {
   return fmi2OK;
 }
 
-FmuInstance::Saved FmuInstance::save() const { return Saved{element_.model->clone(), time_, x_, committed_x_, d1_, d2_}; }
+FmuInstance::Saved FmuInstance::save() const {
+  return Saved{element_.model->clone(), time_, x_, committed_x_, d1_, d2_, x_scale_, x_offset_, force_scale_, sign_};
+}
 
 void FmuInstance::restore(const Saved& s) {
+  if (s.x_scale != x_scale_ || s.x_offset != x_offset_ || s.force_scale != force_scale_ || s.sign != sign_)
+    throw FmuError("the state was saved with other parameter values (x_scale_mm " + text(s.x_scale) + ", x_offset_mm " + text(s.x_offset) +
+                   ", force_scale " + text(s.force_scale) + ", sign " + std::to_string(s.sign) + ") than this instance's");
   element_.model = s.model->clone();
   table_ = dynamic_cast<models::PreisachModel*>(element_.model.get());
   time_ = s.time;
@@ -238,8 +255,25 @@ void FmuInstance::restore(const Saved& s) {
   refresh();
 }
 
+FmuInstance::Saved* FmuInstance::keep(Saved s) {
+  auto p = std::make_unique<Saved>(std::move(s));
+  Saved* raw = p.get();
+  states_.emplace(raw, std::move(p));
+  return raw;
+}
+
+FmuInstance::Saved& FmuInstance::owned(const void* state) const {
+  const auto it = states_.find(state);
+  if (it == states_.end()) throw FmuError("the FMUstate was not got from this instance (or is already freed)");
+  return *it->second;
+}
+
+void FmuInstance::release(const void* state) {
+  if (states_.erase(state) == 0) throw FmuError("the FMUstate was not got from this instance (or is already freed)");
+}
+
 std::vector<char> FmuInstance::serialize(const Saved& s) const {
-  StateRecord r{guid_, {s.time, s.x, s.committed, s.d1, s.d2, x_scale_, x_offset_, force_scale_, static_cast<double>(sign_)}};
+  StateRecord r{guid_, {s.time, s.x, s.committed, s.d1, s.d2, s.x_scale, s.x_offset, s.force_scale, static_cast<double>(s.sign)}};
   const std::vector<double> m = s.model->save_state();
   r.numbers.insert(r.numbers.end(), m.begin(), m.end());
   return encode_state(r);
@@ -256,12 +290,12 @@ FmuInstance::Saved FmuInstance::deserialize(std::span<const char> bytes) const {
     throw FmuError("FMU state: saved by another FMU (GUID " + r.guid + "; this one is " + guid_ + "): a state belongs to the table it was saved from");
   if (r.numbers.size() < kInstanceNumbers) throw FmuError("FMU state: " + std::to_string(r.numbers.size()) + " numbers, too few for a state");
   const double* n = r.numbers.data();
-  for (std::size_t k = 0; k < kInstanceNumbers; ++k)
-    if (!std::isfinite(n[k])) throw FmuError("FMU state: value " + std::to_string(k) + " is not a finite number");
+  for (std::size_t k = 0; k < kInstanceNumbers; ++k)  // the input taken is NaN before initialization ends
+    if (!std::isfinite(n[k]) && !(k == 2 && std::isnan(n[k]))) throw FmuError("FMU state: value " + std::to_string(k) + " is not a finite number");
   if (n[5] != x_scale_ || n[6] != x_offset_ || n[7] != force_scale_ || n[8] != static_cast<double>(sign_))
     throw FmuError("FMU state: saved with other parameter values (x_scale_mm " + text(n[5]) + ", x_offset_mm " + text(n[6]) + ", force_scale " +
                    text(n[7]) + ", sign " + text(n[8]) + ") than this instance's");
-  Saved s{element_.model->clone(), n[0], n[1], n[2], n[3], n[4]};
+  Saved s{element_.model->clone(), n[0], n[1], n[2], n[3], n[4], n[5], n[6], n[7], sign_};
   try {
     s.model->restore_state(std::span<const double>(r.numbers).subspan(kInstanceNumbers));
   } catch (const std::invalid_argument& e) {

@@ -7,6 +7,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 
 #include "../fmi2_functions.h"
 #include "hystlab/models/element.hpp"
@@ -25,10 +26,13 @@ class FmuInstance {
  public:
   enum class Mode { Instantiated, Initialization, Stepping, Terminated };
 
-  // A saved state (fmi2GetFMUstate): everything a rolled-back step needs.
+  // A saved state (fmi2GetFMUstate): everything a rolled-back step needs, and the parameter values
+  // it was saved with (a state is only taken back under the same ones).
   struct Saved {
     std::unique_ptr<models::HysteresisModel> model;
     double time, x, committed, d1, d2;
+    double x_scale, x_offset, force_scale;
+    int sign;
   };
 
   FmuInstance(std::string name, std::string guid, const std::string& resources, const fmi2CallbackFunctions& callbacks, bool logging);
@@ -43,6 +47,7 @@ class FmuInstance {
   void enter_initialization();
   void exit_initialization();
   void terminate() {
+    if (mode_ == Mode::Instantiated) throw FmuError("the instance was never initialized (fmi2FreeInstance ends it)");
     mode_ = Mode::Terminated;
     refresh();
   }
@@ -73,6 +78,11 @@ class FmuInstance {
 
   [[nodiscard]] Saved save() const;
   void restore(const Saved& s);
+  // The states this instance handed out: an FMUstate is only ever one of these (a pointer from
+  // elsewhere is refused by name, never dereferenced), and fmi2FreeInstance frees what is left.
+  [[nodiscard]] Saved* keep(Saved s);
+  [[nodiscard]] Saved& owned(const void* state) const;
+  void release(const void* state);
   [[nodiscard]] std::vector<char> serialize(const Saved& s) const;
   [[nodiscard]] Saved deserialize(std::span<const char> bytes) const;
 
@@ -108,6 +118,7 @@ class FmuInstance {
   double gain_ = 1.0;      // sign * force_scale
   double force_ = 0.0;     // F at the committed input
   bool warned_saturation_ = false;
+  std::unordered_map<const void*, std::unique_ptr<Saved>> states_;
 };
 
 }  // namespace hystlab::fmu

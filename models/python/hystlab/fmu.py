@@ -46,13 +46,14 @@ class FmuError(RuntimeError):
 class FmuState:
     """A state got from an instance (fmi2GetFMUstate); freed with the instance or by free()."""
 
-    def __init__(self, fmu, handle):
-        self._fmu, self.handle = fmu, handle
+    def __init__(self, fmu, handle, time):
+        self._fmu, self.handle, self.time = fmu, handle, time
 
     def free(self):
         if self.handle and self._fmu._c:
             h = ctypes.c_void_p(self.handle)
             self._fmu._lib.fmi2FreeFMUstate(self._fmu._c, ctypes.byref(h))
+            self._fmu._states.discard(self)
         self.handle = None
 
 
@@ -80,7 +81,7 @@ class Fmu:
         self.messages = []
         self._c = None
         self._dir = tempfile.mkdtemp(prefix="hystlab-fmu-")
-        self._states = []
+        self._states = set()
         try:
             self._unpack(path)
             self._load()
@@ -168,9 +169,17 @@ class Fmu:
     def _last_message(self, default):
         return self.messages[-1][2] if self.messages else default
 
-    def _check(self, status, call):
+    def _check(self, status, call, logged_before=None):
+        """Raises FmuError for a refused call, with what the FMU logged during it (logged_before:
+        the number of messages before the call)."""
         if status not in (_OK, _WARNING):
-            raise FmuError(self._last_message("%s returned %s" % (call, _STATUS[status] if 0 <= status < 6 else status)))
+            fresh = self.messages[logged_before:] if logged_before is not None else self.messages[-1:]
+            said = fresh[-1][2] if fresh else "%s returned %s" % (call, _STATUS[status] if 0 <= status < 6 else status)
+            raise FmuError(said)
+
+    def _call(self, name, *args):
+        before = len(self.messages)
+        self._check(getattr(self._lib, name)(self._c, *args), name, before)
 
     def _var(self, name):
         try:
@@ -184,9 +193,9 @@ class Fmu:
             v = self._var(name)
             ref = (ctypes.c_uint * 1)(v.vr)
             if v.type == "Real":
-                self._check(self._lib.fmi2SetReal(self._c, ref, 1, (ctypes.c_double * 1)(value)), "fmi2SetReal")
+                self._call("fmi2SetReal", ref, 1, (ctypes.c_double * 1)(value))
             elif v.type == "Integer":
-                self._check(self._lib.fmi2SetInteger(self._c, ref, 1, (ctypes.c_int * 1)(int(value))), "fmi2SetInteger")
+                self._call("fmi2SetInteger", ref, 1, (ctypes.c_int * 1)(int(value)))
             else:
                 raise FmuError("variable %r is a %s: this importer sets Real and Integer variables" % (name, v.type))
 
@@ -195,20 +204,20 @@ class Fmu:
         ref = (ctypes.c_uint * 1)(v.vr)
         if v.type == "Real":
             out = (ctypes.c_double * 1)()
-            self._check(self._lib.fmi2GetReal(self._c, ref, 1, out), "fmi2GetReal")
+            self._call("fmi2GetReal", ref, 1, out)
         elif v.type == "Integer":
             out = (ctypes.c_int * 1)()
-            self._check(self._lib.fmi2GetInteger(self._c, ref, 1, out), "fmi2GetInteger")
+            self._call("fmi2GetInteger", ref, 1, out)
         else:
             raise FmuError("variable %r is a %s: this importer reads Real and Integer variables" % (name, v.type))
         return out[0]
 
     def initialize(self, start_time=0.0, **values):
         """Set up the experiment, set parameters and inputs (by name), and end initialization."""
-        self._check(self._lib.fmi2SetupExperiment(self._c, 0, 0.0, start_time, 0, 0.0), "fmi2SetupExperiment")
-        self._check(self._lib.fmi2EnterInitializationMode(self._c), "fmi2EnterInitializationMode")
+        self._call("fmi2SetupExperiment", 0, 0.0, start_time, 0, 0.0)
+        self._call("fmi2EnterInitializationMode")
         self.set(**values)
-        self._check(self._lib.fmi2ExitInitializationMode(self._c), "fmi2ExitInitializationMode")
+        self._call("fmi2ExitInitializationMode")
         self.time, self._initialized = start_time, True
 
     def set_input_derivatives(self, name, *derivatives):
@@ -216,12 +225,11 @@ class Fmu:
         v = self._var(name)
         n = len(derivatives)
         refs, orders = (ctypes.c_uint * n)(*[v.vr] * n), (ctypes.c_int * n)(*range(1, n + 1))
-        self._check(self._lib.fmi2SetRealInputDerivatives(self._c, refs, n, orders, (ctypes.c_double * n)(*derivatives)),
-                    "fmi2SetRealInputDerivatives")
+        self._call("fmi2SetRealInputDerivatives", refs, n, orders, (ctypes.c_double * n)(*derivatives))
 
     def do_step(self, h, t=None):
         t = self.time if t is None else t
-        self._check(self._lib.fmi2DoStep(self._c, t, h, 1), "fmi2DoStep")
+        self._call("fmi2DoStep", t, h, 1)
         self.time = t + h
 
     def simulate(self, x, h=1e-3, input="x", output="F", **parameters):
@@ -237,34 +245,41 @@ class Fmu:
         return out
 
     # -- state ----------------------------------------------------------------------------------
-    def get_state(self):
-        h = ctypes.c_void_p()
-        self._check(self._lib.fmi2GetFMUstate(self._c, ctypes.byref(h)), "fmi2GetFMUstate")
-        s = FmuState(self, h.value)
-        self._states.append(s)
+    def get_state(self, into=None):
+        """The instance's state (fmi2GetFMUstate); into: a state of this instance to overwrite."""
+        h = ctypes.c_void_p(into.handle if into is not None else None)
+        self._call("fmi2GetFMUstate", ctypes.byref(h))
+        if into is not None:
+            into.time = self.time
+            return into
+        s = FmuState(self, h.value, self.time)
+        self._states.add(s)
         return s
 
     def set_state(self, state):
-        self._check(self._lib.fmi2SetFMUstate(self._c, state.handle), "fmi2SetFMUstate")
+        """Back to a state: the FMU's memory, input and time (the next do_step starts there)."""
+        self._call("fmi2SetFMUstate", state.handle)
+        self.time = state.time
 
     def serialize(self, state):
         size = ctypes.c_size_t()
-        self._check(self._lib.fmi2SerializedFMUstateSize(self._c, state.handle, ctypes.byref(size)), "fmi2SerializedFMUstateSize")
+        self._call("fmi2SerializedFMUstateSize", state.handle, ctypes.byref(size))
         buf = ctypes.create_string_buffer(size.value)
-        self._check(self._lib.fmi2SerializeFMUstate(self._c, state.handle, buf, size.value), "fmi2SerializeFMUstate")
+        self._call("fmi2SerializeFMUstate", state.handle, buf, size.value)
         return buf.raw
 
-    def deserialize(self, data):
+    def deserialize(self, data, time=None):
+        """A state from serialize()'s bytes (of this FMU); time: the simulation time it holds."""
         h = ctypes.c_void_p()
-        self._check(self._lib.fmi2DeSerializeFMUstate(self._c, bytes(data), len(data), ctypes.byref(h)), "fmi2DeSerializeFMUstate")
-        s = FmuState(self, h.value)
-        self._states.append(s)
+        self._call("fmi2DeSerializeFMUstate", bytes(data), len(data), ctypes.byref(h))
+        s = FmuState(self, h.value, self.time if time is None else time)
+        self._states.add(s)
         return s
 
     # -- lifetime -------------------------------------------------------------------------------
     def close(self):
         if self._c:
-            for s in self._states:
+            for s in list(self._states):
                 s.free()
             if self._initialized:
                 self._lib.fmi2Terminate(self._c)

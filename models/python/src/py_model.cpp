@@ -62,7 +62,9 @@ class Model {
  private:
   static models::PreisachOptions options(double merge_tolerance, std::size_t max_turning_points) {
     if (!(merge_tolerance >= 0.0) || !std::isfinite(merge_tolerance)) throw std::invalid_argument("merge_tolerance must be a finite number >= 0");
-    if (max_turning_points < 3) throw std::invalid_argument("max_turning_points must be at least 3");
+    // The memory is preallocated: a bound keeps a typo from asking for terabytes.
+    if (max_turning_points < 3 || max_turning_points > (std::size_t{1} << 24))
+      throw std::invalid_argument("max_turning_points must be from 3 to 16777216");
     return models::PreisachOptions{merge_tolerance, max_turning_points};
   }
   Impl locked_copy() const {
