@@ -24,7 +24,8 @@ fail() { echo "FAIL: $*"; [ -f d.log ] && tail -n 20 d.log; exit 1; }
 echo '{"rigs": [{"name": "sim frame", "simulate": {"time_scale": 10, "noise_N": 0.05}}]}' > cfg.json
 echo '{"kind": "fot", "range_mm": [0, 2], "subdivisions": 4, "ramp_rate_mm_s": 1, "sample_rate_hz": 500, "validation": {"reversals": 6, "seed": 3}}' > uniform.json
 echo '{"kind": "fot", "nodes_mm": [0, 0.3, 0.8, 1.1, 2], "ramp_rate_mm_s": 1, "sample_rate_hz": 500, "validation": false}' > refined.json
-# TMPDIR: where the HTTP export writes its temporary file; it must be empty after every request.
+# The HTTP export writes its temporary file beside the database (h.db here); nothing may be left
+# there, nor in TMPDIR, after any request.
 TMPDIR="$d/tmp" "$hystlabd" --config cfg.json --db h.db --port 0 > d.log 2>&1 &
 pid=$!
 port=
@@ -130,7 +131,8 @@ refused "no samples for run $empty" runs export "$empty" -o bad.csv --db h.db
 code=$(curl -s -o nf.json -w '%{http_code}' "$api/api/runs/$empty/samples.h5")
 [ "$code" = 404 ] && grep -q "no samples for run $empty" nf.json || fail "a run without samples over HTTP: HTTP $code $(cat nf.json)"
 ls bad.* bad.*.tmp 2>/dev/null && fail "a refused export left a file behind"
-[ -z "$(ls tmp)" ] || fail "the HTTP export left $(ls tmp) in its temporary folder"
+[ -z "$(ls tmp)" ] || fail "the HTTP export left $(ls tmp) in the temporary folder"
+[ -z "$(ls hystlab-export-* 2>/dev/null)" ] || fail "the HTTP export left $(ls hystlab-export-*) beside the database"
 kill -0 "$pid" || fail "hystlabd died"
 echo "refusals: one line each, no file left behind; ok"
 # The daemon stops cleanly, and (in the sanitized tree) said nothing of its memory.

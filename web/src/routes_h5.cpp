@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -26,10 +27,30 @@ struct OpenFile {  // a descriptor closed when the last response holding it is g
   int fd;
 };
 
-// A name for the export in the system's temporary folder; removed when this goes (if still there).
+// At most this many exports at once: each compresses on a core the rig's loop may need, and a
+// third request is told to come back rather than queued (503).
+constexpr int kMaxH5Exports = 2;
+std::atomic<int> g_h5_exports{0};
+
+struct ExportSlot {
+  ExportSlot() {
+    if (g_h5_exports.fetch_add(1) >= kMaxH5Exports) {
+      g_h5_exports.fetch_sub(1);
+      throw ApiError(503, "busy", std::to_string(kMaxH5Exports) + " HDF5 exports are running; try again when one has finished");
+    }
+  }
+  ExportSlot(const ExportSlot&) = delete;
+  ExportSlot& operator=(const ExportSlot&) = delete;
+  ~ExportSlot() { g_h5_exports.fetch_sub(1); }
+};
+
+// A name for the export beside the database (on the disk that holds the runs, not a tmpfs $TMPDIR
+// that would hold the whole file in memory); removed when this goes (if still there).
 struct TempName {
-  TempName() {
-    std::string t = (std::filesystem::temp_directory_path() / "hystlab-export-XXXXXX.h5").string();
+  explicit TempName(const std::string& db_path) {
+    std::filesystem::path dir = std::filesystem::path(db_path).parent_path();
+    if (dir.empty()) dir = ".";
+    std::string t = (dir / "hystlab-export-XXXXXX.h5").string();
     const int fd = ::mkstemps(t.data(), 3);
     if (fd < 0) throw ApiError(500, "internal error", std::string("cannot create a temporary file for the export: ") + std::strerror(errno));
     ::close(fd);
@@ -43,8 +64,9 @@ struct TempName {
 
 // Runs the export into a temporary file and returns it open and already unlinked.
 template <class Export>
-std::shared_ptr<OpenFile> export_to_temp(Export export_to) {
-  const TempName name;
+std::shared_ptr<OpenFile> export_to_temp(const std::string& db_path, Export export_to) {
+  const ExportSlot slot;
+  const TempName name(db_path);
   try {
     export_to(name.path);
   } catch (const db::H5ExportError& e) {
@@ -73,13 +95,13 @@ void add_h5_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/runs/(\d+)/samples\.h5)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     db::Store& store = reader(c.db_path);
     const std::int64_t id = path_id(req);
-    auto file = export_to_temp([&](const std::string& path) { (void)db::export_run_h5(store, id, path); });
+    auto file = export_to_temp(c.db_path, [&](const std::string& path) { (void)db::export_run_h5(store, id, path); });
     send_file(res, std::move(file), "run-" + std::to_string(id) + ".h5");
   }));
   s.Get(R"(/api/campaigns/(\d+)/samples\.h5)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     db::Store& store = reader(c.db_path);
     const std::int64_t id = path_id(req);
-    auto file = export_to_temp([&](const std::string& path) { (void)db::export_campaign_h5(store, id, path); });
+    auto file = export_to_temp(c.db_path, [&](const std::string& path) { (void)db::export_campaign_h5(store, id, path); });
     send_file(res, std::move(file), "campaign-" + std::to_string(id) + ".h5");
   }));
 }
