@@ -1,5 +1,6 @@
 #include <filesystem>
 #include "cli_support.hpp"
+#include "hystlab/models/text_forms.hpp"
 
 #include <cerrno>
 #include <charconv>
@@ -202,11 +203,7 @@ std::vector<double> Csv::column(const std::string& col) const {
   return out;
 }
 
-std::string format_number(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest form that reads back exactly
-  return std::string(buf, r.ptr);
-}
+std::string format_number(double v) { return models::exact_text(v); }
 
 std::string to_csv(const std::vector<std::string>& header, const std::vector<std::vector<double>>& cols) {
   std::string out;
@@ -223,14 +220,7 @@ std::string to_csv(const std::vector<std::string>& header, const std::vector<std
   return out;
 }
 
-std::string now_iso8601() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
+std::string now_iso8601() { return models::iso8601_utc(std::time(nullptr)); }
 
 LoadedModel load_model(const Options& opt) {
   LoadedModel m;

@@ -4,7 +4,6 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "hystlab/fmu/element_export.hpp"
-#include "hystlab/models/formats.hpp"
 
 namespace hystlab::cli {
 namespace {
@@ -20,9 +19,10 @@ Writes a table or simplified-model parameters for other tools (docs/FORMATS.md):
 )";
 }  // namespace
 
-void write_export(const std::string& document, const std::string& format, const std::string& name, const std::string& output) {
+void write_export(const std::string& document, const std::string& format, const std::string& name, const std::string& output,
+                  std::optional<models::ElementKind> kind) {
   if (!fmu::is_export_format(format)) throw CliError("--format: '" + format + "' is not " + std::string(fmu::kExportFormats));
-  const fmu::ExportedFile f = fmu::export_element(document, format, name, now_iso8601());
+  const fmu::ExportedFile f = fmu::export_element(document, format, name, now_iso8601(), kind);
   if (f.binary && (output.empty() || output == "-"))
     throw CliError("--format " + format + " writes a binary archive: give -o FILE." + format);
   write_output(output, f.bytes);
@@ -35,11 +35,9 @@ int run_export(const Args& args) {
   const std::string format = opt.require("format");
   if (!fmu::is_export_format(format)) throw CliError("--format: '" + format + "' is not " + std::string(fmu::kExportFormats));
   const bool table = opt.has("table");
-  std::string doc = read_file(opt.get(table ? "table" : "params"));
-  // The kind the user named: a table given as --params (or the reverse) is refused, naming the field.
-  if (table) (void)models::table_from_json(doc);
-  else (void)models::params_from_json(doc);
-  write_export(doc, format, opt.get("name", table ? "hystlab_table" : "hystlab_params"), opt.get("output"));
+  const std::string doc = read_file(opt.get(table ? "table" : "params"));
+  write_export(doc, format, opt.get("name", table ? "hystlab_table" : "hystlab_params"), opt.get("output"),
+               table ? models::ElementKind::Table : models::ElementKind::Params);
   return 0;
 }
 

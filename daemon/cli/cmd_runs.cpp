@@ -1,7 +1,6 @@
 // hystlab runs export: a run's samples as CSV, streamed to the output as they are read (a 10^7-
 // sample run never sits in memory), or a run or a whole campaign as HDF5 (docs/FORMATS.md).
 #include <cerrno>
-#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +11,7 @@
 #include "hystlab/db/run_h5.hpp"
 #include "hystlab/db/signals.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/models/text_forms.hpp"
 
 namespace hystlab::cli {
 namespace {
@@ -42,8 +42,8 @@ class CsvStream {
  public:
   CsvStream(std::FILE* f, std::string name) : f_(f), name_(std::move(name)) { buf_.reserve(kFlushAt + 4096); }
   void text(const char* s) { buf_ += s; }
-  void number(double v) { put(v); }
-  void integer(std::int64_t v) { put(v); }
+  void number(double v) { models::append_exact(buf_, v); }
+  void integer(std::int64_t v) { buf_ += std::to_string(v); }
   void end_row() {
     buf_ += '\n';
     if (buf_.size() >= kFlushAt) flush();
@@ -56,12 +56,6 @@ class CsvStream {
 
  private:
   static constexpr std::size_t kFlushAt = 1U << 20;
-  template <class T>
-  void put(T v) {
-    char b[32];
-    const auto r = std::to_chars(b, b + sizeof b, v);  // shortest form that reads back exactly
-    buf_.append(b, r.ptr);
-  }
   std::FILE* f_;
   std::string name_, buf_;
 };

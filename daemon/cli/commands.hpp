@@ -1,6 +1,9 @@
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "hystlab/models/element.hpp"
 
 namespace hystlab::cli {
 
@@ -23,7 +26,9 @@ int run_runs_cmd(const Args& args);
 int run_simulate(const Args& args);
 int run_export(const Args& args);
 // Writes a table or parameter document in an export format (hystlab export, tables export).
-void write_export(const std::string& document, const std::string& format, const std::string& name, const std::string& output);
+// kind: the one the user named (a document of the other kind is refused), or none.
+void write_export(const std::string& document, const std::string& format, const std::string& name, const std::string& output,
+                  std::optional<models::ElementKind> kind = {});
 
 // True (and the help printed) when args ask for it.
 bool print_help_if_asked(const Args& args, const char* text);

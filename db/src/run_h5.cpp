@@ -13,19 +13,13 @@
 #include "h5_layout.hpp"
 #include "hystlab/db/signals.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/models/text_forms.hpp"
 
 namespace hystlab::db {
 namespace {
 using h5::Handle;
 
-std::string utc_now() {
-  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return b;
-}
+std::string utc_now() { return models::iso8601_utc(std::time(nullptr)); }
 
 // "force (N)" -> "N": the unit is the label's last parenthesis (signals.hpp names each signal once).
 std::string unit_of(const char* label) {

@@ -1,5 +1,7 @@
 #include "hystlab/models/table_export.hpp"
 
+#include "hystlab/models/text_forms.hpp"
+
 #include <cctype>
 #include <charconv>
 #include <cstdio>
@@ -9,13 +11,7 @@
 
 namespace hystlab::models {
 namespace {
-// The shortest text that reads back to the same double: what was identified is what the other
-// tool gets, and 2.95 stays 2.95.
-std::string num(double v) {
-  char buf[40];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
+std::string num(double v) { return exact_text(v); }
 
 int version_of(const Grid& g) { return g.uniform() ? kTableVersion : kTableVersionNodes; }
 

@@ -34,6 +34,16 @@ def cli_forces(d, model_args, x):
     return [float(line.split(",")[1]) for line in out[1:]]
 
 
+def steps(fmu, xs, h=1e-3):
+    """One step per input from where the instance stands; F after each."""
+    out = []
+    for v in xs:
+        fmu.set(x=v)
+        fmu.do_step(h)
+        out.append(fmu.get("F"))
+    return out
+
+
 def random_path(seed, lo, hi, n):
     rng = random.Random(seed)
     x = [0.0]
@@ -75,28 +85,16 @@ with tempfile.TemporaryDirectory() as d:
     with hystlab.fmu.Fmu(fmu_t) as f, hystlab.fmu.Fmu(fmu_t, "second") as g, hystlab.fmu.Fmu(os.path.join(d, "T2.json.fmu")) as other:
         f.simulate(x[:700])
         s = f.get_state()
-        ahead = []
-        for v in x[700:]:
-            f.set(x=v)
-            f.do_step(1e-3)
-            ahead.append(f.get("F"))
+        ahead = steps(f, x[700:])
         t_ahead = f.time
         f.set_state(s)
         check(f.time < t_ahead and f.time == s.time, "set_state takes the time back too (%.3f s)" % f.time)
-        again = []
-        for v in x[700:]:
-            f.set(x=v)
-            f.do_step(1e-3)
-            again.append(f.get("F"))
+        again = steps(f, x[700:])
         check(again == ahead, "a state set back gives the same outputs (%d steps)" % len(ahead))
         blob = f.serialize(s)
         g.simulate([0.0])
         g.set_state(g.deserialize(blob))
-        moved = []
-        for v in x[700:]:
-            g.set(x=v)
-            g.do_step(1e-3)
-            moved.append(g.get("F"))
+        moved = steps(g, x[700:])
         check(moved == ahead, "a serialized state (%d bytes) continues in another instance" % len(blob))
         other.simulate([0.0])
         try:

@@ -97,6 +97,15 @@ inline fmi2Component started(const Fmu& f, const fmi2CallbackFunctions& cb) {
   return c;
 }
 
+// A state's bytes, as fmi2SerializedFMUstateSize and fmi2SerializeFMUstate give them.
+inline std::vector<fmi2Byte> serialized(const Fmu& f, fmi2Component c, fmi2FMUstate s) {
+  std::size_t size = 0;
+  REQUIRE(f.fmi2SerializedFMUstateSize(c, s, &size) == fmi2OK);
+  std::vector<fmi2Byte> bytes(size);
+  REQUIRE(f.fmi2SerializeFMUstate(c, s, bytes.data(), size) == fmi2OK);
+  return bytes;
+}
+
 inline int exact_matches(const std::vector<double>& a, const std::vector<double>& b) {
   int n = 0;
   for (std::size_t k = 0; k < a.size() && k < b.size(); ++k) n += a[k] == b[k] ? 1 : 0;  // the same doubles

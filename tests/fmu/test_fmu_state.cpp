@@ -31,10 +31,8 @@ TEST_CASE("fmu: a state got, set and serialized rolls a simulation back to the s
     const std::vector<double> first = run_fmu(f, c, x, cut, 1.0);
     REQUIRE(f.fmi2SetFMUstate(c, s) == fmi2OK);  // roll back
     CHECK(exact_matches(run_fmu(f, c, x, cut, 1.0), first) == static_cast<int>(first.size()));
-    std::size_t size = 0;
-    REQUIRE(f.fmi2SerializedFMUstateSize(c, s, &size) == fmi2OK);
-    std::vector<fmi2Byte> bytes(size);
-    REQUIRE(f.fmi2SerializeFMUstate(c, s, bytes.data(), size) == fmi2OK);
+    const std::vector<fmi2Byte> bytes = serialized(f, c, s);
+    const std::size_t size = bytes.size();
     fmi2Component other = started(f, cb);  // a second instance takes the serialized state
     (void)run_fmu(f, other, {0.0});
     CHECK(f.fmi2SetFMUstate(other, s) == fmi2Error);  // a handle is its instance's own
@@ -100,10 +98,8 @@ TEST_CASE("fmu: a state from another table, or bytes that are no state, are refu
   (void)run_fmu(b, cbi, {0.0});
   fmi2FMUstate s = nullptr;
   REQUIRE(a.fmi2GetFMUstate(ca, &s) == fmi2OK);
-  std::size_t size = 0;
-  REQUIRE(a.fmi2SerializedFMUstateSize(ca, s, &size) == fmi2OK);
-  std::vector<fmi2Byte> bytes(size);
-  REQUIRE(a.fmi2SerializeFMUstate(ca, s, bytes.data(), size) == fmi2OK);
+  std::vector<fmi2Byte> bytes = serialized(a, ca, s);
+  const std::size_t size = bytes.size();
   fmi2FMUstate into = nullptr;
   CHECK(b.fmi2DeSerializeFMUstate(cbi, bytes.data(), size, &into) == fmi2Error);
   CHECK(into == nullptr);

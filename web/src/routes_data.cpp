@@ -10,6 +10,7 @@
 #include "hystlab/fmu/element_export.hpp"
 #include "hystlab/models/table_export.hpp"
 #include "hystlab/models/table_score.hpp"
+#include "hystlab/models/text_forms.hpp"
 #include "hystlab/db/signals.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
@@ -47,9 +48,7 @@ std::unique_ptr<models::HysteresisModel> model_of(const json& body, db::Store& s
 // A number in the shortest form that reads back to the same double (as the CLI's exports and
 // HDF5 hold it: an analyst's arrays are the stored values), then the separator.
 void append_exact(std::string& out, double v, char sep) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, r.ptr);
+  models::append_exact(out, v);
   out.push_back(sep);
 }
 

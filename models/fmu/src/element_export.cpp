@@ -11,11 +11,17 @@ namespace hystlab::fmu {
 
 bool is_export_format(std::string_view f) { return f == "json" || f == "csv" || f == "m" || f == "h" || f == "fmu"; }
 
-ExportedFile export_element(std::string_view document, std::string_view format, const std::string& name, const std::string& created) {
+ExportedFile export_element(std::string_view document, std::string_view format, const std::string& name, const std::string& created,
+                            std::optional<models::ElementKind> kind) {
   if (!is_export_format(format)) throw std::invalid_argument("'" + std::string(format) + "' is not " + std::string(kExportFormats));
-  if (format == "fmu") return {fmu_archive(document, FmuOptions{name, created}), "application/zip", true};
   const auto j = nlohmann::json::parse(document.begin(), document.end(), nullptr, false);
-  const bool table = j.is_object() && j.contains("format");
+  const bool looks_table = j.is_object() && j.contains("format");
+  const bool table = kind ? *kind == models::ElementKind::Table : looks_table;
+  if (table != looks_table) {  // not the kind named: its parser says what is missing
+    if (table) (void)models::table_from_json(document);
+    else (void)models::params_from_json(document);
+  }
+  if (format == "fmu") return {fmu_archive(document, FmuOptions{name, created}), "application/zip", true};
   if (table) {
     const models::TableDocument doc = models::table_from_json(document);
     if (format == "json") return {models::table_to_json(doc.table, doc.provenance).dump(2) + "\n", "application/json"};

@@ -6,6 +6,7 @@
 #include "fmu_guid.hpp"
 #include "fmu_variables.hpp"
 #include "hystlab/models/element.hpp"
+#include "hystlab/models/text_forms.hpp"
 #include "zip_writer.hpp"
 
 #ifndef HYSTLAB_VERSION
@@ -30,11 +31,7 @@ std::string xml_escaped(std::string_view s) {
   return out;
 }
 
-std::string num(double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
+std::string num(double v) { return models::exact_text(v); }
 
 // One line on what the element is, from its document (the table's provenance, or the parameters).
 std::string element_summary(const models::Element& e) {

@@ -7,19 +7,12 @@
 #include <string>
 #include <string_view>
 
+#include "hystlab/models/fingerprint.hpp"
+
 namespace hystlab::fmu {
 
-inline std::uint64_t fnv1a64(std::string_view text, std::uint64_t basis) {
-  std::uint64_t h = basis;
-  for (const char c : text) {
-    h ^= static_cast<std::uint8_t>(c);
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
-
 inline std::string element_guid(std::string_view canonical_json) {
-  const std::uint64_t a = fnv1a64(canonical_json, 0xcbf29ce484222325ULL), b = fnv1a64(canonical_json, 0x84222325cbf29ce4ULL);
+  const std::uint64_t a = models::fnv1a64(canonical_json), b = models::fnv1a64(canonical_json, 0x84222325cbf29ce4ULL);
   char buf[48];
   std::snprintf(buf, sizeof buf, "{%08x-%04x-%04x-%04x-%012llx}", static_cast<unsigned>(a >> 32), static_cast<unsigned>((a >> 16) & 0xffffU),
                 static_cast<unsigned>(a & 0xffffU), static_cast<unsigned>(b >> 48), static_cast<unsigned long long>(b & 0xffffffffffffULL));

@@ -11,6 +11,7 @@
 #include "fmu_guid.hpp"
 #include "fmu_state.hpp"
 #include "fmu_variables.hpp"
+#include "hystlab/models/text_forms.hpp"
 
 namespace hystlab::fmu {
 namespace {
@@ -19,11 +20,7 @@ namespace {
 constexpr double kNotDriven = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t kInstanceNumbers = 9;  // time, x, committed, d1, d2, x_scale, x_offset, force_scale, sign
 
-std::string text(double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
+std::string text(double v) { return models::exact_text(v); }
 
 std::string percent_decoded(const std::string& s) {
   std::string out;

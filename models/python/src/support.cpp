@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "bindings.hpp"
+#include "hystlab/models/fingerprint.hpp"
+#include "hystlab/models/text_forms.hpp"
 
 namespace hystlab::python {
 
@@ -42,20 +44,9 @@ void write_file(const fs::path& path, const std::string& text) {
   }
 }
 
-std::string format_number(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
+std::string format_number(double v) { return models::exact_text(v); }
 
-std::string now_iso8601() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
+std::string now_iso8601() { return models::iso8601_utc(std::time(nullptr)); }
 
 py::object json_to_py(const nlohmann::json& j) {
   return py::module_::import("json").attr("loads")(j.dump());
@@ -83,12 +74,9 @@ py::array_t<double> to_numpy(std::span<const double> v) {
 }
 
 namespace {
-struct Fnv {
-  std::uint64_t h = 1469598103934665603ULL;
-  void add(const void* data, std::size_t n) {
-    const auto* b = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < n; ++k) h = (h ^ b[k]) * 1099511628211ULL;
-  }
+struct Fnv {  // the bytes of the values, chained through models::fnv1a64
+  std::uint64_t h = models::kFnvBasis;
+  void add(const void* data, std::size_t n) { h = models::fnv1a64({static_cast<const char*>(data), n}, h); }
   void add(double v) { add(&v, sizeof v); }
 };
 }  // namespace
