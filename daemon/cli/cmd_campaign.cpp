@@ -236,7 +236,7 @@ int run_campaign_cmd(const Args& args) {
     refuse_db_option(args, "campaign " + verb);
     const Options opt(rest(args, 2), {"daemon", "token"}, {});
     const auto a = post_to_daemon(daemon_address(opt), "/api/campaigns/" + std::to_string(id) + "/" + verb, "");
-    std::cout << verb << " sent to campaign " << id << " (" << a.value("state", "") << ")\n";
+    std::cout << verb << " " << (a.value("result", "") == "done" ? "done" : "sent") << ": campaign " << id << " (" << a.value("state", "") << ": " << a.value("reason", "") << ")\n";
     return 0;
   }
   const Options opt(rest(args, 2), {"db"}, {"json"});

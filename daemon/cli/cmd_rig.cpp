@@ -30,7 +30,9 @@ int run_rig_cmd(const Args& args) {
   refuse_db_option(args, "rig " + verb);
   const Options opt(Args(args.begin() + 2, args.end()), {"daemon", "token"}, {});
   const auto a = post_to_daemon(daemon_address(opt), "/api/rigs/" + url_segment(name) + "/" + verb, "");
-  std::cout << verb << " sent to rig '" << a.value("rig", name) << "' (" << a.value("state", "") << ")\n";
+  // done: latched and seen by the rig (or reset); pending: taken, not yet confirmed; refusals exit 2 above.
+  std::cout << verb << " " << (a.value("result", "") == "done" ? "done" : "sent") << ": rig '" << a.value("rig", name) << "' is " << a.value("state", "") << " ("
+            << a.value("reason", "") << ")\n";
   return 0;
 }
 

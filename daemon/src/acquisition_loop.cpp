@@ -141,6 +141,10 @@ bool arm(Loop& L) {
     c.clock.sleep_until(next);
     const double t = L.rig_time();
     if (c.stop && c.stop->load()) return L.end(CampaignEnd::interrupted, "the daemon is stopping"), c.supervisor.disarm(t, "stopping"), false;
+    const bool was_latched = c.supervisor.latched();  // a latch from before fails the handshake below, named
+    if (c.service) c.service(t);
+    if (!was_latched && c.supervisor.latched()) return L.end(CampaignEnd::aborted, c.supervisor.latch_reason() + " while arming"), false;
+    c.supervisor.heartbeat(c.clock.now());
     if (const auto ctl = c.next_control(); ctl && (*ctl == Control::abort || *ctl == Control::estop)) {
       if (*ctl == Control::estop) c.supervisor.estop(t, "e-stop by the operator");
       else c.supervisor.disarm(t, "aborted while arming");
@@ -179,15 +183,27 @@ bool arm(Loop& L) {
   }
 }
 
-// Pause, resume, abort, e-stop; false when the campaign ends at once (e-stop).
+// The rig's latch ends the campaign at once, whatever it was doing: a safe ramp under way keeps
+// its end (aborted) and says that the e-stop came on top of it.
+bool latched_end(Loop& L) {
+  const Supervisor& sup = L.ctx.supervisor;
+  if (!sup.latched()) return false;
+  if (L.result.end == CampaignEnd::none) L.end(CampaignEnd::aborted, sup.latch_reason());
+  else if (L.result.reason.find(sup.latch_reason()) == std::string::npos) L.result.reason += "; then " + sup.latch_reason();
+  L.safing = false;
+  return true;
+}
+
+// The stop channel, then pause, resume, abort, e-stop; false when the campaign ends at once.
 bool handle_control(Loop& L, Strategy& strategy, double t, double x) {
+  Supervisor& sup = L.ctx.supervisor;
+  if (L.ctx.service) L.ctx.service(t);
+  if (latched_end(L)) return false;
   const auto c = L.ctx.next_control();
   if (!c) return true;
-  Supervisor& sup = L.ctx.supervisor;
   if (*c == Control::estop) {
-    sup.estop(t, "e-stop by the operator");
-    L.end(CampaignEnd::aborted, "e-stop by the operator");
-    return false;
+    (void)sup.estop(t, "e-stop by the operator");
+    return !latched_end(L);
   }
   if (*c == Control::abort) {
     L.paused = false;
@@ -405,15 +421,17 @@ void record_quality(Loop& L) {
                       {"requested_rate_hz", L.plan.sample_rate_hz}});
 }
 
-void hand_off(Loop& L, Strategy& strategy) {
+// drove: the loop ran on the rig (a resume with nothing left to drive has no quality of its own).
+void hand_off(Loop& L, Strategy& strategy, bool drove = true) {
   FinishJob fj;
   fj.campaign = L.job.id;
   fj.plan = L.plan;
   strategy.fill_finish(L, fj);  // first: the last descent's bottom node is counted there
+  if (fj.validation.x.empty() && !L.job.prior_validation.x.empty()) fj.validation = L.job.prior_validation;
   fj.result = L.result;
   if (L.result.gaps > 0)
     L.event("gaps", {{"count", L.result.gaps}, {"total_ms", L.result.gap_total_s * 1e3}, {"longest_ms", L.result.longest_gap_s * 1e3}});
-  record_quality(L);
+  if (drove) record_quality(L);
   if (L.ctx.finish) {
     L.ctx.finish(std::move(fj));
     return;
@@ -451,7 +469,8 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
                      {"in_position_mm", ctx.supervisor.settings().in_position_mm}});
   if (!strategy->has_work()) {  // a resume with every node measured: finish without moving
     L.end(CampaignEnd::completed, "every node was measured by earlier runs: finished without driving the rig");
-    hand_off(L, *strategy);
+    L.result.run_id = job.prior_run;  // the tables belong to the last run that measured (it exists)
+    hand_off(L, *strategy, false);
     return L.result;
   }
   L.state(db::CampaignState::arming, "started by the daemon");

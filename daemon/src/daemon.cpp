@@ -74,28 +74,41 @@ struct Daemon::Impl {
   }
 
   // An operator command that found no running campaign: the main loop, with the database.
-  void route(std::int64_t campaign, CampaignCommand cmd) {
-    if (direct(campaign, cmd)) return;
+  CommandOutcome route(std::int64_t campaign, CampaignCommand cmd) {
+    using R = CommandOutcome::Result;
+    if (direct(campaign, cmd)) return {R::pending, false, false, "running", "taken by the running campaign", 0};
     const auto row = store.campaign(campaign);
-    if (!row) return;
+    if (!row) return {R::conflict, false, false, "", "no campaign " + std::to_string(campaign), 0};
     using C = CampaignCommand;
-    RigWorker* w = worker_of(row->rig_id);
-    if (cmd == C::estop && w) w->push_rig_command(RigCommand::estop);
     using S = db::CampaignState;
+    RigWorker* w = worker_of(row->rig_id);
+    const std::string state = db::to_string(row->state);
     if (cmd == C::resume && (row->state == S::interrupted || row->state == S::paused || row->state == S::held)) {
       dispatched.erase(campaign);
       store.transition(campaign, S::queued,
                        row->state == S::held ? "released by the operator" : "re-queued to resume: wipe-out preamble, then the rows not yet measured",
                        now_iso());
-    } else if ((cmd == C::abort || cmd == C::estop) && (row->state == S::queued || row->state == S::held)) {
+      return {R::done, false, false, "queued", "queued to resume", 0};
+    }
+    if ((cmd == C::abort || cmd == C::estop) && !db::is_final(row->state)) {
       if (w && w->has_queued(campaign) && !w->cancel_queued(campaign)) {  // it just started: stop it there
         (void)direct(campaign, cmd);
-        return;
+        return {R::pending, false, false, "running", "taken by the campaign that had just started", 0};
       }
-      store.transition(campaign, S::aborted, "aborted by the operator before it started", now_iso());
-    } else {
-      store.add_event(campaign, "command", std::string("'") + to_string(cmd) + "' ignored: the campaign is " + db::to_string(row->state), now_iso());
+      const std::string why = std::string(cmd == C::estop ? "e-stop" : "aborted") + " by the operator while " + state;
+      store.transition(campaign, S::aborted, why, now_iso());
+      return {R::done, false, false, "aborted", why, 0};
     }
+    const std::string why = "campaign " + std::to_string(campaign) + " is " + state + ": '" + to_string(cmd) + "' does not apply";
+    store.add_event(campaign, "command", std::string("'") + to_string(cmd) + "' refused: the campaign is " + state, now_iso());
+    return {R::conflict, false, false, state, why, 0};
+  }
+
+  // The rig a campaign runs on (or is stored for); nullptr when unknown.
+  RigWorker* rig_of_campaign(std::int64_t campaign) {
+    for (auto& w : workers)
+      if (w->running_campaign == campaign || w->has_queued(campaign)) return w.get();
+    return nullptr;
   }
 
   // Hands queued campaigns to their rigs' threads, once each, with the plan checked against the
@@ -124,10 +137,22 @@ struct Daemon::Impl {
       return std::nullopt;
     }
     for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) job.prior_nodes.push_back({a, b, fa, fab});
-    if (job.plan.kind == db::CampaignKind::fot && !job.prior_nodes.empty())  // the fits after a resume use every run
-      for (const std::int64_t run : store.runs_of_campaign(id, db::RunRole::campaign))  // never the validation runs
+    if (job.plan.kind == db::CampaignKind::fot && !job.prior_nodes.empty()) {  // the fits after a resume use every run
+      for (const std::int64_t run : store.runs_of_campaign(id, db::RunRole::campaign)) {  // never the validation runs
         store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(),
                               [&job](const db::SampleRow& r) { job.prior_series.add(r.disp, r.force); });
+        job.prior_run = run;
+      }
+      // The last validation run that holds samples: a resume with every node measured scores its
+      // tables on it (an interruption during the validation run or the finishing left it there).
+      for (const std::int64_t run : store.runs_of_campaign(id, db::RunRole::validation)) {
+        if (store.sample_count(run) == 0) continue;
+        job.prior_validation = {};
+        store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(),
+                              [&job](const db::SampleRow& r) { job.prior_validation.add(r.disp, r.force); });
+        job.prior_validation_run = run;
+      }
+    }
     return job;
   }
 
@@ -293,24 +318,44 @@ std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) 
   return impl_->on_main<std::int64_t>([this, rig_id, kind, text] { return impl_->store.create_campaign(rig_id, kind, text, now_iso()); });
 }
 
-void Daemon::command(std::int64_t campaign_id, CampaignCommand cmd) {
-  if (impl_->direct(campaign_id, cmd)) return;  // no database on the way to a running campaign
-  impl_->on_main<int>([this, campaign_id, cmd] {
-    impl_->route(campaign_id, cmd);
-    return 0;
-  });
+CommandOutcome Daemon::command(std::int64_t campaign_id, CampaignCommand cmd) {
+  auto& d = *impl_;
+  if (cmd == CampaignCommand::estop) {  // the rig first, latched and confirmed; the campaign ends by the latch
+    RigWorker* w = d.rig_of_campaign(campaign_id);
+    if (!w) w = d.on_main<RigWorker*>([&d, campaign_id]() -> RigWorker* {
+      const auto row = d.store.campaign(campaign_id);
+      return row && !db::is_final(row->state) ? d.worker_of(row->rig_id) : nullptr;
+    });
+    if (w) {
+      std::size_t k = 0;
+      while (d.workers[k].get() != w) ++k;
+      CommandOutcome rig = rig_command(k, RigCommand::estop);
+      if (w->running_campaign != campaign_id)  // not running: the record ends here (running: the latch ended it)
+        (void)d.on_main<CommandOutcome>([&d, campaign_id] { return d.route(campaign_id, CampaignCommand::abort); });
+      else
+        d.direct(campaign_id, cmd);  // the command is recorded with the campaign
+      return rig;
+    }
+  }
+  if (d.direct(campaign_id, cmd)) return {CommandOutcome::Result::pending, false, false, "running", "taken by the running campaign", 0};
+  return d.on_main<CommandOutcome>([&d, campaign_id, cmd] { return d.route(campaign_id, cmd); });
 }
 
-void Daemon::rig_command(std::size_t rig, RigCommand c) {
+CommandOutcome Daemon::rig_command(std::size_t rig, RigCommand c, double wait_s) {
   RigWorker& w = *impl_->workers.at(rig);
-  w.push_rig_command(c);
-  if (c != RigCommand::estop) return;
-  // The operator's e-stop is latched before the answer, so a submission right after it is refused
-  // rather than accepted in the moment before the rig's thread takes the command (the review of
-  // stop 21 found a script could do that). The rig's thread takes it within a period, or 0.2 s
-  // between campaigns; 2 s bounds the wait for a rig whose thread is stuck in I/O.
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  while (!w.snapshot().latched && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  std::future<CommandOutcome> answer = w.push_rig_command(c);
+  // The rig's thread takes it at its next period (1 ms at 1 kHz, 50 ms between campaigns) and
+  // answers once the rig's status word confirms it. A thread stuck in I/O answers late: the
+  // caller then hears what is known, never silence. A latch is on the host at once either way.
+  if (answer.wait_for(std::chrono::duration<double>(wait_s)) == std::future_status::ready) {
+    try {
+      return answer.get();
+    } catch (const std::future_error&) {  // the thread ended (the daemon is stopping)
+    }
+  }
+  const RigSupervision s = w.snapshot();
+  return {CommandOutcome::Result::pending, s.latched, false, s.state,
+          "the rig's thread has not confirmed it within " + std::to_string(wait_s).substr(0, 3) + " s", wait_s};
 }
 
 int run_daemon(const DaemonConfig& config, const std::atomic<bool>& stop) {

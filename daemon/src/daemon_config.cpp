@@ -129,7 +129,8 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
       const json& s = r["simulate"];
       if (!s.is_object()) fail(where + ".simulate", "must be an object");
       for (const auto& [f, _] : s.items())
-        if (f != "time_scale" && f != "noise_N" && f != "corner_width_mm" && f != "rig" && f != "realtime_priority" && f != "shakedown")
+        if (f != "time_scale" && f != "noise_N" && f != "corner_width_mm" && f != "rig" && f != "realtime_priority" && f != "shakedown" &&
+            f != "host_timeout_ms")
           fail(where + ".simulate." + f, "is not a known field");
       e.simulated = true;
       e.sim.time_scale = positive(s, "time_scale", 10.0, where + ".simulate");
@@ -151,6 +152,12 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
         if (!p.is_number_integer() || p.get<long long>() < 0 || p.get<long long>() > 98)
           fail(where + ".simulate.realtime_priority", "must be an integer from 0 (normal scheduling) to 98");
         e.sim.realtime_priority = p.get<int>();
+      }
+      if (s.contains("host_timeout_ms")) {
+        const json& h = s["host_timeout_ms"];
+        if (!h.is_number() || !(h.get<double>() >= 0) || h.get<double>() > 60000)
+          fail(where + ".simulate.host_timeout_ms", "must be a number of milliseconds from 0 (no host watchdog) to 60000");
+        e.sim.host_timeout_ms = h.get<double>();
       }
       r.erase("simulate");
     }  // driver fields are checked by make_rig when the daemon creates the rigs, before anything runs

@@ -38,7 +38,7 @@ class DaemonControl final : public control::DaemonInterface {
             live.campaign.load(), live.run.load(), live.sample_rate_hz.load()};
   }
   std::size_t rig_index(const std::string& name) const override { return d_.rig_index(name); }
-  void rig_command(std::size_t k, control::RigCommand c) override { d_.rig_command(k, c); }
+  control::CommandOutcome rig_command(std::size_t k, control::RigCommand c) override { return d_.rig_command(k, c); }
 
   std::uint64_t live_head(std::size_t k) const noexcept override { return k < d_.rig_count() ? d_.rig_live(k).ring.head() : 0; }
   std::uint64_t read_live(std::size_t k, std::uint64_t from, std::size_t stride, std::vector<control::LiveSample>& out,
@@ -55,7 +55,7 @@ class DaemonControl final : public control::DaemonInterface {
     if (p.kind != db::CampaignKind::fot) return std::nullopt;
     return control::FotGrid{p.lo_mm, p.hi_mm, p.subdivisions, p.nodes_mm};
   }
-  void command(std::int64_t campaign, control::CampaignCommand c) override { d_.command(campaign, c); }
+  control::CommandOutcome command(std::int64_t campaign, control::CampaignCommand c) override { return d_.command(campaign, c); }
 
   control::WriterCounters writer() const override {
     const db::WriterStats w = d_.writer_stats();

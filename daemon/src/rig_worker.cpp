@@ -70,7 +70,12 @@ std::optional<T> pop_locked(std::mutex& mu, std::deque<T>& q) {
 
 void RigWorker::push_job(CampaignJob job) { push_locked(mu_, cv_, jobs_, std::move(job)); }
 void RigWorker::push_control(Control c) { push_locked(mu_, cv_, controls_, c); }
-void RigWorker::push_rig_command(RigCommand c) { push_locked(mu_, cv_, rig_commands_, c); }
+std::future<CommandOutcome> RigWorker::push_rig_command(RigCommand c) {
+  PendingCommand p{c, std::make_shared<std::promise<CommandOutcome>>(), mono_now()};
+  auto fut = p.answer->get_future();
+  push_locked(mu_, cv_, rig_commands_, std::move(p));
+  return fut;
+}
 bool RigWorker::cancel_queued(std::int64_t id) {
   std::lock_guard lk(mu_);
   for (auto it = jobs_.begin(); it != jobs_.end(); ++it)
@@ -96,7 +101,75 @@ std::optional<CampaignJob> RigWorker::pop_job() {
   return j;
 }
 std::optional<Control> RigWorker::pop_control() { return pop_locked(mu_, controls_); }
-std::optional<RigCommand> RigWorker::pop_rig_command() { return pop_locked(mu_, rig_commands_); }
+
+void RigWorker::answer(const PendingCommand& c, CommandOutcome::Result r, const std::string& reason) {
+  CommandOutcome o;
+  o.result = r;
+  o.latched = supervisor->latched();
+  o.confirmed = r == CommandOutcome::Result::done;
+  o.state = std::string(to_string(supervisor->state()));
+  o.reason = reason;
+  o.waited_s = mono_now() - c.asked_mono;
+  try {
+    c.answer->set_value(std::move(o));
+  } catch (const std::future_error&) {  // answered already
+  }
+}
+
+// An e-stop is written at once from any state; a reset applies only to a latched rig (while a
+// campaign moves the rig nothing is latched, and the controller's reset is not written then).
+void RigWorker::carry_out(PendingCommand c, double t) {
+  using R = CommandOutcome::Result;
+  Supervisor& sup = *supervisor;
+  if (c.command == RigCommand::estop) {
+    if (const std::error_code ec = sup.estop(t, "e-stop by the operator")) {
+      answer(c, R::unreachable, "the rig did not take the e-stop (" + ec.message() +
+                                    "): latched here, nothing arms, and the e-stop is written again the moment the rig answers");
+      return;
+    }
+    waiting_.push_back(std::move(c));
+    return;
+  }
+  if (!sup.latched()) {
+    answer(c, R::conflict, "the rig is " + std::string(to_string(sup.state())) + ", not latched: there is nothing to reset");
+    return;
+  }
+  sup.begin_reset(t);
+  if (!sup.resetting()) return answer(c, R::unreachable, sup.reset_refusal());
+  waiting_.push_back(std::move(c));
+}
+
+bool RigWorker::settled(const PendingCommand& c) {
+  using R = CommandOutcome::Result;
+  const Supervisor& sup = *supervisor;
+  if (c.command == RigCommand::estop) {
+    if (sup.state() != RigState::estopped) return answer(c, R::done, "latched, then reset"), true;
+    if (!sup.estop_confirmed()) return false;
+    answer(c, R::done, "latched: the rig reports its e-stop");
+    return true;
+  }
+  if (sup.resetting()) return false;
+  if (!sup.latched()) return answer(c, R::done, "reset: the rig reports ready"), true;
+  answer(c, R::refused, sup.reset_refusal().empty() ? "the rig is still latched" : sup.reset_refusal());
+  return true;
+}
+
+void RigWorker::service(double t) {
+  std::erase_if(waiting_, [this](const PendingCommand& c) { return settled(c); });
+  for (;;) {
+    std::optional<PendingCommand> c = pop_locked(mu_, rig_commands_);
+    if (!c) break;
+    carry_out(std::move(*c), t);
+  }
+  // An answer nobody confirms (a rig that takes writes and never reports): the asker has long
+  // had its bounded wait; the entry is dropped so that waiting_ stays bounded.
+  const double now = mono_now();
+  std::erase_if(waiting_, [&](const PendingCommand& c) {
+    if (now - c.asked_mono < 30.0) return false;
+    answer(c, CommandOutcome::Result::pending, "not confirmed by the rig within 30 s");
+    return true;
+  });
+}
 void RigWorker::wait(double seconds) {
   std::unique_lock lk(mu_);
   cv_.wait_for(lk, std::chrono::duration<double>(seconds), [this] { return !jobs_.empty() || !rig_commands_.empty(); });
@@ -149,6 +222,7 @@ void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std:
   ctx.stop = &stop;
   ctx.now_iso = now_iso;
   ctx.next_control = [&w] { return w.pop_control(); };
+  ctx.service = [&w](double t) { w.service(t); };
   ctx.live = &w.live;
   ctx.finish = finish;
   ctx.epoch = epoch;
@@ -160,11 +234,6 @@ void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std:
   w.live.campaign = 0;
   spdlog::info("rig '{}': campaign {} ended {} ({} samples, {} missed deadlines, {} late wake-ups, {} gaps, {} dropped){}{}", w.entry.name,
                id, to_string(r.end), r.samples, r.missed_deadlines, r.late_wakeups, r.gaps, r.dropped, r.reason.empty() ? "" : ": ", r.reason);
-}
-
-void rig_command(RigWorker& w, RigCommand c, double t) {
-  if (c == RigCommand::estop) w.supervisor->estop(t, "e-stop by the operator");
-  else w.supervisor->begin_reset(t);
 }
 
 constexpr int kIdleMissesForLinkLoss = 3;  // 150 ms of 50 ms idle ticks, plus the read timeouts
@@ -225,7 +294,7 @@ void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void
   (void)w.rig->connect(0.0);
   while (!stop) {
     try {
-      while (auto c = w.pop_rig_command()) rig_command(w, *c, rig_time());
+      w.service(rig_time());
       if (auto job = w.pop_job()) {
         run_job(w, std::move(*job), writer, finish, stop, t0);
         w.idle_misses = 0;
@@ -233,6 +302,7 @@ void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void
         continue;
       }
       idle_tick(w, rig_time(), base);
+      w.service(rig_time());  // what this read confirmed is answered now, not a wait later
       w.wait(0.05);
     } catch (const std::exception& e) {
       contain(w, writer, e.what(), rig_time());

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -38,10 +39,12 @@ struct RigWorker {
   int idle_misses = 0;  // failed idle reads in a row (the acquisition thread's)
 
   void build_rig(const std::string& base);  // throws drivers::RigConfigError
-  // From other threads: a campaign, a campaign control, a rig command. Never blocks on I/O.
+  // From other threads: a campaign, a campaign control, a rig command. Never blocks on I/O. A rig
+  // command's future is set by the acquisition thread once it is carried out, confirmed by the
+  // rig, refused, or found not to apply.
   void push_job(CampaignJob job);
   void push_control(Control c);
-  void push_rig_command(RigCommand c);
+  std::future<CommandOutcome> push_rig_command(RigCommand c);
   // Takes a queued (not yet started) campaign out of the queue; false when it is not there.
   bool cancel_queued(std::int64_t campaign);
   [[nodiscard]] bool has_queued(std::int64_t campaign);
@@ -50,7 +53,10 @@ struct RigWorker {
   // The acquisition thread's side.
   std::optional<CampaignJob> pop_job();
   std::optional<Control> pop_control();
-  std::optional<RigCommand> pop_rig_command();
+  // The stop channel: the rig's commands taken and carried out, and those taken earlier settled
+  // against what the rig now reports. Called on every period in every phase (idle, arming, every
+  // tick of a campaign whatever it is doing), so that nothing waits behind a campaign.
+  void service(double t);
   void wait(double seconds);
   void record(const RigTransition& t);  // the supervisor's transitions, for the API and the log
   void update_snapshot(const StatusView& v, double x, double f, bool have_sample);
@@ -60,8 +66,17 @@ struct RigWorker {
   std::condition_variable cv_;
   std::deque<CampaignJob> jobs_;
   std::deque<Control> controls_;
-  std::deque<RigCommand> rig_commands_;
+  struct PendingCommand {
+    RigCommand command{};
+    std::shared_ptr<std::promise<CommandOutcome>> answer;
+    double asked_mono = 0;  // host seconds when it was asked
+  };
+  std::deque<PendingCommand> rig_commands_;
+  std::vector<PendingCommand> waiting_;  // taken, awaiting the rig's confirmation (acquisition thread only)
   RigSupervision snap_;
+  void carry_out(PendingCommand c, double t);
+  bool settled(const PendingCommand& c);  // answered (and to be dropped)
+  void answer(const PendingCommand& c, CommandOutcome::Result r, const std::string& reason);
 };
 
 // The rig's acquisition thread: operator commands first, then queued campaigns in order; between

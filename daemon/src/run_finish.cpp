@@ -170,17 +170,37 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   end.state = state_of(r.end);
   end.reason = (r.reason.empty() ? std::string("finished") : r.reason) + note;
   end.now = now;
-  // Retried: a busy database delays the end of a campaign, it never loses it.
+  // Retried: a busy database delays the end of a campaign, it never loses it. An end the database
+  // refuses outright (a constraint, a full disk) is retried a few times, then the campaign is
+  // failed with that reason, without its tables: its samples stay, and it is never left 'queued'
+  // or 'running' (stop 25's resumes stayed queued for ever when the tables had no run).
+  std::string refused;
   for (int attempt = 0; attempt < 30; ++attempt) {
-    auto ids = writer.call<std::vector<std::int64_t>>([&end](db::Store& s) { return s.finish_run(end); }, 10.0);
+    auto ids = writer.call<std::vector<std::int64_t>>([&end, &refused](db::Store& s) {
+      try {
+        return s.finish_run(end);
+      } catch (const std::exception& e) {
+        refused = e.what();
+        throw;
+      }
+    }, 10.0);
     if (ids) {
       if (ids->size() > 0) r.table_id = (*ids)[0];
       if (ids->size() > 1) r.lsq_table_id = (*ids)[1];
       r.reason = end.reason == "finished" ? "" : end.reason;
       return r;
     }
+    if (!refused.empty() && attempt >= 2) break;
   }
-  r.reason = end.reason + "; the database did not take the end of the campaign";
+  r.end = CampaignEnd::failed;
+  r.reason = end.reason + "; the database did not take the end of the campaign" + (refused.empty() ? std::string() : " (" + refused + ")");
+  const std::string reason = r.reason;
+  const auto id = j.campaign;
+  const auto last = writer.call<int>([id, reason, now](db::Store& s) {
+    s.transition(id, db::CampaignState::failed, reason, now);
+    return 0;
+  }, 10.0);
+  if (!last) r.reason += "; nor its failure";
   return r;
 }
 

@@ -52,6 +52,7 @@ int SimChild::ensure_running() {
   std::vector<std::string> args{exe, "--port", "0", "--time-scale", scale, "--noise", noise, "--corner-width", corner, "--exit-with-parent", "1", "--rig", opt_.rig};
   // --realtime only when configured: at a large time scale the physics catch-up is real work, and
   // at SCHED_FIFO it starved the daemon's other threads (a campaign stalled in a sanitizer build).
+  if (opt_.host_timeout_ms > 0) args.insert(args.end(), {"--host-timeout-ms", std::to_string(opt_.host_timeout_ms)});
   if (opt_.realtime_priority > 0) args.insert(args.end(), {"--realtime", std::to_string(opt_.realtime_priority)});
   if (opt_.shakedown_extra_N > 0)
     args.insert(args.end(), {"--shakedown", std::to_string(opt_.shakedown_extra_N) + "," + std::to_string(opt_.shakedown_tau_cycles)});

@@ -130,6 +130,7 @@ std::optional<std::string> Supervisor::check_bits(double now, const StatusView& 
 std::optional<std::string> Supervisor::on_status(double now, const StatusView& v) {
   now += offset_;
   if (reassert_pending_) reassert(now);
+  if (state_ == RigState::estopped && (v.status & st::estop)) estop_confirmed_ = true;
   if (state_ == RigState::disconnected) return std::nullopt;  // not yet re-asserted: nothing else
   if (resetting_) {
     reset_step(now, v);
@@ -235,12 +236,16 @@ void Supervisor::disarm_at(double now, const std::string& reason) {
   if (state_ != RigState::disconnected) go(now, RigState::idle, reason);
 }
 
-void Supervisor::estop(double now, const std::string& reason) {
+std::error_code Supervisor::estop(double now, const std::string& reason) {
   now += offset_;
-  if (rig_->estop(true)) reassert_pending_ = true;  // re-sent the moment the rig answers
+  estop_confirmed_ = false;
+  intended_ = RigState::estopped;
+  const std::error_code ec = rig_->estop(true);
+  if (ec) reassert_pending_ = true;  // re-sent the moment the rig answers
   (void)write_hold();
-  if (state_ == RigState::estopped) return;
+  if (state_ == RigState::estopped) return ec;
   latch(now, RigState::estopped, reason, 0);
+  return ec;
 }
 
 void Supervisor::begin_reset(double now) {

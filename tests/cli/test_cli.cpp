@@ -444,8 +444,8 @@ TEST_CASE("cli: submit, preview and the commands go to the running hystlabd over
   const Result running = run_until(w, "campaign show 1 --db " + d.db_path(), [](const Result& r) { return r.out.find(", running") != std::string::npos; }, 60);
   CAPTURE(running.out);
   REQUIRE(running.out.find(", running") != std::string::npos);
-  CHECK(w.run("campaign pause 1" + auth).out.find("pause sent to campaign 1") != std::string::npos);
-  CHECK(w.run("campaign abort 1" + auth).out.find("abort sent to campaign 1") != std::string::npos);
+  CHECK(w.run("campaign pause 1" + auth).out.find("pause sent: campaign 1 (running: taken by the running campaign)") != std::string::npos);
+  CHECK(w.run("campaign abort 1" + auth).out.find("abort sent: campaign 1") != std::string::npos);
   const Result aborted = run_until(w, "campaign show 1 --db " + d.db_path(), [](const Result& r) { return r.out.find(", aborted") != std::string::npos; }, 60);
   CAPTURE(aborted.out);
   REQUIRE(aborted.out.find(", aborted") != std::string::npos);
@@ -455,7 +455,7 @@ TEST_CASE("cli: submit, preview and the commands go to the running hystlabd over
   // The rig's e-stop latches in the daemon: a submission is refused until the operator's reset.
   const Result estop = w.run("rig estop 'sim frame'" + auth);
   CAPTURE(estop.err);
-  CHECK(estop.out.find("estop sent to rig 'sim frame' (estopped)") != std::string::npos);  // latched before the answer
+  CHECK(estop.out.find("estop done: rig 'sim frame' is estopped (latched: the rig reports its e-stop)") != std::string::npos);  // confirmed before the answer
   check_error(w.run("campaign submit --plan plan.json" + auth), "reset it first");  // at once, never a moment later
   CHECK(w.run("rig reset 'sim frame'" + auth).code == 0);
   const Result again = run_until(w, "campaign submit --plan plan.json" + auth, [](const Result& r) { return r.code == 0; }, 30);

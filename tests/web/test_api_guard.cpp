@@ -88,11 +88,15 @@ TEST_CASE("commands need no body: the documented curl -X POST works, and an unkn
   CHECK(status_line(raw) == "HTTP/1.1 202 Accepted");
   CHECK(live.wait_json("/api/campaigns/" + id, [](const json& j) { return j["state"] == "aborted"; }, 30));
   // The rig's e-stop and reset the same way.
+  // The e-stop answers once latched and seen in the rig's status word; the reset once the rig
+  // reports ready again.
   raw = test::raw_request(port, request("POST", "/api/rigs/sim%20frame/estop", ""));
-  CHECK(status_line(raw) == "HTTP/1.1 202 Accepted");
+  CHECK(status_line(raw) == "HTTP/1.1 200 OK");
+  CHECK(error_of(raw)["latched"] == true);
+  CHECK(error_of(raw)["confirmed"] == true);
   CHECK(live.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["latched"] == true; }, 30));
   raw = test::raw_request(port, request("POST", "/api/rigs/sim%20frame/reset", ""));
-  CHECK(status_line(raw) == "HTTP/1.1 202 Accepted");
+  CHECK(status_line(raw) == "HTTP/1.1 200 OK");
   CHECK(live.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["latched"] == false; }, 30));
 }
 

@@ -37,7 +37,10 @@ class FakeDaemon final : public control::DaemonInterface {
     if (!name.empty() && name != "fake frame") throw std::invalid_argument("rig: no rig named '" + name + "'");
     return 0;
   }
-  void rig_command(std::size_t, control::RigCommand c) override { estopped = c == control::RigCommand::estop; }
+  control::CommandOutcome rig_command(std::size_t, control::RigCommand c) override {
+    estopped = c == control::RigCommand::estop;
+    return {control::CommandOutcome::Result::done, estopped, true, estopped ? "estopped" : "idle", "", 0.0};
+  }
   std::uint64_t live_head(std::size_t) const noexcept override { return 3; }
   std::uint64_t read_live(std::size_t, std::uint64_t from, std::size_t, std::vector<control::LiveSample>& out, std::uint64_t*) const override {
     for (std::uint64_t i = from; i < 3; ++i) out.push_back({0, static_cast<double>(i), 1, 2.5, 42.0, 0, 5});
@@ -50,9 +53,10 @@ class FakeDaemon final : public control::DaemonInterface {
   }
   control::PlanPreview preview(const std::string&, const nlohmann::json&, models::HysteresisModel*) const override { return {}; }
   std::optional<control::FotGrid> fot_grid(const nlohmann::json&) const override { return control::FotGrid{0, 4, 2, {}}; }
-  void command(std::int64_t campaign, control::CampaignCommand c) override {
+  control::CommandOutcome command(std::int64_t campaign, control::CampaignCommand c) override {
     std::lock_guard lk(mu);
     commands.emplace_back(campaign, c);
+    return {control::CommandOutcome::Result::done, false, false, "running", "", 0.0};
   }
   control::WriterCounters writer() const override { return {99, 0, 0, 1}; }
   double uptime_s() const noexcept override { return 12.5; }
@@ -95,7 +99,8 @@ TEST_CASE("the web layer runs on the daemon's interface alone: snapshots, comman
   SUBCASE("e-stop reaches the interface, and the panel shows the latch") {
     auto r = c.Post("/api/rigs/fake%20frame/estop", "", "application/json");
     REQUIRE(r);
-    CHECK(r->status == 202);
+    CHECK(r->status == 200);
+    CHECK(json::parse(r->body)["result"] == "done");
     CHECK(fake.estopped);
     CHECK(json::parse(c.Get("/api/rigs/fake%20frame")->body)["latched"] == true);
   }
@@ -112,7 +117,7 @@ TEST_CASE("the web layer runs on the daemon's interface alone: snapshots, comman
     httplib::Headers none;
     auto a = c.Post("/api/campaigns/" + std::to_string(id) + "/abort", none, "", "");
     REQUIRE(a);
-    CHECK(a->status == 202);
+    CHECK(a->status == 200);  // the fake says done
     auto bad = c.Post("/api/campaigns/" + std::to_string(id) + "/abort_all", none, "", "");
     REQUIRE(bad);
     CHECK(bad->status == 404);
@@ -153,7 +158,7 @@ TEST_CASE("the commands a campaign's state admits are those the daemon carries o
   CHECK(control::commands_for(S::running) == std::vector<C>{C::pause, C::abort, C::estop});
   CHECK(control::commands_for(S::paused) == std::vector<C>{C::resume, C::abort, C::estop});
   CHECK(control::commands_for(S::held) == std::vector<C>{C::resume, C::abort, C::estop});
-  CHECK(control::commands_for(S::interrupted) == std::vector<C>{C::resume});
+  CHECK(control::commands_for(S::interrupted) == std::vector<C>{C::resume, C::abort, C::estop});
   for (const S s : {S::completed, S::aborted, S::failed}) CHECK(control::commands_for(s).empty());
   for (const S s : db::kCampaignStates) {
     CAPTURE(db::to_string(s));

@@ -29,7 +29,9 @@ TEST_CASE("operator e-stop from the API latches the rig; a campaign is refused u
   REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle"; }));
   auto r = c.Post("/api/rigs/sim%20frame/estop", "", "application/json");
   REQUIRE(r);
-  CHECK(r->status == 202);
+  CHECK(r->status == 200);  // answered once latched and confirmed by the rig, never before
+  CHECK(json::parse(r->body)["latched"] == true);
+  CHECK(json::parse(r->body)["state"] == "estopped");
   REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "estopped" && j["latched"] == true; }, 10));
   const auto refused = c.Post("/api/campaigns", json{{"plan", waveform({0, 1})}}.dump(), "application/json");
   REQUIRE(refused);
@@ -37,7 +39,13 @@ TEST_CASE("operator e-stop from the API latches the rig; a campaign is refused u
   CHECK(refused->body.find("reset it first") != std::string::npos);
   r = c.Post("/api/rigs/sim%20frame/reset", "", "application/json");
   REQUIRE(r);
-  CHECK(r->status == 202);
+  CAPTURE(r->body);
+  CHECK(r->status == 200);
+  // A second reset finds nothing to reset: 409 with the reason.
+  const auto again = c.Post("/api/rigs/sim%20frame/reset", "", "application/json");
+  REQUIRE(again);
+  CHECK(again->status == 409);
+  CHECK(again->body.find("nothing to reset") != std::string::npos);
   REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle" && j["latched"] == false; }, 10));
   const auto id = submit(c, waveform({0, 1.0, 0.5}));
   CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "completed"; }));

@@ -24,6 +24,22 @@ void send_error(httplib::Response& res, int status, const std::string& error, co
   send_json(res, body, status);
 }
 
+void send_outcome(httplib::Response& res, json head, const control::CommandOutcome& o) {
+  using R = control::CommandOutcome::Result;
+  head["result"] = control::to_string(o.result);
+  head["accepted"] = o.result == R::done || o.result == R::pending;
+  head["latched"] = o.latched;
+  head["confirmed"] = o.confirmed;
+  head["state"] = o.state;
+  head["reason"] = o.reason;
+  head["waited_ms"] = std::round(o.waited_s * 1e4) / 10;
+  int status = 200;
+  if (o.result == R::pending) status = 202;
+  if (o.result == R::conflict || o.result == R::refused) status = 409, head["error"] = "conflict", head["detail"] = o.reason;
+  if (o.result == R::unreachable) status = 503, head["error"] = "rig unreachable", head["detail"] = o.reason;
+  send_json(res, head, status);
+}
+
 namespace {
 // "rig: no rig named 'x'" names its field before the colon ("rig", "plan.kind").
 std::string field_of(const std::string& text) {

@@ -26,6 +26,10 @@ using nlohmann::json;
 void send_json(httplib::Response& res, const json& body, int status = 200);
 // field: the request's field at fault ("plan.ramp_rate_mm_s"), for a form to mark; empty: none.
 void send_error(httplib::Response& res, int status, const std::string& error, const std::string& detail, const std::string& field = {});
+// An operator command's answer: 200 done, 202 pending (taken, not yet confirmed), 409 conflict or
+// refused (with the reason), 503 unreachable (an e-stop is latched here all the same). The body
+// carries the outcome whatever the status, with error and detail when it is not 2xx.
+void send_outcome(httplib::Response& res, nlohmann::json head, const control::CommandOutcome& o);
 
 // Wraps a handler: every exception becomes one JSON error (400 for bad input, 500 otherwise).
 httplib::Server::Handler guarded(std::function<void(const httplib::Request&, httplib::Response&)> f);

@@ -1,4 +1,5 @@
 // Campaigns: submit, list, get, commands; their events, FOT nodes (coverage) and runs.
+#include <algorithm>
 #include <set>
 
 #include "hystlab/models/grid.hpp"
@@ -128,10 +129,14 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
     if (!cmd) throw ApiError(404, "not found", "no command '" + verb + "' for a campaign (pause, resume, abort, estop)");
     auto& store = reader(c.db_path);
     const auto row = campaign_or_404(store, path_id(req));
-    if (db::is_final(row.state))
-      throw ApiError(409, "conflict", "campaign " + std::to_string(row.id) + " is " + db::to_string(row.state) + ": '" + verb + "' does not apply");
-    c.daemon.command(row.id, *cmd);
-    send_json(res, json{{"campaign", row.id}, {"command", verb}, {"accepted", true}, {"state", db::to_string(row.state)}}, 202);
+    const auto applies = control::commands_for(row.state);
+    if (std::find(applies.begin(), applies.end(), *cmd) == applies.end()) {
+      std::string which;
+      for (const auto a : applies) which += std::string(which.empty() ? "" : ", ") + control::to_string(a);
+      throw ApiError(409, "conflict", "campaign " + std::to_string(row.id) + " is " + db::to_string(row.state) + ": '" + verb + "' does not apply" +
+                                          (which.empty() ? std::string() : " (" + which + " do)"));
+    }
+    send_outcome(res, json{{"campaign", row.id}, {"command", verb}}, c.daemon.command(row.id, *cmd));
   }));
   s.Get(R"(/api/campaigns/(\d+)/events)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);

@@ -198,8 +198,8 @@ void add_status_routes(httplib::Server& s, ApiContext& c) {
   post_route(s, c, R"(/api/rigs/([^/]+)/(reset|estop))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     const std::size_t k = rig_of(c, req.matches[1].str());
     const std::string verb = req.matches[2].str();
-    c.daemon.rig_command(k, verb == "reset" ? control::RigCommand::reset : control::RigCommand::estop);
-    send_json(res, json{{"rig", c.daemon.rig_info(k).name}, {"command", verb}, {"accepted", true}, {"state", c.daemon.rig_supervision(k).state}}, 202);
+    const control::CommandOutcome o = c.daemon.rig_command(k, verb == "reset" ? control::RigCommand::reset : control::RigCommand::estop);
+    send_outcome(res, json{{"rig", c.daemon.rig_info(k).name}, {"command", verb}}, o);
   }));
   s.Get("/metrics", guarded([&c](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics_text(c), "text/plain; version=0.0.4");

@@ -24,8 +24,23 @@ std::vector<CampaignCommand> commands_for(db::CampaignState s) {
   std::vector<CampaignCommand> out;
   if (s == S::running) out.push_back(CampaignCommand::pause);
   if (s == S::paused || s == S::interrupted || s == S::held) out.push_back(CampaignCommand::resume);
-  if (s != S::interrupted) out.push_back(CampaignCommand::abort), out.push_back(CampaignCommand::estop);
+  // An interrupted campaign can be ended too (it was answered 202 and then ignored): abort ends
+  // it where it is; e-stop also latches its rig.
+  out.push_back(CampaignCommand::abort);
+  out.push_back(CampaignCommand::estop);
   return out;
+}
+
+const char* to_string(CommandOutcome::Result r) noexcept {
+  using R = CommandOutcome::Result;
+  switch (r) {
+    case R::done: return "done";
+    case R::pending: return "pending";
+    case R::conflict: return "conflict";
+    case R::unreachable: return "unreachable";
+    case R::refused: return "refused";
+  }
+  return "?";
 }
 
 }  // namespace hystlab::control

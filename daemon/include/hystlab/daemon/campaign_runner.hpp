@@ -51,6 +51,10 @@ struct CampaignJob {
   std::shared_ptr<const IsolatorModel> isolator;  // a shaker's, when the daemon has a model of it (sine)
   std::vector<models::FotNode> prior_nodes;
   RunSeries prior_series;
+  // A resumed campaign's last run and validation run: the tables of a resume with nothing left to
+  // drive belong to them (the tables' run must exist), and the validation run's samples score them.
+  std::int64_t prior_run = 0, prior_validation_run = 0;
+  RunSeries prior_validation;
 };
 
 struct RunnerResult {
@@ -92,6 +96,10 @@ struct RunnerContext {
   Clock& clock;
   double time_scale = 1.0;  // rig seconds per wall second (a time-scaled simulator)
   std::function<std::optional<Control>()> next_control = [] { return std::nullopt; };
+  // The rig's stop channel (the operator's e-stop and reset, rig_worker.hpp), serviced at the top
+  // of every period in every phase (arming, running, paused, safing); a latch it leaves ends the
+  // campaign at once. Empty: none (tests of the loop alone).
+  std::function<void(double)> service;
   const std::atomic<bool>* stop = nullptr;  // the daemon is shutting down: hold, interrupted
   double resume_preamble_after_s = 2.0;     // rig seconds of pause after which memory is re-wiped
   int watchdog_hold_periods = 20, watchdog_fail_periods = 500;

@@ -41,6 +41,10 @@ struct SimulatorOptions {
   // An untrained specimen (load frame): the upper plateau starts extra_N higher and settles over
   // tau transformation cycles (hystlab-sim --shakedown); extra_N 0: a trained one.
   double shakedown_extra_N = 0, shakedown_tau_cycles = 0;
+  // The controller's host watchdog: with the drive on, no change of host_heartbeat for this many
+  // wall-clock ms stops the frame with fault 4, as a real controller does when its host is gone.
+  // The daemon writes it every 0.1 s in every state; 1 s leaves room for a frozen shared machine.
+  double host_timeout_ms = 1000;
   int cpu = -1;                     // pinned there when >= 0 (the daemon sets its acquisition CPU)
   int realtime_priority = -1;       // > 0: SCHED_FIFO, as a controller with a CPU of its own; 0: normal;
                                     // -1: one below the acquisition's when that is pinned and
@@ -77,6 +81,7 @@ struct DaemonConfig {
 void check_http_security(HttpConfig& http, const char* env_token);
 
 using control::CampaignCommand;
+using control::CommandOutcome;
 using control::RigCommand;
 using control::RigInfo;
 using control::RigSupervision;
@@ -113,10 +118,12 @@ class Daemon {
   // What submit checks, without queuing: the plan parsed, for the rig (its index) it would run on.
   [[nodiscard]] std::pair<Plan, std::size_t> check_plan(const std::string& rig_name, const nlohmann::json& plan) const;
   // A running campaign's command goes straight to its rig's thread (never through the database,
-  // which may be busy); a queued or held one's through the main loop.
-  void command(std::int64_t campaign_id, CampaignCommand c);
-  // reset or estop a rig: straight to its thread, from any state.
-  void rig_command(std::size_t rig, RigCommand c);
+  // which may be busy); a queued or held one's through the main loop. An e-stop latches the
+  // campaign's rig first (as rig_command), whatever the campaign's state.
+  CommandOutcome command(std::int64_t campaign_id, CampaignCommand c);
+  // reset or estop a rig: straight to its thread, read there every period in every state; waits
+  // (at most wait_s) for the rig to confirm it, and says what happened.
+  CommandOutcome rig_command(std::size_t rig, RigCommand c, double wait_s = 2.0);
 
  private:
   struct Impl;

@@ -76,8 +76,11 @@ class Supervisor {
   void release(double now, const std::string& reason);  // holding -> armed (the hold released)
   void begin_safing(double now, const std::string& reason);  // -> safing (the safe ramp)
   void disarm(double now, const std::string& reason);  // -> idle: held and disabled, verified
-  // The e-stop, to the rig at once from any state; latched until reset.
-  void estop(double now, const std::string& reason);
+  // The e-stop, to the rig at once from any state; latched until reset. Returns the write's
+  // result: on an error the latch stands here and the e-stop is re-sent the moment the rig answers.
+  std::error_code estop(double now, const std::string& reason);
+  // The rig's status word has shown its e-stop bit since the last estop() (verified, not assumed).
+  [[nodiscard]] bool estop_confirmed() const noexcept { return estop_confirmed_; }
   // The operator's reset: releases the rig's e-stop and fault signals; the latch clears when the
   // rig then reports ready without e-stop or fault (within reset_timeout_s), else it says why.
   void begin_reset(double now);
@@ -125,6 +128,7 @@ class Supervisor {
   double next_heartbeat_ = 0;
   std::uint32_t heartbeat_count_ = 0;
   std::uint64_t link_losses_ = 0;
+  bool estop_confirmed_ = false;
 };
 
 }  // namespace hystlab::daemon

@@ -27,8 +27,11 @@ class DaemonInterface {
   [[nodiscard]] virtual AcquisitionCounters rig_counters(std::size_t rig) const = 0;
   // The rig by name (empty: the only rig); throws std::invalid_argument naming it.
   [[nodiscard]] virtual std::size_t rig_index(const std::string& name) const = 0;
-  // reset or estop a rig: straight to its thread, from any state.
-  virtual void rig_command(std::size_t rig, RigCommand c) = 0;
+  // reset or estop a rig: straight to its thread, which reads its commands every period in every
+  // state (idle, arming, running, paused, safing, a campaign being finished). Returns once carried
+  // out (an e-stop latched and seen in the rig's status word; a reset confirmed by the rig) or
+  // refused, or after a bounded wait with what is known then (pending).
+  virtual CommandOutcome rig_command(std::size_t rig, RigCommand c) = 0;
 
   // Live samples: indices count every sample the rig's thread published. live_head is one past
   // the newest; read_live appends samples [from, head) taking every stride-th, skips (and counts
@@ -45,7 +48,9 @@ class DaemonInterface {
   [[nodiscard]] virtual PlanPreview preview(const std::string& rig, const nlohmann::json& plan, models::HysteresisModel* model) const = 0;
   // A stored FOT plan's grid (nullopt for other kinds); throws PlanError for a plan it cannot read.
   [[nodiscard]] virtual std::optional<FotGrid> fot_grid(const nlohmann::json& stored_plan) const = 0;
-  virtual void command(std::int64_t campaign, CampaignCommand c) = 0;
+  // A campaign's command. conflict when it does not apply to the campaign's state (the reason
+  // says why); an e-stop latches the campaign's rig as rig_command does, then ends the campaign.
+  virtual CommandOutcome command(std::int64_t campaign, CampaignCommand c) = 0;
 
   [[nodiscard]] virtual WriterCounters writer() const = 0;
   [[nodiscard]] virtual double uptime_s() const noexcept = 0;

@@ -32,6 +32,24 @@ struct RigInfo {
 // Operator commands for a rig itself, whatever campaign runs (or none).
 enum class RigCommand { reset, estop };
 
+// What became of an operator's command, as its answer says it (rig and campaign commands).
+struct CommandOutcome {
+  enum class Result {
+    done,         // carried out (an e-stop: latched; a reset: the rig reports ready again)
+    pending,      // taken, not yet confirmed within the answer's wait (reason says what is awaited)
+    conflict,     // does not apply in this state (reason says why): nothing was done
+    unreachable,  // the rig did not take the write (an e-stop stays latched here and is re-sent)
+    refused,      // the rig refused it (a reset while the cause is present)
+  };
+  Result result = Result::done;
+  bool latched = false;    // the rig's supervision is latched (e-stop or fault) after the command
+  bool confirmed = false;  // the rig's status word shows it (the e-stop bit; ready and clear)
+  std::string state;       // the rig's supervision state (rig commands) or the campaign's
+  std::string reason;
+  double waited_s = 0;     // from the request to the answer
+};
+[[nodiscard]] const char* to_string(CommandOutcome::Result r) noexcept;
+
 // Operator commands for a campaign. Text only at the edges (JSON, the database's commands).
 enum class CampaignCommand { pause, resume, abort, estop };
 [[nodiscard]] const char* to_string(CampaignCommand c) noexcept;
