@@ -24,6 +24,26 @@ db::CampaignState state_of(CampaignEnd e) noexcept {
 
 const char* to_string(CampaignEnd e) noexcept { return db::to_string(state_of(e)); }
 
+const char* to_string(CampaignPhase p) noexcept {
+  using P = CampaignPhase;
+  switch (p) {
+    case P::none: return "none";
+    case P::arming: return "arming";
+    case P::preamble: return "preamble";
+    case P::training: return "training";
+    case P::ramping: return "ramping";
+    case P::dwelling: return "dwelling";
+    case P::retake: return "retake";
+    case P::validation: return "validation";
+    case P::paused: return "paused";
+    case P::held: return "held";
+    case P::safing: return "safing";
+    case P::shaker_control: return "shaker_control";
+    case P::shaker_measure: return "shaker_measure";
+  }
+  return "?";
+}
+
 Loop::Loop(const CampaignJob& j, RunnerContext& c)
     : job(j), plan(j.plan), ctx(c), shaker(j.plan.kind == db::CampaignKind::sine), safety(j.plan.limits),
       watchdog(c.watchdog_hold_periods, c.watchdog_fail_periods), health0(c.rig.health()) {}
@@ -141,11 +161,14 @@ bool arm(Loop& L) {
     c.clock.sleep_until(next);
     const double t = L.rig_time();
     if (c.stop && c.stop->load()) return L.end(CampaignEnd::interrupted, "the daemon is stopping"), c.supervisor.disarm(t, "stopping"), false;
+    L.show_phase(CampaignPhase::arming);
     const bool was_latched = c.supervisor.latched();  // a latch from before fails the handshake below, named
     if (c.service) c.service(t);
     if (!was_latched && c.supervisor.latched()) return L.end(CampaignEnd::aborted, c.supervisor.latch_reason() + " while arming"), false;
     c.supervisor.heartbeat(c.clock.now());
-    if (const auto ctl = c.next_control(); ctl && (*ctl == Control::abort || *ctl == Control::estop)) {
+    const auto ctl = c.next_control();
+    if (ctl && (*ctl == Control::pause || *ctl == Control::resume)) L.pause_pending = *ctl == Control::pause;  // applied once armed
+    if (ctl && (*ctl == Control::abort || *ctl == Control::estop)) {
       if (*ctl == Control::estop) c.supervisor.estop(t, "e-stop by the operator");
       else c.supervisor.disarm(t, "aborted while arming");
       return L.end(CampaignEnd::aborted, *ctl == Control::estop ? "e-stop by the operator" : "aborted by the operator while arming"), false;
@@ -183,6 +206,14 @@ bool arm(Loop& L) {
   }
 }
 
+void pause_now(Loop& L, Strategy& strategy, double t) {
+  L.ctx.supervisor.hold(t, "paused by the operator");
+  strategy.on_pause(L, t);
+  L.paused = true;
+  L.pause_started = t;
+  L.state(db::CampaignState::paused, "operator");
+}
+
 // The rig's latch ends the campaign at once, whatever it was doing: a safe ramp under way keeps
 // its end (aborted) and says that the e-stop came on top of it.
 bool latched_end(Loop& L) {
@@ -212,11 +243,7 @@ bool handle_control(Loop& L, Strategy& strategy, double t, double x) {
   }
   if (L.safing) return true;  // pause and resume mean nothing on the way to the safe position
   if (*c == Control::pause && !L.paused) {
-    sup.hold(t, "paused by the operator");
-    strategy.on_pause(L, t);
-    L.paused = true;
-    L.pause_started = t;
-    L.state(db::CampaignState::paused, "operator");
+    pause_now(L, strategy, t);
   } else if (*c == Control::resume && L.paused) {
     sup.release(t, "resumed by the operator");
     if (sup.state() != RigState::armed) return true;  // still held (the link): resumed when it answers
@@ -364,6 +391,7 @@ void run_ticks(Loop& L, Strategy& strategy) {
   L.spacing = period * c.time_scale;
   Reader rd;
   double next = c.clock.now(), prev_tick = 0;
+  if (L.pause_pending) pause_now(L, strategy, L.rig_time());  // asked while arming: paused the moment it is armed
   for (;;) {
     next += period;
     c.clock.sleep_until(next);
@@ -384,6 +412,7 @@ void run_ticks(Loop& L, Strategy& strategy) {
       break;
     }
     const double x = rd.block.empty() ? 0.0 : rd.block.back().displacement_mm;
+    L.show_phase(L.safing ? CampaignPhase::safing : L.paused ? CampaignPhase::paused : L.link_held ? CampaignPhase::held : strategy.phase());
     if (!handle_control(L, strategy, t, x)) break;
     const bool going = tick(L, strategy, rd, t, blocks, period);
     if (blocks) {
@@ -479,6 +508,7 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
     L.state(db::CampaignState::running, "armed");
     run_ticks(L, *strategy);
   }
+  L.show_phase(CampaignPhase::none);
   leave_rig(L);
   L.result.dropped = ctx.writer.stats().dropped_full - dropped_before;
   if (L.result.gaps > 0 && L.result.end == CampaignEnd::completed)

@@ -26,6 +26,8 @@ class Strategy {
   // After a pause (long: memory-aware) or a held link: re-issue the command in progress.
   virtual void on_resume(Loop&, double t, bool after_link_loss) = 0;
   [[nodiscard]] virtual bool done() const = 0;
+  // What it is doing (the loop says paused, held and safing itself).
+  [[nodiscard]] virtual CampaignPhase phase() const { return CampaignPhase::ramping; }
   virtual void fill_finish(Loop&, FinishJob&) {}
 };
 
@@ -44,6 +46,7 @@ struct Loop {
   double wall0 = 0;
   std::int64_t next_seq = 0;
   bool paused = false, link_held = false, safing = false;
+  bool pause_pending = false;  // a pause asked while arming
   double pause_started = 0, answered_at = -1e300;
   double safe_deadline = 0, safe_started = 0, safe_stalled = 0;
   // Rig seconds the loop itself was not running (woken kLoopStall_s late or more): deadlines are
@@ -73,6 +76,9 @@ struct Loop {
   // The shaker's drive; false (result set, rig held) when the rig refused it.
   bool command_drive(double t, double f_hz, double amplitude_mm);
   void check_gap(double t);
+  void show_phase(CampaignPhase p) noexcept {
+    if (ctx.live) ctx.live->phase.store(static_cast<std::uint8_t>(p), std::memory_order_relaxed);
+  }
   // A command the rig did not take. A lost answer (timeout, dropped link) holds the rig like a
   // lost read, and the segment is commanded again when the rig answers; true while the campaign
   // goes on. Any other refusal, or kMaxLostCommands in a row, holds and fails it.

@@ -1,5 +1,6 @@
 #include "hystlab/daemon/daemon_control.hpp"
 
+#include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/plan_preview.hpp"
 
 namespace hystlab::daemon {
@@ -35,7 +36,7 @@ class DaemonControl final : public control::DaemonInterface {
   control::AcquisitionCounters rig_counters(std::size_t k) const override {
     const RigLive& live = d_.rig_live(k);
     return {live.samples.load(), live.missed_deadlines.load(), live.late_wakeups.load(),
-            live.campaign.load(), live.run.load(), live.sample_rate_hz.load()};
+            live.campaign.load(), live.run.load(), live.sample_rate_hz.load(), to_string(static_cast<CampaignPhase>(live.phase.load()))};
   }
   std::size_t rig_index(const std::string& name) const override { return d_.rig_index(name); }
   control::CommandOutcome rig_command(std::size_t k, control::RigCommand c) override { return d_.rig_command(k, c); }

@@ -6,7 +6,7 @@
 
 namespace hystlab::daemon {
 
-Finisher::Finisher(db::SampleWriter& writer) : writer_(writer), thread_([this] { run(); }) {}
+Finisher::Finisher(db::SampleWriter& writer, Work work) : writer_(writer), work_(std::move(work)), thread_([this] { run(); }) {}
 
 Finisher::~Finisher() {
   {
@@ -37,7 +37,7 @@ void Finisher::run() {
     }
     const auto id = job.campaign;
     try {
-      const RunnerResult r = finish_campaign(std::move(job), writer_, now_iso);
+      const RunnerResult r = work_ ? work_(std::move(job)) : finish_campaign(std::move(job), writer_, now_iso);
       spdlog::info("campaign {} finished: {}{}{}", id, to_string(r.end), r.reason.empty() ? "" : ": ", r.reason);
     } catch (const std::exception& e) {  // a fit that throws fails the campaign; the thread goes on
       spdlog::error("campaign {}: finishing failed: {}", id, e.what());

@@ -3,6 +3,7 @@
 // the acquisition threads, one job after another. Stopping finishes what was handed over.
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -12,7 +13,9 @@ namespace hystlab::daemon {
 
 class Finisher {
  public:
-  explicit Finisher(db::SampleWriter& writer);
+  using Work = std::function<RunnerResult(FinishJob)>;
+  // work: what finishing a job is (finish_campaign by default; the safety matrix injects a failure).
+  explicit Finisher(db::SampleWriter& writer, Work work = {});
   ~Finisher();  // finishes every job handed over, then stops
   Finisher(const Finisher&) = delete;
   Finisher& operator=(const Finisher&) = delete;
@@ -21,6 +24,7 @@ class Finisher {
  private:
   void run();
   db::SampleWriter& writer_;
+  Work work_;
   std::mutex mu_;
   std::condition_variable cv_;
   std::deque<FinishJob> jobs_;

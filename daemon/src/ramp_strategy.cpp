@@ -40,6 +40,16 @@ class RampStrategy final : public Strategy {
 
   [[nodiscard]] bool has_work() const override { return !(builder_ && builder_->complete()); }
 
+  [[nodiscard]] CampaignPhase phase() const override {
+    const Segment* cur = seq_.current();
+    if (!cur) return CampaignPhase::ramping;
+    if (cur->kind == SegmentKind::preamble) return CampaignPhase::preamble;
+    if (cur->kind == SegmentKind::training) return CampaignPhase::training;
+    if (cur->kind == SegmentKind::validation || validating_) return CampaignPhase::validation;
+    if (rounds_ > 0) return CampaignPhase::retake;
+    return seq_.in_position() ? CampaignPhase::dwelling : CampaignPhase::ramping;
+  }
+
   bool on_frame(Loop& L, const drivers::RigSample& s) override {
     (validating_ ? validation_ : series_).add(s.displacement_mm, s.force_N);
     const std::size_t before = seq_.index();

@@ -238,6 +238,8 @@ void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std:
 
 constexpr int kIdleMissesForLinkLoss = 3;  // 150 ms of 50 ms idle ticks, plus the read timeouts
 
+}  // namespace
+
 // Between campaigns: one supervised read, shown live (run 0); the simulator restarted if it died.
 void idle_tick(RigWorker& w, double t, const std::string& base) {
   if (w.sim && !w.sim->alive()) {
@@ -270,6 +272,12 @@ void idle_tick(RigWorker& w, double t, const std::string& base) {
   w.update_snapshot(v, x, f, !ec);
 }
 
+void idle_step(RigWorker& w, double t, const std::string& base) {
+  w.service(t);
+  idle_tick(w, t, base);
+  w.service(t);  // what this read confirmed is answered now, not a wait later
+}
+
 // An exception escaped a campaign or a tick: hold the rig, fail the campaign, keep the thread.
 void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, double t) {
   spdlog::error("rig '{}': {}: rig held", w.entry.name, what);
@@ -282,8 +290,8 @@ void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, do
     writer.post([id, reason, now](db::Store& s) { s.transition(id, db::CampaignState::failed, reason, now); });
   }
   w.live.campaign = 0;
+  w.live.phase = 0;
 }
-}  // namespace
 
 void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish, const std::atomic<bool>& stop,
                 const std::string& base) {
@@ -301,8 +309,7 @@ void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void
         w.running_campaign = 0;
         continue;
       }
-      idle_tick(w, rig_time(), base);
-      w.service(rig_time());  // what this read confirmed is answered now, not a wait later
+      idle_step(w, rig_time(), base);
       w.wait(0.05);
     } catch (const std::exception& e) {
       contain(w, writer, e.what(), rig_time());

@@ -79,6 +79,14 @@ struct RigWorker {
   void answer(const PendingCommand& c, CommandOutcome::Result r, const std::string& reason);
 };
 
+// One period between campaigns: the stop channel, one supervised read shown live (the simulator
+// restarted if it died), the channel again (what the read confirmed is answered at once).
+void idle_tick(RigWorker& w, double t, const std::string& base);
+void idle_step(RigWorker& w, double t, const std::string& base);
+// The acquisition thread's error boundary: an exception escaped a campaign or a tick. The rig is
+// held (disarmed), the running campaign failed with the reason, and the thread goes on.
+void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, double t);
+
 // The rig's acquisition thread: operator commands first, then queued campaigns in order; between
 // them the rig is sampled every 50 ms (supervised, shown live). Every exception is caught here:
 // the rig is held, the campaign failed with the reason, and the thread goes on.

@@ -4,6 +4,9 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <vector>
+#include <chrono>
+#include <thread>
+#include "hystlab/db/sqlite.hpp"
 
 #include "hystlab/models/accuracy.hpp"
 #include "hystlab/models/fot_identification.hpp"
@@ -175,12 +178,18 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   // failed with that reason, without its tables: its samples stay, and it is never left 'queued'
   // or 'running' (stop 25's resumes stayed queued for ever when the tables had no run).
   std::string refused;
+  bool busy = false;  // SQLITE_BUSY or SQLITE_LOCKED: another connection's lock, retried like a timeout
   for (int attempt = 0; attempt < 30; ++attempt) {
-    auto ids = writer.call<std::vector<std::int64_t>>([&end, &refused](db::Store& s) {
+    auto ids = writer.call<std::vector<std::int64_t>>([&end, &refused, &busy](db::Store& s) {
       try {
         return s.finish_run(end);
+      } catch (const db::DbError& e) {
+        refused = e.what();
+        busy = (e.code & 0xff) == 5 || (e.code & 0xff) == 6;
+        throw;
       } catch (const std::exception& e) {
         refused = e.what();
+        busy = false;
         throw;
       }
     }, 10.0);
@@ -190,7 +199,8 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
       r.reason = end.reason == "finished" ? "" : end.reason;
       return r;
     }
-    if (!refused.empty() && attempt >= 2) break;
+    if (!refused.empty() && !busy && attempt >= 2) break;
+    if (busy) std::this_thread::sleep_for(std::chrono::milliseconds(100 * (attempt + 1)));
   }
   r.end = CampaignEnd::failed;
   r.reason = end.reason + "; the database did not take the end of the campaign" + (refused.empty() ? std::string() : " (" + refused + ")");

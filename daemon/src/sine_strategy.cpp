@@ -51,6 +51,9 @@ class SineStrategy final : public Strategy {
   }
 
   [[nodiscard]] bool done() const override { return pass_ >= passes_.size(); }
+  [[nodiscard]] CampaignPhase phase() const override {
+    return mode_ == Mode::measure || mode_ == Mode::sweep ? CampaignPhase::shaker_measure : CampaignPhase::shaker_control;
+  }
 
   void fill_finish(Loop& L, FinishJob& fj) override {
     fj.isolator = L.job.isolator;

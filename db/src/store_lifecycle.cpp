@@ -2,6 +2,8 @@
 // holding what a restart found queued, the rigs' names and I/O statistics.
 #include "hystlab/db/store.hpp"
 
+#include <algorithm>
+
 namespace hystlab::db {
 void records_changed() noexcept;  // store.cpp
 
@@ -63,7 +65,11 @@ std::vector<std::int64_t> Store::finish_run(const RunEnd& e) {
   }
   if (e.run > 0) end_run(e.run, e.state, e.now);
   if (e.validation_run > 0) {
-    if (sample_count(e.validation_run) > 0) {
+    // A validation run with loop figures is kept even when its samples were lost (a full writer
+    // ring): the figures reference it (the safety matrix's "ring full" cells failed the campaign
+    // with a FOREIGN KEY error here).
+    const bool has_loops = std::any_of(e.loops.begin(), e.loops.end(), [&e](const LoopRecord& l) { return l.run == e.validation_run; });
+    if (has_loops || sample_count(e.validation_run) > 0) {
       end_run(e.validation_run, e.state, e.now);
     } else {  // never started (the campaign ended before it): no empty run is left behind
       Statement del(db_, "DELETE FROM runs WHERE id = ? AND NOT EXISTS (SELECT 1 FROM samples WHERE run_id = ?)");

@@ -3,7 +3,9 @@
 // the contract of a real one (ready/enabled handshake, a mode interlock, latched e-stop and
 // faults cleared only by a reset, a servo dead band, hold), driven by the time passed in, with a
 // fault plan (latch fault k at t, e-stop at t, drop or exceptions or a frozen counter over a
-// window, a late answer). It records what the host wrote, so invariants can be checked.
+// window, a late answer, a limit trip, not ready, the host's heartbeat lost). It records what the
+// host wrote, so invariants can be checked. As a shaker (shaker = true) its table follows the
+// drive's amplitude with a first-order lag and the mass answers 1.5 times the base, 0.3 rad behind.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -17,7 +19,8 @@ namespace st = protocols::status;
 using drivers::RigError;
 
 struct FaultEvent {
-  enum Kind { latch_fault, estop, drop, exceptions, freeze, drop_enable } kind;
+  // The randomized schedules draw from the first six; the safety matrix uses them all.
+  enum Kind { latch_fault, estop, drop, exceptions, freeze, drop_enable, limit_trip, not_ready, heartbeat_loss } kind;
   double at_s = 0, until_s = 0;  // windows: [at, until)
   std::uint16_t code = 0;
   bool applied = false;  // one-shot events (latch_fault, estop, drop_enable) happen once
@@ -28,10 +31,14 @@ class FakeRig final : public drivers::Rig {
   // What the host did, for the invariants.
   struct Log {
     int setpoints_while_latched = 0, enables_while_latched = 0, resets = 0, hold_writes = 0, estop_writes = 0;
-    int mode_writes = 0, heartbeats = 0;
+    int mode_writes = 0, heartbeats = 0, disables = 0, drive_writes = 0, drives_while_latched = 0;
     std::vector<double> setpoints;
   } log;
   double deadband_mm = 0, rate_cap_mm_s = 500, dt = 0.001;
+  double t_base = 0;                // added to the time a read passes in (campaigns count from their start)
+  double enable_delay_s = 0;        // enabled reported this long after enable (the handshake's wait)
+  double heartbeat_timeout_s = 0;   // > 0: the controller's host watchdog (fault 4), timed while enabled
+  bool shaker = false;
   std::uint16_t required_mode = 1;
   std::vector<FaultEvent> plan;
 
@@ -40,6 +47,8 @@ class FakeRig final : public drivers::Rig {
   std::error_code arm(bool on) noexcept override {
     if (auto ec = link()) return ec;
     if (on && (estop_ || fault_)) ++log.enables_while_latched;
+    if (!on) ++log.disables;
+    if (on && !enable_) enabled_at_ = now_;
     enable_ = on;
     return {};
   }
@@ -73,17 +82,46 @@ class FakeRig final : public drivers::Rig {
     if (auto ec = link()) return ec;
     ++log.resets;
     estop_cmd_ = false;
-    if (!cause_) fault_ = 0, estop_ = false, enable_ = false;
+    if (!cause_) fault_ = 0, estop_ = false, enable_ = false, limit_ = false;
     return {};
   }
   std::error_code write_host_heartbeat(std::uint32_t) noexcept override {
     if (auto ec = link()) return ec;
+    if (in(FaultEvent::heartbeat_loss)) return RigError::timeout;  // the host's writes never arrive
     ++log.heartbeats;
+    heartbeat_at_ = now_;
+    return {};
+  }
+  std::error_code command_shaker(double f_hz, double amplitude_mm, bool enable) noexcept override {
+    if (!shaker) return RigError::unsupported;
+    if (auto ec = link()) return ec;
+    ++log.drive_writes;
+    if ((estop_ || fault_) && amplitude_mm > 0) ++log.drives_while_latched;
+    if (enable && !enable_) enabled_at_ = now_;
+    if (!enable) ++log.disables;
+    enable_ = enable;
+    f_hz_ = f_hz, drive_mm_ = amplitude_mm;
+    return {};
+  }
+  std::error_code read_shaker(double now, drivers::ShakerSample& out) noexcept override {
+    if (!shaker) return RigError::unsupported;
+    advance(now + t_base);
+    if (auto ec = link()) return ec;
+    const double w = 2 * 3.141592653589793 * f_hz_;
+    out.time_s = now;
+    out.base_displacement_mm = amp_ * std::sin(phase_);
+    out.mass_displacement_mm = 1.5 * amp_ * std::sin(phase_ - 0.3);
+    out.base_accel_m_s2 = -w * w * out.base_displacement_mm * 1e-3;
+    out.mass_accel_m_s2 = -w * w * out.mass_displacement_mm * 1e-3;
+    out.status_word = status();
+    out.fault_code = fault_;
+    if (!frozen()) ++counter_;
+    out.sample_counter = counter_;
     return {};
   }
   std::string fault_text(std::uint16_t code) const override { return code == 7 ? "hydraulic pressure low" : ""; }
   std::error_code read_sample(double now, drivers::RigSample& out) noexcept override {
-    advance(now);
+    advance(now + t_base);
     if (auto ec = link()) return ec;
     out.time_s = now;
     out.displacement_mm = x_;
@@ -104,6 +142,9 @@ class FakeRig final : public drivers::Rig {
   [[nodiscard]] bool latched() const { return estop_ || fault_ != 0; }
   [[nodiscard]] double position() const { return x_; }
   [[nodiscard]] bool moving() const { return moving_; }
+  [[nodiscard]] double amplitude() const { return amp_; }  // the shaker table's
+  [[nodiscard]] double now() const { return now_; }
+  [[nodiscard]] bool estop_commanded() const { return estop_cmd_; }
   void clear_cause() { cause_ = false; }
   void set_cause() { cause_ = true; }
 
@@ -132,7 +173,16 @@ class FakeRig final : public drivers::Rig {
           if (e.kind == FaultEvent::latch_fault) fault_ = e.code;
           if (e.kind == FaultEvent::estop) latch_estop();
           if (e.kind == FaultEvent::drop_enable) enable_ = false;
+          if (e.kind == FaultEvent::limit_trip && !fault_) fault_ = 1, limit_ = true;
         }
+      if (heartbeat_timeout_s > 0 && enabled() && now_ - std::max(heartbeat_at_, enabled_at_) > heartbeat_timeout_s && !fault_) fault_ = 4;
+      if (shaker) {
+        const double target = enabled() && !hold_ ? drive_mm_ : 0.0;
+        amp_ += (target - amp_) * 0.05;  // the table's amplitude lags the drive by ~20 ms
+        phase_ += 2 * 3.141592653589793 * f_hz_ * dt;
+        moving_ = amp_ > 1e-4;
+        continue;
+      }
       const bool driving = enabled() && !hold_;
       const double before = x_;
       if (driving) cmd_ += std::clamp(setpoint_ - cmd_, -std::min(rate_, rate_cap_mm_s) * dt, std::min(rate_, rate_cap_mm_s) * dt);
@@ -142,13 +192,16 @@ class FakeRig final : public drivers::Rig {
     }
   }
   std::uint16_t status() const {
-    const bool ready = !estop_ && !fault_;
-    return static_cast<std::uint16_t>((ready ? st::ready : 0U) | (enabled() ? st::enabled : 0U) | (hold_ ? st::holding : 0U) |
-                                      (estop_ ? st::estop : 0U) | (fault_ && !estop_ ? st::fault : 0U) | (moving_ ? st::moving : 0U));
+    const bool ready = !estop_ && !fault_ && !in(FaultEvent::not_ready);
+    const bool on = enabled() && now_ - enabled_at_ >= enable_delay_s;
+    return static_cast<std::uint16_t>((ready ? st::ready : 0U) | (on ? st::enabled : 0U) | (hold_ ? st::holding : 0U) |
+                                      (estop_ ? st::estop : 0U) | (fault_ && !estop_ ? st::fault : 0U) | (moving_ ? st::moving : 0U) |
+                                      (limit_ ? st::limit_tripped : 0U));
   }
 
   double now_ = 0, x_ = 0, cmd_ = 0, setpoint_ = 0, rate_ = 1;
-  bool enable_ = false, hold_ = false, estop_ = false, estop_cmd_ = false, cause_ = false, moving_ = false;
+  bool enable_ = false, hold_ = false, estop_ = false, estop_cmd_ = false, cause_ = false, moving_ = false, limit_ = false;
+  double enabled_at_ = 0, heartbeat_at_ = 0, f_hz_ = 0, drive_mm_ = 0, amp_ = 0, phase_ = 0;
   std::uint16_t mode_ = 0, fault_ = 0;
   std::uint32_t counter_ = 0;
 };

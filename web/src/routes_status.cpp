@@ -30,7 +30,7 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
   const control::RigInfo info = d.rig_info(k);
   const control::AcquisitionCounters live = d.rig_counters(k);
   json j{{"id", info.id}, {"index", k}, {"name", info.name}, {"kind", info.kind}, {"description", info.description},
-         {"simulated", info.simulated}, {"campaign", live.campaign}, {"samples", live.samples},
+         {"simulated", info.simulated}, {"campaign", live.campaign}, {"phase", live.phase}, {"samples", live.samples},
          {"missed_deadlines", live.missed_deadlines}, {"late_wakeups", live.late_wakeups}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
   const control::RigSupervision sv = d.rig_supervision(k);
   j["state"] = sv.state;

@@ -28,6 +28,13 @@ namespace hystlab::daemon {
 
 enum class Control { pause, resume, abort, estop };  // estop: the rig's e-stop, now; no motion
 
+// What the campaign's loop is doing now, as an operator names it (the rig panel, the safety
+// matrix's states). Text only at the edges.
+enum class CampaignPhase : std::uint8_t {
+  none, arming, preamble, training, ramping, dwelling, retake, validation, paused, held, safing, shaker_control, shaker_measure
+};
+[[nodiscard]] const char* to_string(CampaignPhase p) noexcept;
+
 // What a campaign ends as: text only at the JSON/database edges.
 enum class CampaignEnd { none, completed, failed, aborted, interrupted };
 [[nodiscard]] const char* to_string(CampaignEnd e) noexcept;

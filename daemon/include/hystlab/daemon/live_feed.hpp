@@ -84,6 +84,7 @@ struct RigLive {
   std::atomic<std::uint64_t> samples{0}, missed_deadlines{0}, late_wakeups{0};
   std::atomic<std::int64_t> campaign{0}, run{0};
   std::atomic<double> sample_rate_hz{0};
+  std::atomic<std::uint8_t> phase{0};  // daemon::CampaignPhase, set by the loop every period
 };
 
 }  // namespace hystlab::daemon

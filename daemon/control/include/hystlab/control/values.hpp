@@ -96,6 +96,7 @@ struct AcquisitionCounters {
   std::uint64_t samples = 0, missed_deadlines = 0, late_wakeups = 0;
   std::int64_t campaign = 0, run = 0;  // 0: none running
   double sample_rate_hz = 0;           // the running campaign's
+  std::string phase = "none";          // what its loop is doing: arming, ramping, dwelling, paused, safing, ...
 };
 
 struct WriterCounters {
