@@ -181,3 +181,28 @@ TEST_CASE("slow senders do not hold the threads that status, commands and stream
   CHECK(s < 3.0);
   for (const int fd : slow) close(fd);
 }
+
+TEST_CASE("bodies are bounded whatever their encoding: chunked and compressed bodies refused unread, header floods refused") {
+  test::LiveDaemon live;
+  const int port = live.http->port();
+  // A chunked body (256 MiB took the daemon to 1.14 GB): refused before a byte of it is read.
+  std::string raw = test::raw_request(port, request("POST", "/api/campaigns", "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n") +
+                                                "10\r\n{\"plan\": {}}    \r\n0\r\n\r\n");
+  CAPTURE(raw);
+  CHECK(status_line(raw) == "HTTP/1.1 411 Length Required");
+  CHECK(error_of(raw)["detail"].get<std::string>().find("Content-Length") != std::string::npos);
+  // A gzip body (199 KB inflated to 200 MB): refused.
+  raw = test::raw_request(port, request("POST", "/api/campaigns", "Content-Type: application/json\r\nContent-Encoding: gzip\r\n", "\x1f\x8b junk"));
+  CHECK(status_line(raw) == "HTTP/1.1 415 Unsupported Media Type");
+  CHECK(error_of(raw)["detail"].get<std::string>().find("gzip") != std::string::npos);
+  // 2,000 header fields: refused with the count.
+  std::string many;
+  for (int k = 0; k < 2000; ++k) many += "X-Filler-" + std::to_string(k) + ": 1\r\n";
+  raw = test::raw_request(port, request("GET", "/api/status", many));
+  CHECK(status_line(raw).find("431") != std::string::npos);
+  // And the daemon carries on.
+  auto c = live.client();
+  const auto r = c.Get("/api/status");
+  REQUIRE(r);
+  CHECK(r->status == 200);
+}

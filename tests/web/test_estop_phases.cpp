@@ -1,0 +1,166 @@
+// The operator's e-stop against a real daemon and hystlab-sim over Modbus TCP in real time (time
+// scale 1), pressed through the API in the phases where it used to wait for the campaign to end:
+// just submitted, ramping, dwelling at a top, paused, and on the safe ramp of an abort. Each press
+// must be answered only once latched and confirmed by the rig's status word, end the campaign
+// aborted, and leave the frame where it was (measured from the samples the daemon read: the
+// controller's own view). Then a reset clears it and the next phase runs.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "api_fixture.hpp"
+#include "hystlab/protocols/signals.hpp"
+
+using namespace hystlab;
+using namespace hystlab::test;
+
+namespace {
+
+json plan() {  // a preamble at 0 mm (dwell 1 s), a rise to 1 mm, a dwell there, descents: about 12 s
+  return json{{"kind", "fot"}, {"range_mm", {0, 2}}, {"subdivisions", 2}, {"ramp_rate_mm_s", 1.0}, {"dwell_s", 1.0},
+              {"sample_rate_hz", 500}, {"validation", false},
+              {"limits", {{"displacement_mm", {-0.5, 2.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
+}
+
+struct Press {
+  int status = 0;
+  json answer;
+  double seconds = 0;      // from the request to the answer
+  double moved_mm = 0;     // from the last sample before the request to the farthest within 1 s after it
+  double estop_seen_s = -1;  // from the request to the first sample whose status word shows the e-stop
+};
+
+// The daemon's live samples (as read from the rig) in [from, head).
+std::vector<control::LiveSample> samples(LiveDaemon& ld, std::uint64_t from) {
+  std::vector<control::LiveSample> out;
+  (void)ld.control->read_live(0, from, 1, out);
+  return out;
+}
+
+Press press(LiveDaemon& ld) {
+  Press p;
+  auto c = ld.client();
+  const std::uint64_t head = ld.control->live_head(0);
+  const auto before = samples(ld, head > 0 ? head - 1 : 0);
+  const double x0 = before.empty() ? 0.0 : before.back().disp;
+  const double t0 = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  const auto r = c.Post("/api/rigs/sim%20frame/estop", "", "application/json");
+  p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() - t0;
+  REQUIRE(r);
+  p.status = r->status;
+  p.answer = json::parse(r->body);
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  for (const control::LiveSample& s : samples(ld, head)) {
+    if (s.mono_s < t0) continue;
+    p.moved_mm = std::max(p.moved_mm, std::fabs(s.disp - x0));
+    if (p.estop_seen_s < 0 && (s.status & protocols::status::estop)) p.estop_seen_s = s.mono_s - t0;
+  }
+  return p;
+}
+
+std::string phase_of(LiveDaemon& ld) {
+  auto c = ld.client();
+  const auto r = c.Get("/api/rigs/sim%20frame");
+  return r && r->status == 200 ? json::parse(r->body).value("phase", "") : "";
+}
+
+bool wait_phase(LiveDaemon& ld, const std::string& phase, double seconds, const std::function<bool()>& also = {}) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (phase_of(ld) == phase && (!also || also())) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
+
+double position(LiveDaemon& ld) {
+  const std::uint64_t head = ld.control->live_head(0);
+  const auto s = samples(ld, head > 0 ? head - 1 : 0);
+  return s.empty() ? 0.0 : s.back().disp;
+}
+
+std::int64_t submit(httplib::Client& c) {
+  const auto r = c.Post("/api/campaigns", json{{"plan", plan()}}.dump(), "application/json");
+  REQUIRE(r);
+  REQUIRE(r->status == 201);
+  return json::parse(r->body)["id"].get<std::int64_t>();
+}
+}  // namespace
+
+TEST_CASE("operator e-stop in every phase of a campaign (hystlabd, hystlab-sim over Modbus, real time): latched and confirmed before the answer, "
+          "the campaign aborted, the frame stopped") {
+  LiveDaemon ld([](daemon::DaemonConfig& c) {
+    c.rigs[0].sim.time_scale = 1.0;
+    c.rigs[0].sim.noise_N = 0.0;
+  });
+  auto c = ld.client();
+  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle"; }));
+  const std::vector<std::string> phases{"just submitted", "ramping", "dwelling", "paused", "safing"};
+  for (const std::string& phase : phases) {
+    CAPTURE(phase);
+    const std::int64_t id = submit(c);
+    if (phase == "ramping") REQUIRE(wait_phase(ld, "ramping", 20, [&] { return position(ld) > 0.3; }));
+    if (phase == "dwelling") REQUIRE(wait_phase(ld, "dwelling", 20, [&] { return position(ld) > 0.9; }));
+    if (phase == "paused") {
+      REQUIRE(wait_phase(ld, "ramping", 20, [&] { return position(ld) > 0.3; }));
+      REQUIRE(c.Post(("/api/campaigns/" + std::to_string(id) + "/pause").c_str(), "", "application/json"));
+      REQUIRE(wait_phase(ld, "paused", 10));
+    }
+    if (phase == "safing") {
+      REQUIRE(wait_phase(ld, "dwelling", 20, [&] { return position(ld) > 0.9; }));
+      REQUIRE(c.Post(("/api/campaigns/" + std::to_string(id) + "/abort").c_str(), "", "application/json"));
+      REQUIRE(wait_phase(ld, "safing", 10, [&] { return position(ld) < 0.8; }));
+    }
+    const Press p = press(ld);
+    CAPTURE(p.answer.dump());
+    MESSAGE(phase << ": answered in " << p.seconds * 1e3 << " ms; e-stop in the status word " << p.estop_seen_s * 1e3
+                  << " ms after the request; moved " << p.moved_mm << " mm after it");
+    CHECK(p.status == 200);  // never 202 "armed": answered once latched and seen in the status word
+    CHECK(p.answer["latched"] == true);
+    CHECK(p.answer["confirmed"] == true);
+    CHECK(p.answer["state"] == "estopped");
+    CHECK(p.seconds < 1.0);
+    CHECK(p.estop_seen_s >= 0);
+    CHECK(p.estop_seen_s < 0.5);
+    // At 1 mm/s, 2 periods of 2 ms and the controller's own stop: far below 0.05 mm (it was
+    // 0.7-1.0 mm in 0.6 s when the press waited for the campaign).
+    CHECK(p.moved_mm < 0.05);
+    CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["final"] == true; }, 30));
+    const json camp = json::parse(c.Get(("/api/campaigns/" + std::to_string(id)).c_str())->body);
+    CHECK((camp["state"] == "aborted" || camp["state"] == "failed"));
+    const auto reset = c.Post("/api/rigs/sim%20frame/reset", "", "application/json");
+    REQUIRE(reset);
+    CAPTURE(reset->body);
+    CHECK(reset->status == 200);
+    REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle" && j["latched"] == false; }, 10));
+  }
+}
+
+TEST_CASE("the documented commands as written: curl -d '' reaches the e-stop; a command that does not apply answers 409 with the reason") {
+  LiveDaemon ld;
+  auto c = ld.client();
+  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle"; }));
+  // curl -s -X POST -d '' "$H/api/rigs/sim%20frame/estop": a form content type with an empty body.
+  auto r = c.Post("/api/rigs/sim%20frame/estop", "", "application/x-www-form-urlencoded");
+  REQUIRE(r);
+  CHECK(r->status == 200);
+  CHECK(json::parse(r->body)["latched"] == true);
+  r = c.Post("/api/rigs/sim%20frame/reset", "", "application/x-www-form-urlencoded");
+  REQUIRE(r);
+  CHECK(r->status == 200);
+  // A body that is not JSON still is refused (a cross-site form cannot carry one).
+  r = c.Post("/api/rigs/sim%20frame/estop", "a=1", "application/x-www-form-urlencoded");
+  REQUIRE(r);
+  CHECK(r->status == 415);
+  // Resume a running campaign: 409, and what does apply.
+  const auto id = submit(c);
+  REQUIRE(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "running"; }, 30));
+  r = c.Post(("/api/campaigns/" + std::to_string(id) + "/resume").c_str(), "", "application/json");
+  REQUIRE(r);
+  CHECK(r->status == 409);
+  CHECK(r->body.find("'resume' does not apply (pause, abort, estop do)") != std::string::npos);
+  r = c.Post(("/api/campaigns/" + std::to_string(id) + "/abort").c_str(), "", "application/json");
+  REQUIRE(r);
+  CHECK(r->status == 202);
+  CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "aborted"; }, 30));
+}
