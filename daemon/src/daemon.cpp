@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <filesystem>
 #include <condition_variable>
 #include <future>
 #include <limits>
@@ -192,8 +193,25 @@ struct Daemon::Impl {
   }
 };
 
+namespace {
+// An HTTP HDF5 export's temporary file (web/src/routes_h5.cpp) is unlinked once open; a kill in
+// between left it beside the database for good. Any left from an earlier run go at start-up.
+void remove_leftover_exports(const std::string& db_path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path dir = fs::absolute(db_path, ec).parent_path();
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind("hystlab-export-", 0) != 0 || it->path().extension() != ".h5") continue;
+    std::error_code rm;
+    if (fs::remove(it->path(), rm)) spdlog::warn("removed a left-over export file: {}", it->path().string());
+  }
+}
+}  // namespace
+
 Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config)) {
   auto& d = *impl_;
+  remove_leftover_exports(config.db_path);
   if (const int n = d.store.mark_interrupted(now_iso())) spdlog::warn("{} campaign(s) were left running: now interrupted", n);
   if (const int n = d.store.hold_queued(now_iso()))
     spdlog::warn("{} queued campaign(s) held after the restart: nothing moves until an operator releases them (resume)", n);

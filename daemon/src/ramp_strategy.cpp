@@ -24,6 +24,7 @@ class RampStrategy final : public Strategy {
         time_scale_(L.ctx.time_scale), shakedown_(L.plan.training) {
     series_ = L.job.prior_series;
     rows_begin_ = series_.x.size();
+    halvings_seen_ = series_.halvings;
     if (plan_.kind != db::CampaignKind::fot) return;
     const models::Grid g = fot_grid(plan_);
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
@@ -52,6 +53,11 @@ class RampStrategy final : public Strategy {
 
   bool on_frame(Loop& L, const drivers::RigSample& s) override {
     (validating_ ? validation_ : series_).add(s.displacement_mm, s.force_N);
+    if (series_.halvings != halvings_seen_) {  // the series was thinned 2:1: its indices follow
+      halvings_seen_ = series_.halvings;
+      rows_begin_ = (rows_begin_ + 1) / 2;
+      cycle_start_.reset();  // a training cycle in progress is not judged on a thinned record
+    }
     const std::size_t before = seq_.index();
     std::optional<SetpointCommand> cmd = seq_.step(s.time_s, s.displacement_mm);
     if (cmd) cmd = segment_changed(L, s, before, *cmd);
@@ -245,7 +251,7 @@ class RampStrategy final : public Strategy {
   double time_scale_ = 1.0;
   ShakedownRule shakedown_;
   std::optional<std::size_t> cycle_start_;  // the sample a training cycle began at
-  std::size_t rows_begin_ = 0;
+  std::size_t rows_begin_ = 0, halvings_seen_ = 0;
   bool validating_ = false;
   std::int64_t campaign_run_ = 0;
   double target_ = 0, started_ = 0, deadline_ = 1e300;

@@ -241,7 +241,7 @@ constexpr int kIdleMissesForLinkLoss = 3;  // 150 ms of 50 ms idle ticks, plus t
 }  // namespace
 
 // Between campaigns: one supervised read, shown live (run 0); the simulator restarted if it died.
-void idle_tick(RigWorker& w, double t, const std::string& base) {
+void idle_tick(RigWorker& w, double t, const std::string& base, double host_s) {
   if (w.sim && !w.sim->alive()) {
     spdlog::warn("rig '{}': the simulator died; starting a new one", w.entry.name);
     w.build_rig(base);
@@ -268,13 +268,13 @@ void idle_tick(RigWorker& w, double t, const std::string& base) {
   const bool gone = ec == drivers::RigError::connection_lost || ec == drivers::RigError::not_connected;
   if (!ec) w.idle_misses = 0, (void)w.supervisor->on_status(t, v);
   else if (gone || ++w.idle_misses >= kIdleMissesForLinkLoss) w.supervisor->on_link_error(t, ec);
-  w.supervisor->heartbeat(mono_now());
+  w.supervisor->heartbeat(host_s);
   w.update_snapshot(v, x, f, !ec);
 }
 
-void idle_step(RigWorker& w, double t, const std::string& base) {
+void idle_step(RigWorker& w, double t, const std::string& base, double host_s) {
   w.service(t);
-  idle_tick(w, t, base);
+  idle_tick(w, t, base, host_s);
   w.service(t);  // what this read confirmed is answered now, not a wait later
 }
 
@@ -309,7 +309,7 @@ void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void
         w.running_campaign = 0;
         continue;
       }
-      idle_step(w, rig_time(), base);
+      idle_step(w, rig_time(), base, mono_now());
       w.wait(0.05);
     } catch (const std::exception& e) {
       contain(w, writer, e.what(), rig_time());

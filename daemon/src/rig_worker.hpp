@@ -80,9 +80,10 @@ struct RigWorker {
 };
 
 // One period between campaigns: the stop channel, one supervised read shown live (the simulator
-// restarted if it died), the channel again (what the read confirmed is answered at once).
-void idle_tick(RigWorker& w, double t, const std::string& base);
-void idle_step(RigWorker& w, double t, const std::string& base);
+// restarted if it died), the channel again (what the read confirmed is answered at once). t: rig
+// seconds; host_s: the host's monotonic seconds (the heartbeat's clock).
+void idle_tick(RigWorker& w, double t, const std::string& base, double host_s);
+void idle_step(RigWorker& w, double t, const std::string& base, double host_s);
 // The acquisition thread's error boundary: an exception escaped a campaign or a tick. The rig is
 // held (disarmed), the running campaign failed with the reason, and the thread goes on.
 void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, double t);

@@ -29,7 +29,11 @@ void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const mode
                      const RunSeries& series, const std::string& now) {
   auto table = builder.table();
   const std::size_t known = builder.identified_nodes(), needed = builder.required_nodes();
-  writer.post([campaign, table = std::move(table), x = series.x, f = series.f, known, needed, now](db::Store& s) {
+  // On at most 65,536 samples of the run, evenly spread: a copy of the whole run after every
+  // descent was O(N) on the acquisition thread, and held ~400 bytes a sample in the process's
+  // heap over a long campaign (fragments of ever larger copies); the final tables are scored on all.
+  RunSeries few = series.thinned(kEvaluationSamples);
+  writer.post([campaign, table = std::move(table), x = std::move(few.x), f = std::move(few.f), known, needed, now](db::Store& s) {
     const json detail{{"nodes", known}, {"required", needed}, {"accuracy", models::accuracy_json(models::score_table(table, x, f))}};
     s.add_event(campaign, "fit", detail.dump(), now);
   });

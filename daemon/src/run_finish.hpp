@@ -7,8 +7,10 @@
 
 namespace hystlab::daemon {
 
-// After a descent: the partial table against every sample so far, per branch, stored as an event
-// by the writer thread (the acquisition thread only copies).
+// After a descent: the partial table against the samples so far (at most kEvaluationSamples of
+// them, evenly spread), per branch, stored as an event by the writer thread (the acquisition
+// thread only copies that many).
+inline constexpr std::size_t kEvaluationSamples = 65536;
 void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const models::OnlineTableBuilder& builder,
                      const RunSeries& series, const std::string& now);
 

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <malloc.h>
+
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -171,6 +173,11 @@ H5ExportStats export_campaign_h5(Store& store, std::int64_t campaign_id, const s
     if (const RigKind k = rig_kind_of(store, r.id); k != RigKind::none) runs.emplace_back(r, k);
   if (runs.empty()) throw H5ExportError(H5ExportError::Kind::no_samples, "no samples in any run of campaign " + std::to_string(campaign_id));
   return write_file(path, [&](hid_t f) { return write_runs(store, f, "campaign", campaign_id, runs, opt); });
+}
+
+void release_export_memory() noexcept {
+  (void)H5garbage_collect();
+  (void)malloc_trim(0);
 }
 
 }  // namespace hystlab::db

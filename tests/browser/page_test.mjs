@@ -99,14 +99,29 @@ async function checkServerFieldError(page) {
   await page.fill('input[name=hi]', '4');
 }
 
-// E-STOP from the rig panel: latched at once, the reason shown, Submit refused; Reset asks
-// first, then the latch clears when the simulated rig reports ready (it may refuse a reset on a
-// busy machine: the operator, and this test, press it again).
+// E-STOP from the rig panel **while a campaign runs** (it once did nothing then: the rig's
+// commands were read only between campaigns): the campaign ends aborted, the rig latches, the page
+// shows it within a second, the reason shown, Submit refused; Reset asks first, then the latch
+// clears when the simulated rig reports ready (it may refuse a reset on a busy machine: the
+// operator, and this test, press it again).
 async function checkEstop(page) {
   await page.selectOption('select[name=kind]', 'fot');
   await page.selectOption('select[name=rig]', 'sim frame');
+  const plan = { kind: 'fot', range_mm: [0, 4], subdivisions: 4, ramp_rate_mm_s: 0.5, sample_rate_hz: 500,
+                 limits: { displacement_mm: [-0.5, 4.5], force_N: 400, rate_mm_s: 20 } };
+  const answer = await fetch(base + '/api/campaigns', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+    body: JSON.stringify({ plan, rig: 'sim frame' }), signal: AbortSignal.timeout(10000) });
+  const id = (await answer.json()).id;
+  const running = async () => { for (let k = 0; k < 300; k++) { if ((await getJSON(`/api/campaigns/${id}`)).state === 'running') return true; await new Promise(r => setTimeout(r, 100)); } return false; };
+  check(answer.status === 201 && await running(), `a campaign runs on "sim frame" (campaign ${id})`);
+  const pressed = Date.now();
   await page.click('.rig[data-rig="sim frame"] button.estop');
-  check(await wait(page, rigLatched, 'sim frame', 'the rig latched', 20000), 'E-STOP latches "sim frame"');
+  const latched = await wait(page, rigLatched, 'sim frame', 'the rig latched', 20000);
+  const shownMs = Date.now() - pressed;
+  check(latched && shownMs < 1000, `E-STOP during the campaign latches "sim frame", shown on the page ${shownMs} ms after the click (bound: 1 s)`);
+  let ended = null;
+  for (let k = 0; k < 100 && !ended; k++) { const c = await getJSON(`/api/campaigns/${id}`); if (c.final) ended = c; else await new Promise(r => setTimeout(r, 100)); }
+  check(ended && ended.state === 'aborted', `the running campaign ends aborted by the e-stop (${ended && ended.state})`);
   check(await wait(page, () => { const l = document.querySelector('.rig[data-rig="sim frame"] .latch'); return l && !l.hidden && /LATCHED: \S/.test(l.textContent); },
                     null, 'the latch shown', 10000), 'the rig panel shows the latch and its reason: ' +
         JSON.stringify(await page.textContent('.rig[data-rig="sim frame"] .latch strong')));

@@ -159,7 +159,9 @@ void Cell::describe(const daemon::RunnerResult& r, bool ran, int bound) {
   std::string o = ran ? std::string(daemon::to_string(r.end)) : "no campaign";
   if (ran && !r.reason.empty()) o += ": " + short_reason(r.reason);
   if (closed_tick >= 0) o += " (went on; ended by an abort " + std::to_string(closing_ticks()) + " periods later)";
-  if (r.dropped > 0) o += "; samples dropped at the full ring, counted in the run's quality";
+  // (where the loop runs when the event comes, the ring is asserted to have filled; elsewhere how
+  // much of the run meets the lock is the host's timing, and the text must not depend on it)
+  if (event == Event::ring_full && loop_state(state)) o += "; samples dropped at the full ring, counted in the run's quality";
   o += " · rig " + std::string(daemon::to_string(sup().state()));
   out.outcome = o;
   if (std::getenv("HYSTLAB_SAFETY_ONLY")) out.outcome += " [" + r.reason + "]";  // the whole reason when looking at a few cells

@@ -17,7 +17,6 @@
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
-#include "monotonic_clock.hpp"
 #include "rig_worker.hpp"
 
 namespace hystlab::test {
@@ -57,7 +56,7 @@ struct SafetyWorld {
     rig->t_base = 0;
     for (int k = 0; k < n; ++k) {
       clock.advance(0.05);
-      daemon::idle_step(w, rig_time(), "");
+      daemon::idle_step(w, rig_time(), "", clock.now());
     }
   }
 
@@ -126,9 +125,7 @@ struct SafetyWorld {
   std::unique_ptr<db::SampleWriter> writer;
   std::int64_t rig_id = 0;
   daemon::SupervisionSettings settings;
-  // On the steady clock's scale, ahead of it: the supervisor's heartbeat deadlines are in host
-  // seconds, and the idle step reads the steady clock (rig_worker.cpp) while campaigns read this one.
-  daemon::FakeClock clock{daemon::mono_now() + 1000.0};
+  daemon::FakeClock clock;
   double t0 = 0;
   FakeRig* rig = nullptr;
   daemon::RigWorker w;

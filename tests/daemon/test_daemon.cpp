@@ -186,6 +186,64 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
   CHECK(preamble);
 }
 
+TEST_CASE("hystlabd: kill -9 after the last node (in the validation run), restart, resume: completed, its tables built once, then left alone") {
+  Dir d;
+  d.write("cfg.json", kConfig);
+  // The validation run slow (0.02 mm/s: some 20 s of wall time at time scale 100), to be killed in.
+  d.write("plan.json", R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 3, "ramp_rate_mm_s": 0.1, "sample_rate_hz": 1000,
+                          "validation": {"rate_mm_s": 0.02},
+                          "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 400, "rate_mm_s": 50}})");
+  pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
+  const Reaper reaper{pid};
+  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
+  REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + daemon_at(d.path / "log")).code == 0);
+  REQUIRE(eventually([&] {  // every node measured, the validation run under way
+    db::Store s(d.db());
+    db::Statement st(s.database(), "SELECT count(*) FROM samples WHERE run_id IN (SELECT id FROM runs WHERE role = 'validation')");
+    st.step();
+    return st.column_int(0) > 500;
+  }));
+  CHECK(state_of(d.db(), 1) == "running");  // killed inside the validation run, not after it
+  kill(pid, SIGKILL);
+  wait_exit(pid);
+  CHECK(state_of(d.db(), 1) == "running");  // as the crash left it
+  pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log2");
+  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "interrupted"; }));
+  REQUIRE(cli("campaign resume 1" + daemon_at(d.path / "log2")).code == 0);
+  // It stayed 'queued' for ever (the tables were given run 0, which the database refused).
+  REQUIRE(eventually([&] { return state_of(d.db(), 1) == "completed"; }, 30000));
+  auto tables = [&] {
+    db::Store s(d.db());
+    db::Statement st(s.database(), "SELECT count(*), min(run_id IN (SELECT id FROM runs)) FROM tables WHERE campaign_id = 1");
+    st.step();
+    return std::pair{st.column_int(0), st.column_int(1)};
+  };
+  CHECK(tables() == std::pair<std::int64_t, std::int64_t>{2, 1});  // fot and lsq, each on a run that exists
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+  pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log3");
+  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  CHECK(state_of(d.db(), 1) == "completed");  // a restart leaves an ended campaign alone
+  CHECK(tables().first == 2);
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+}
+
+TEST_CASE("hystlabd: an HTTP export's temporary file left by a kill is removed at start-up") {
+  Dir d;
+  d.write("cfg.json", kConfig);
+  d.write("hystlab-export-Ab12Cd.h5", "partial");
+  d.write("keep-me.h5", "a user's file");
+  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
+  const Reaper reaper{pid};
+  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
+  CHECK_FALSE(fs::exists(d.path / "hystlab-export-Ab12Cd.h5"));
+  CHECK(fs::exists(d.path / "keep-me.h5"));
+  kill(pid, SIGTERM);
+  CHECK(wait_exit(pid) == 0);
+}
+
 namespace {
 const char* kShortPlan = R"({"kind": "waveform", "points_mm": [0, 1.0, 0.5], "ramp_rate_mm_s": 1.0, "sample_rate_hz": 500})";
 }  // namespace

@@ -67,6 +67,9 @@ template <class Export>
 std::shared_ptr<OpenFile> export_to_temp(const std::string& db_path, Export export_to) {
   const ExportSlot slot;
   const TempName name(db_path);
+  struct Release {
+    ~Release() { db::release_export_memory(); }
+  } const release;
   try {
     export_to(name.path);
   } catch (const db::H5ExportError& e) {
