@@ -7,6 +7,8 @@
 // fails when the document differs from what the code does.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -44,11 +46,20 @@ TEST_CASE("safety matrix: every state x every event, each stop within its bound,
       if (!only || (std::string(to_string(s)) + " x " + to_string(e)).find(only) != std::string::npos) cells.emplace_back(s, e);
   all.resize(cells.size());
   std::vector<std::thread> slow;
+  std::vector<std::size_t> fast;
   for (std::size_t k = 0; k < cells.size(); ++k) {
     const auto [s, e] = cells[k];
     if (e == Event::db_busy || e == Event::db_failing) slow.emplace_back([&all, k, s = s, e = e] { all[k] = run_cell(s, e); });
-    else all[k] = run_cell(s, e);
+    else fast.push_back(k);
   }
+  // The others on every core (each cell's time is its fake clock's: the outcome is the same).
+  std::atomic<std::size_t> next{0};
+  std::vector<std::thread> workers;
+  for (unsigned w = 0; w < std::max(1U, std::thread::hardware_concurrency()); ++w)
+    workers.emplace_back([&] {
+      for (std::size_t i; (i = next++) < fast.size();) all[fast[i]] = run_cell(cells[fast[i]].first, cells[fast[i]].second);
+    });
+  for (auto& t : workers) t.join();
   for (auto& t : slow) t.join();
   int applied = 0;
   for (const CellResult& c : all) {
