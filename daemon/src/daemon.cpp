@@ -31,6 +31,15 @@ struct Daemon::Impl {
   std::deque<std::function<void()>> jobs;  // from other threads, run by the main loop
   bool accepting = true;
   std::set<std::int64_t> dispatched;  // campaigns handed to a rig's thread (main loop only)
+  // Campaigns handed to the finisher and not yet finished: their rig is idle, their record still
+  // says running; a command to one is refused (an abort there was stored, then overwritten by
+  // the finisher's end).
+  std::mutex finishing_mu;
+  std::set<std::int64_t> finishing;
+  bool being_finished(std::int64_t id) {
+    std::lock_guard lk(finishing_mu);
+    return finishing.count(id) > 0;
+  }
   double db_backoff_s = 0;            // a busy or failing database: retried, reported once per episode
 
   explicit Impl(const DaemonConfig& c) : config(c), store(c.db_path) {}
@@ -80,6 +89,9 @@ struct Daemon::Impl {
     if (direct(campaign, cmd)) return {R::pending, false, false, "running", "taken by the running campaign", 0};
     const auto row = store.campaign(campaign);
     if (!row) return {R::conflict, false, false, "", "no campaign " + std::to_string(campaign), 0};
+    if (being_finished(campaign))
+      return {R::conflict, false, false, "finishing",
+              "campaign " + std::to_string(campaign) + " no longer moves the rig: its tables are being built, '" + to_string(cmd) + "' does not apply", 0};
     using C = CampaignCommand;
     using S = db::CampaignState;
     RigWorker* w = worker_of(row->rig_id);
@@ -240,7 +252,17 @@ Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config
   // acquisition's wake-ups by milliseconds.
   const bool moved = avoid_cpu(resolve_cpu(config.acquisition.cpu));
   d.writer = std::make_unique<db::SampleWriter>(config.db_path);
-  d.finisher = std::make_unique<Finisher>(*d.writer);
+  d.finisher = std::make_unique<Finisher>(*d.writer, [&d](FinishJob j) {
+    struct Done {
+      Impl& d;
+      std::int64_t id;
+      ~Done() {
+        std::lock_guard lk(d.finishing_mu);
+        d.finishing.erase(id);
+      }
+    } const done{d, j.campaign};
+    return finish_campaign(std::move(j), *d.writer, now_iso);
+  });
   if (moved) (void)avoid_cpu(-1);
 }
 
@@ -260,7 +282,13 @@ Daemon::~Daemon() {
 
 void Daemon::run(const std::atomic<bool>& stop) {
   auto& d = *impl_;
-  const std::function<void(FinishJob)> finish = [&d](FinishJob j) { d.finisher->submit(std::move(j)); };
+  const std::function<void(FinishJob)> finish = [&d](FinishJob j) {
+    {
+      std::lock_guard lk(d.finishing_mu);
+      d.finishing.insert(j.campaign);
+    }
+    d.finisher->submit(std::move(j));
+  };
   for (auto& w : d.workers)
     w->thread = std::thread(rig_thread, std::ref(*w), std::ref(*d.writer), finish, std::cref(stop), d.config.base_dir);
   spdlog::info("hystlabd running: database {}", d.config.db_path);

@@ -40,11 +40,12 @@ std::string why_not(State s, Event e) {
   if (e == Event::dead_band && (no_campaign || s == State::queued || s == State::finishing || shaker_state(s)))
     return shaker_state(s) ? "a shaker has no positioning dead band (its base is held in closed loop)" : "no motion is commanded in this state";
   if (e == Event::strategy_exception && !loop_state(s)) return "no strategy runs in this state";
+  if (campaign_event(e) && s == State::idle && e != Event::finisher_failing) return "there is no campaign in this state";
   if (campaign_event(e) && (no_campaign || s == State::queued || s == State::finishing) && e != Event::finisher_failing &&
       !(s == State::queued && (e == Event::db_busy || e == Event::db_failing || e == Event::ring_full)) && s != State::finishing)
     return "a campaign command here goes through the daemon's main loop (route): tests/daemon/test_daemon.cpp and tests/web";
   if (s == State::finishing && (e == Event::campaign_estop || e == Event::abort || e == Event::pause || e == Event::resume || e == Event::dead_band))
-    return "the campaign no longer moves the rig: the daemon answers 409 (test_api: 'commands that do not apply')";
+    return "the campaign no longer moves the rig: the daemon's main loop answers 409 while its tables are being built (daemon.cpp, route)";
   return "";
 }
 

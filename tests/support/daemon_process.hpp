@@ -80,6 +80,11 @@ class DaemonProcess {
   }
   ~DaemonProcess() { stop(); }
   [[nodiscard]] int port() const noexcept { return port_; }
+  // kill -9, as a crash would: nothing of the daemon's runs after it (the folder stays).
+  void kill9() {
+    kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
   [[nodiscard]] std::string db_path() const { return (dir_ / "bench.db").string(); }
   [[nodiscard]] std::string log() const { return read_log((dir_ / "daemon.log").string()); }
 
