@@ -2,9 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
-#include <filesystem>
 #include <condition_variable>
+#include <filesystem>
 #include <future>
 #include <limits>
 #include <mutex>
@@ -117,7 +118,10 @@ struct Daemon::Impl {
     return {R::conflict, false, false, state, why, 0};
   }
 
-  // The rig a campaign runs on (or is stored for); nullptr when unknown.
+  // The rig's command through its stop channel, answered once confirmed (or after wait_s).
+  CommandOutcome rig_command(RigWorker& w, RigCommand c, double wait_s);
+
+  // The rig a campaign runs on (or is queued for); nullptr when unknown.
   RigWorker* rig_of_campaign(std::int64_t campaign) {
     for (auto& w : workers)
       if (w->running_campaign == campaign || w->has_queued(campaign)) return w.get();
@@ -158,12 +162,12 @@ struct Daemon::Impl {
       }
       // The last validation run that holds samples: a resume with every node measured scores its
       // tables on it (an interruption during the validation run or the finishing left it there).
-      for (const std::int64_t run : store.runs_of_campaign(id, db::RunRole::validation)) {
-        if (store.sample_count(run) == 0) continue;
-        job.prior_validation = {};
-        store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(),
+      const std::vector<std::int64_t> vruns = store.runs_of_campaign(id, db::RunRole::validation);
+      const auto last = std::find_if(vruns.rbegin(), vruns.rend(), [this](std::int64_t run) { return store.sample_count(run) > 0; });
+      if (last != vruns.rend()) {
+        store.for_each_sample(*last, 0, std::numeric_limits<std::int64_t>::max(),
                               [&job](const db::SampleRow& r) { job.prior_validation.add(r.disp, r.force); });
-        job.prior_validation_run = run;
+        job.prior_validation_run = *last;
       }
     }
     return job;
@@ -373,9 +377,7 @@ CommandOutcome Daemon::command(std::int64_t campaign_id, CampaignCommand cmd) {
       return row && !db::is_final(row->state) ? d.worker_of(row->rig_id) : nullptr;
     });
     if (w) {
-      std::size_t k = 0;
-      while (d.workers[k].get() != w) ++k;
-      CommandOutcome rig = rig_command(k, RigCommand::estop);
+      CommandOutcome rig = d.rig_command(*w, RigCommand::estop, 2.0);
       if (w->running_campaign != campaign_id)  // not running: the record ends here (running: the latch ended it)
         (void)d.on_main<CommandOutcome>([&d, campaign_id] { return d.route(campaign_id, CampaignCommand::abort); });
       else
@@ -387,8 +389,9 @@ CommandOutcome Daemon::command(std::int64_t campaign_id, CampaignCommand cmd) {
   return d.on_main<CommandOutcome>([&d, campaign_id, cmd] { return d.route(campaign_id, cmd); });
 }
 
-CommandOutcome Daemon::rig_command(std::size_t rig, RigCommand c, double wait_s) {
-  RigWorker& w = *impl_->workers.at(rig);
+CommandOutcome Daemon::rig_command(std::size_t rig, RigCommand c, double wait_s) { return impl_->rig_command(*impl_->workers.at(rig), c, wait_s); }
+
+CommandOutcome Daemon::Impl::rig_command(RigWorker& w, RigCommand c, double wait_s) {
   std::future<CommandOutcome> answer = w.push_rig_command(c);
   // The rig's thread takes it at its next period (1 ms at 1 kHz, 50 ms between campaigns) and
   // answers once the rig's status word confirms it. A thread stuck in I/O answers late: the

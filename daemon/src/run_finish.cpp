@@ -1,13 +1,15 @@
 #include "run_finish.hpp"
 
 #include <algorithm>
-#include <cstdio>
-#include <nlohmann/json.hpp>
-#include <vector>
 #include <chrono>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
 #include <thread>
-#include "hystlab/db/sqlite.hpp"
+#include <vector>
 
+#include "hystlab/db/sqlite.hpp"
 #include "hystlab/models/accuracy.hpp"
 #include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
@@ -181,33 +183,49 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   // refuses outright (a constraint, a full disk) is retried a few times, then the campaign is
   // failed with that reason, without its tables: its samples stay, and it is never left 'queued'
   // or 'running' (stop 25's resumes stayed queued for ever when the tables had no run).
-  std::string refused;
-  bool busy = false;  // SQLITE_BUSY or SQLITE_LOCKED: another connection's lock, retried like a timeout
+  // The job's state is shared with it, not borrowed: a call that timed out leaves its job queued,
+  // and it may run after this function has returned.
+  struct Attempt {
+    db::Store::RunEnd end;
+    std::mutex mu;  // refused and busy: written by the writer thread, read here
+    std::string refused;
+    bool busy = false;  // SQLITE_BUSY or SQLITE_LOCKED: another connection's lock, retried like a timeout
+    void failed(const std::string& what, bool is_busy) {
+      std::lock_guard lk(mu);
+      refused = what, busy = is_busy;
+    }
+    std::pair<std::string, bool> why() {
+      std::lock_guard lk(mu);
+      return {refused, busy};
+    }
+  };
+  const auto a = std::make_shared<Attempt>();
+  a->end = std::move(end);
   for (int attempt = 0; attempt < 30; ++attempt) {
-    auto ids = writer.call<std::vector<std::int64_t>>([&end, &refused, &busy](db::Store& s) {
+    auto ids = writer.call<std::vector<std::int64_t>>([a](db::Store& s) {
       try {
-        return s.finish_run(end);
+        return s.finish_run(a->end);
       } catch (const db::DbError& e) {
-        refused = e.what();
-        busy = (e.code & 0xff) == 5 || (e.code & 0xff) == 6;
+        a->failed(e.what(), (e.code & 0xff) == 5 || (e.code & 0xff) == 6);
         throw;
       } catch (const std::exception& e) {
-        refused = e.what();
-        busy = false;
+        a->failed(e.what(), false);
         throw;
       }
     }, 10.0);
     if (ids) {
       if (ids->size() > 0) r.table_id = (*ids)[0];
       if (ids->size() > 1) r.lsq_table_id = (*ids)[1];
-      r.reason = end.reason == "finished" ? "" : end.reason;
+      r.reason = a->end.reason == "finished" ? "" : a->end.reason;
       return r;
     }
+    const auto [refused, busy] = a->why();
     if (!refused.empty() && !busy && attempt >= 2) break;
     if (busy) std::this_thread::sleep_for(std::chrono::milliseconds(100 * (attempt + 1)));
   }
+  const std::string refused = a->why().first;
   r.end = CampaignEnd::failed;
-  r.reason = end.reason + "; the database did not take the end of the campaign" + (refused.empty() ? std::string() : " (" + refused + ")");
+  r.reason = a->end.reason + "; the database did not take the end of the campaign" + (refused.empty() ? std::string() : " (" + refused + ")");
   const std::string reason = r.reason;
   const auto id = j.campaign;
   const auto last = writer.call<int>([id, reason, now](db::Store& s) {

@@ -208,7 +208,7 @@ CellResult run_cell(State s, Event e) {
 }
 
 CellResult run_schedule(bool shaker, const std::vector<std::pair<double, Event>>& schedule) {
-  Cell c(shaker ? State::shaker_measure : State::ramping, Event::resume);
+  Cell c(shaker ? State::shaker_measure : State::ramping, Event::resume);  // resume: no stop until one is scheduled
   c.schedule = schedule;
   std::sort(c.schedule.begin(), c.schedule.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   c.schedule_mode = true;
@@ -222,7 +222,6 @@ CellResult run_schedule(bool shaker, const std::vector<std::pair<double, Event>>
     c.world.idle(3);
     daemon::RunnerResult fin = r;
     if (auto f = c.world.finish(false)) fin = *f;
-    if (!c.injected) c.event = Event::resume;  // no stop was scheduled while it ran: no bound to check
     c.check_after(fin, true, job.id);
   } catch (const std::exception& ex) {
     c.fail(std::string("an exception escaped: ") + ex.what());
