@@ -33,7 +33,7 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
   demo       the paper's §3.3 study on Table 1, with a report and plots
   campaign   submit, preview, pause, resume, abort, estop campaigns of the running hystlabd
              (over its HTTP API); list and show them from its db file
-  rig        estop or reset one of the running hystlabd's rigs (over its HTTP API)
+  rig        estop, reset or recover one of the running hystlabd's rigs (over its HTTP API)
   tables     list and export the tables hystlabd identified
   runs       export a run's samples as CSV, or a run or campaign as HDF5
   simulate   the base-excited isolator (sdof): time histories, transmissibility sweeps

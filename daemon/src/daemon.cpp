@@ -335,20 +335,30 @@ double Daemon::uptime_s() const noexcept {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - impl_->started).count();
 }
 
-std::size_t Daemon::rig_index(const std::string& name) const {
+// Without a name: the only rig, or the only one of the kind the plan needs (the embedded
+// defaults have a load frame and a shaker, and a FOT plan can only mean the frame).
+std::size_t Daemon::rig_index(const std::string& name, std::string_view plan_kind) const {
   const auto& ws = impl_->workers;
+  std::string names;
+  for (const auto& w : ws) names += (names.empty() ? "'" : ", '") + w->info.name + "' (" + w->info.kind + ")";
   if (name.empty()) {
-    if (ws.size() != 1) throw std::invalid_argument("rig: several rigs are configured; name one");
-    return 0;
+    if (ws.size() == 1) return 0;
+    const std::string want = plan_kind.empty() ? "" : plan_kind == "sine" ? "shaker" : "load_frame";
+    std::vector<std::size_t> fit;
+    for (std::size_t k = 0; k < ws.size(); ++k)
+      if (!want.empty() && ws[k]->info.kind == want) fit.push_back(k);
+    if (fit.size() == 1) return fit[0];
+    throw std::invalid_argument("rig: several rigs " + (want.empty() ? std::string("are configured") : "can run a " + std::string(plan_kind) + " plan") +
+                                " (" + names + "); name one with \"rig\" (--rig NAME)");
   }
   for (std::size_t k = 0; k < ws.size(); ++k)
     if (ws[k]->info.name == name) return k;
-  throw std::invalid_argument("rig: no rig named '" + name + "'");
+  throw std::invalid_argument("rig: no rig named '" + name + "' (the rigs: " + names + ")");
 }
 
 std::pair<Plan, std::size_t> Daemon::check_plan(const std::string& rig_name, const json& plan_json) const {
   Plan plan = parse_plan(plan_json);  // PlanError names the field
-  const std::size_t k = rig_index(rig_name);
+  const std::size_t k = rig_index(rig_name, db::to_string(plan.kind));
   const RigWorker& rig = *impl_->workers.at(k);
   const bool shaker = rig.info.kind == "shaker";
   if ((plan.kind == db::CampaignKind::sine) != shaker)

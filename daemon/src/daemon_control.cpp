@@ -38,8 +38,11 @@ class DaemonControl final : public control::DaemonInterface {
     return {live.samples.load(), live.missed_deadlines.load(), live.late_wakeups.load(),
             live.campaign.load(), live.run.load(), live.sample_rate_hz.load(), to_string(static_cast<CampaignPhase>(live.phase.load()))};
   }
-  std::size_t rig_index(const std::string& name) const override { return d_.rig_index(name); }
-  control::CommandOutcome rig_command(std::size_t k, control::RigCommand c) override { return d_.rig_command(k, c); }
+  std::size_t rig_index(const std::string& name, std::string_view plan_kind) const override { return d_.rig_index(name, plan_kind); }
+  // A recovery ramps the frame at the safe rate (a few seconds): its answer waits for the outcome.
+  control::CommandOutcome rig_command(std::size_t k, control::RigCommand c) override {
+    return d_.rig_command(k, c, c == control::RigCommand::recover ? 25.0 : 2.0);
+  }
 
   std::uint64_t live_head(std::size_t k) const noexcept override { return k < d_.rig_count() ? d_.rig_live(k).ring.head() : 0; }
   std::uint64_t read_live(std::size_t k, std::uint64_t from, std::size_t stride, std::vector<control::LiveSample>& out,

@@ -7,6 +7,7 @@
 #include <ctime>
 
 #include "hystlab/drivers/rig_factory.hpp"
+#include "hystlab/protocols/signals.hpp"
 #include "monotonic_clock.hpp"
 
 namespace hystlab::daemon {
@@ -130,6 +131,13 @@ void RigWorker::carry_out(PendingCommand c, double t) {
     waiting_.push_back(std::move(c));
     return;
   }
+  if (c.command == RigCommand::recover) {
+    if (running_campaign) return answer(c, R::conflict, "a campaign is running on the rig");
+    if (auto why = sup.begin_recovery(t, entry.envelope.stroke_min_mm, entry.envelope.stroke_max_mm)) return answer(c, R::conflict, *why);
+    waiting_.push_back(std::move(c));
+    return;
+  }
+  if (sup.recovering()) return answer(c, R::conflict, "the frame is being brought back into its stroke (an e-stop stops it)");
   if (!sup.latched()) {
     answer(c, R::conflict, "the rig is " + std::string(to_string(sup.state())) + ", not latched: there is nothing to reset");
     return;
@@ -148,9 +156,17 @@ bool RigWorker::settled(const PendingCommand& c) {
     answer(c, R::done, "latched: the rig reports its e-stop");
     return true;
   }
+  if (c.command == RigCommand::recover) {
+    if (sup.recovering()) return false;
+    answer(c, sup.latched() ? R::refused : R::done, sup.recovery_result());
+    return true;
+  }
   if (sup.resetting()) return false;
   if (!sup.latched()) return answer(c, R::done, "reset: the rig reports ready"), true;
-  answer(c, R::refused, sup.reset_refusal().empty() ? "the rig is still latched" : sup.reset_refusal());
+  std::string why = sup.reset_refusal().empty() ? "the rig is still latched" : sup.reset_refusal();
+  if (info.kind != "shaker" && (sup.last_status().status & protocols::status::limit_tripped))
+    why += "; a frame beyond its stroke is brought back with POST /api/rigs/NAME/recover (hystlab rig recover)";
+  answer(c, R::refused, why);
   return true;
 }
 
@@ -197,6 +213,8 @@ void RigWorker::update_snapshot(const StatusView& v, double x, double f, bool ha
   snap_.latched_fault_code = s.fault_code();
   snap_.resetting = s.resetting();
   snap_.reset_refusal = s.reset_refusal();
+  snap_.recovering = s.recovering();
+  snap_.recovery_result = s.recovery_result();
   snap_.link_losses = s.link_losses();
   if (!have) return;
   snap_.have_sample = true;

@@ -57,6 +57,7 @@ void Supervisor::latch(double now, RigState to, const std::string& reason, std::
   fault_code_ = code;
   intended_ = to;
   resetting_ = false;
+  if (recovery_ != Recovery::none) recovery_ = Recovery::none, recovery_result_ = "limit recovery stopped: " + reason;
   go(now, to, reason);
 }
 
@@ -76,6 +77,7 @@ void Supervisor::on_link_error(double now, std::error_code ec) {
   reassert_pending_ = true;
   if (state_ == RigState::disconnected) return;
   ++link_losses_;
+  if (recovering()) recovery_failed(now, "link lost (" + ec.message() + "): held and disabled the moment the rig answers");
   if (latched()) return;  // the latch is the supervisor's: it outlives the link
   if (moving_state()) intended_ = RigState::holding;  // whatever it was doing, it is held when it answers
   go(now, RigState::disconnected, "link lost: " + ec.message());
@@ -132,6 +134,11 @@ std::optional<std::string> Supervisor::on_status(double now, const StatusView& v
   if (reassert_pending_) reassert(now);
   if (state_ == RigState::estopped && (v.status & st::estop)) estop_confirmed_ = true;
   if (state_ == RigState::disconnected) return std::nullopt;  // not yet re-asserted: nothing else
+  last_ = v, have_last_ = true;
+  if (recovering()) {
+    recovery_step(now, v);
+    return std::nullopt;
+  }
   if (resetting_) {
     reset_step(now, v);
     return std::nullopt;
@@ -151,6 +158,7 @@ std::optional<std::string> Supervisor::begin_arming(double now) {
   now += offset_;
   if (latched()) return "the rig is latched (" + latch_reason_ + "): reset it first";
   if (resetting_) return "the rig is being reset";
+  if (recovering()) return "the frame is being brought back into its stroke";
   if (state_ == RigState::disconnected) return "the rig is not connected";
   if (state_ != RigState::idle) return "the rig is busy (" + std::string(to_string(state_)) + ")";
   arming_written_ = false;

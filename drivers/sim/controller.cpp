@@ -23,6 +23,7 @@ void Controller::command(const HostCommands& c, double now_s, bool cause_present
 
 void Controller::reset(bool cause_present) noexcept {
   estop_ = false;
+  if (cause_present && code_ == kDisplacementLimit && p_.limit_recovery) recovering_ = true, code_ = kNoFault;
   if (!cause_present) code_ = kNoFault;
   enable_ = false;
   enable_seen_low_ = false;
@@ -46,7 +47,7 @@ void Controller::watch(double now_s) noexcept {
 
 unsigned Controller::status_bits() const noexcept {
   return (stopped() ? 0U : st::ready) | (drive_on() ? st::enabled : 0U) | (estop_ ? st::estop : 0U) |
-         (code_ == kDisplacementLimit || code_ == kForceLimit ? st::limit_tripped : 0U) | (code_ != kNoFault ? st::fault : 0U);
+         (code_ == kDisplacementLimit || code_ == kForceLimit || recovering_ ? st::limit_tripped : 0U) | (code_ != kNoFault ? st::fault : 0U);
 }
 
 }  // namespace hystlab::sim

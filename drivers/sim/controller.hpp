@@ -19,6 +19,7 @@ struct ControllerParams {
   bool mode_interlock = false;  // the rig has a mode signal: it moves only in `mode`
   std::uint16_t mode = 1;
   double host_timeout_s = 0;    // 0: no heartbeat watchdog
+  bool limit_recovery = true;   // a reset beyond the stroke enters limit recovery (a real frame's limit override)
 };
 
 // The host's commands the controller logic watches (the rest is physics).
@@ -33,7 +34,10 @@ class Controller {
   explicit Controller(ControllerParams p) : p_(p) {}
   // The host's commands as last written. A rising edge of fault_reset with the e-stop signal at 0
   // releases the e-stop latch, and clears the latched fault unless cause_present, and drops the
-  // enable command (a drive never re-enables itself: the host must write enable again).
+  // enable command (a drive never re-enables itself: the host must write enable again). A stroke
+  // limit trip whose cause is present is cleared into limit recovery instead (when the controller
+  // offers it): limit_tripped stays, the drive may be enabled, and the frame's owner lets it move
+  // only back toward its stroke, slowly, until end_recovery().
   void command(const HostCommands& c, double now_s, bool cause_present) noexcept;
   void press_estop() noexcept;               // the operator's button: latches like the signal
   void latch(std::uint16_t code) noexcept;   // the first fault's code stays until the reset
@@ -47,6 +51,8 @@ class Controller {
   // ready, enabled, estop, limit_tripped and fault (holding and moving are the physics').
   [[nodiscard]] unsigned status_bits() const noexcept;
   [[nodiscard]] const ControllerParams& params() const noexcept { return p_; }
+  [[nodiscard]] bool recovering() const noexcept { return recovering_; }
+  void end_recovery() noexcept { recovering_ = false; }
 
  private:
   void reset(bool cause_present) noexcept;
@@ -57,6 +63,7 @@ class Controller {
   bool heartbeat_armed_ = false;
   double heartbeat_at_ = 0;  // when the heartbeat last changed, or the drive came on
   bool was_on_ = false;
+  bool recovering_ = false;
 };
 
 }  // namespace hystlab::sim

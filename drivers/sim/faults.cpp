@@ -29,7 +29,7 @@ std::string Faults::apply(const std::string& spec) {
   else if (name == "clear") *this = Faults{};
   else
     return "unknown fault '" + name +
-           "' (drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload, can-silent, estop, latch=CODE, deadband=MM, clear)";
+           "' (drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload, can-silent, estop, latch=CODE, deadband=MM, overtravel=MM, clear)";
   return "";
 }
 
@@ -71,6 +71,18 @@ std::string apply_fault(const std::string& spec, Faults& faults, SimRig& rig) {
     }
     if (value.empty() || used != value.size() || !(mm >= 0) || !std::isfinite(mm)) return "fault 'deadband': '" + value + "' must be a number of mm >= 0";
     return rig.set_deadband(mm);
+  }
+  if (name == "overtravel") {
+    double mm = 0;
+    std::size_t used = 0;
+    try {
+      mm = std::stod(value, &used);
+    } catch (...) {
+      used = 0;
+    }
+    if (value.empty() || used != value.size() || !std::isfinite(mm) || std::fabs(mm) > 100)
+      return "fault 'overtravel': '" + value + "' must be a position in mm (within ±100)";
+    return rig.overtravel(mm);
   }
   return faults.apply(spec);
 }

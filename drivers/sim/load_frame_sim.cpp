@@ -42,7 +42,9 @@ LoadFrameSim::LoadFrameSim(std::unique_ptr<models::HysteresisModel> specimen, Lo
 
 void LoadFrameSim::set_commands(const LoadFrameCommands& c) noexcept {
   cmd_ = c;
+  const bool was_recovering = ctl_.recovering();
   ctl_.command(HostCommands{c.enable, c.estop, c.fault_reset, c.mode, c.host_heartbeat}, state_.time_s, limit_cause_present());
+  if (ctl_.recovering() && !was_recovering) recovery_closest_ = std::fabs(state_.displacement_mm);
   publish_status(false);  // a host reading right after its write sees the latch or the reset
 }
 
@@ -63,8 +65,18 @@ bool LoadFrameSim::limit_cause_present() const noexcept {
          (code == kForceLimit && std::fabs(state_.force_N) > p_.load_cell_range_N);
 }
 
+// In limit recovery the frame may only come back: within the stroke it ends; moving out again by
+// more than kRecoveryOutward from the closest it came trips the limit once more.
 void LoadFrameSim::check_limits() noexcept {
-  if (std::fabs(state_.displacement_mm) > p_.limit_mm) ctl_.latch(kDisplacementLimit);
+  constexpr double kRecoveryOutward = 0.1;
+  const double x = std::fabs(state_.displacement_mm);
+  if (ctl_.recovering()) {
+    recovery_closest_ = std::min(recovery_closest_, x);
+    if (x <= p_.limit_mm) ctl_.end_recovery();
+    else if (x > recovery_closest_ + kRecoveryOutward) ctl_.end_recovery(), ctl_.latch(kDisplacementLimit);
+  } else if (x > p_.limit_mm) {
+    ctl_.latch(kDisplacementLimit);
+  }
   if (std::fabs(state_.force_N) > p_.load_cell_range_N) ctl_.latch(kForceLimit);
 }
 
@@ -77,17 +89,29 @@ void LoadFrameSim::publish_status(bool driving) noexcept {
   state_.status_word = static_cast<std::uint16_t>(ctl_.status_bits() | (cmd_.hold ? st::holding : 0U) | (moving ? st::moving : 0U));
 }
 
+// The command moves toward the setpoint at the ramp rate (never faster than the valve; in limit
+// recovery only toward the stroke, at most at the recovery rate), or toward an overtravel's target.
+void LoadFrameSim::advance_command(double dt) noexcept {
+  LoadFrameState& s = state_;
+  if (ctl_.stopped()) overtravel_ = false;
+  double target = cmd_.setpoint_mm, rate = std::min(std::fabs(cmd_.ramp_rate_mm_s), p_.max_rate_mm_s);
+  if (overtravel_) {
+    target = overtravel_to_, rate = p_.overtravel_rate_mm_s;
+    if (std::fabs(target - s.command_mm) <= rate * dt) overtravel_ = false;
+  } else if (!(ctl_.drive_on() && !cmd_.hold)) {
+    if (ctl_.stopped()) s.command_mm = s.displacement_mm;  // a latched fault or e-stop: the actuator holds where it is
+    return;
+  } else if (ctl_.recovering()) {
+    target = std::clamp(target, -p_.limit_mm, p_.limit_mm);
+    rate = std::min(rate, p_.recovery_rate_mm_s);
+  }
+  s.command_mm += std::clamp(target - s.command_mm, -rate * dt, rate * dt);
+}
+
 void LoadFrameSim::step(double dt) noexcept {
   LoadFrameState& s = state_;
   s.time_s += dt;
-  const bool driving = ctl_.drive_on() && !cmd_.hold;
-  if (driving) {  // command moves toward the setpoint at the ramp rate (and never faster than the valve)
-    const double rate = std::min(std::fabs(cmd_.ramp_rate_mm_s), p_.max_rate_mm_s);
-    const double step = std::clamp(cmd_.setpoint_mm - s.command_mm, -rate * dt, rate * dt);
-    s.command_mm += step;
-  } else if (ctl_.stopped()) {
-    s.command_mm = s.displacement_mm;  // a latched fault or e-stop: the actuator holds where it is
-  }
+  advance_command(dt);
   const double error = s.command_mm - s.displacement_mm;
   if (std::fabs(error) >= p_.deadband_mm) s.displacement_mm += error * (1.0 - std::exp(-dt / p_.lag_s));
   const double f = specimen_.step(s.displacement_mm);

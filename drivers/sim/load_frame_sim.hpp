@@ -21,6 +21,8 @@ struct LoadFrameParams {
   double drift_N_per_s = 0.0;        // slow load cell drift
   double corner_width_mm = 0.05;      // corner smoothing of the specimen (0: none)
   double deadband_mm = 0;            // the servo stops correcting when |command - displacement| < this
+  double recovery_rate_mm_s = 1.0;   // limit recovery: the fastest the frame moves back into its stroke
+  double overtravel_rate_mm_s = 5.0; // the outside push of `fault overtravel` (a hand set's jog)
   std::uint64_t seed = 1;
   ControllerParams controller;       // mode interlock and host watchdog (default: neither)
 };
@@ -71,12 +73,16 @@ class LoadFrameSim {
   void press_estop() noexcept;
   void latch_fault(std::uint16_t code) noexcept;
   void set_deadband(double mm) noexcept { p_.deadband_mm = mm; }
+  // An outside cause (the hand set's jog, a specimen giving way) pushes the actuator toward mm
+  // whatever the host commands, until it gets there or the controller latches (a limit trip).
+  void overtravel(double mm) noexcept { overtravel_ = true, overtravel_to_ = mm; }
   [[nodiscard]] double deadband() const noexcept { return p_.deadband_mm; }
   [[nodiscard]] const Controller& controller() const noexcept { return ctl_; }
 
  private:
   [[nodiscard]] bool limit_cause_present() const noexcept;
   void check_limits() noexcept;
+  void advance_command(double dt) noexcept;
   void publish_status(bool driving) noexcept;
   LoadFrameParams p_;
   SmoothedSpecimen specimen_;
@@ -85,6 +91,9 @@ class LoadFrameSim {
   Controller ctl_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};
+  bool overtravel_ = false;
+  double overtravel_to_ = 0;
+  double recovery_closest_ = 0;  // limit recovery: the least |displacement| since it began
 };
 
 }  // namespace hystlab::sim

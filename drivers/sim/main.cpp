@@ -53,7 +53,7 @@ A simulated rig that speaks hystlab's real protocols over real sockets.
   --shakedown EXTRA,TAU          an untrained specimen (simplified model only): its upper plateau starts EXTRA N
                                  higher and settles by exp(-N/TAU) over transformation cycles N (see SIM.md)
   --fault SPEC                   start with a fault: drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload,
-                                 can-silent, or a controller event: estop, latch=CODE, deadband=MM
+                                 can-silent, or a controller event: estop, latch=CODE, deadband=MM, overtravel=MM
   --deadband-mm D                load frame servo dead band: no correction while |command - displacement| < D (default 0)
   --mode N                       the controller moves only while the map's mode register (CAN: the command's mode)
                                  holds N (default 1; a map without mode has no interlock). It starts at 0

@@ -64,13 +64,19 @@ std::string SimRig::set_deadband(double mm) {
   return "";
 }
 
+std::string SimRig::overtravel(double mm) {
+  if (!frame_) return "fault 'overtravel': a shaker has no stroke to leave";
+  frame_->overtravel(mm);
+  return "";
+}
+
 bool SimRig::enable_command() const noexcept { return controller().enable_command(); }
 
 std::string SimRig::describe_controller() const {
   std::ostringstream s;
   const Controller& c = controller();
   s << "fault_code=" << c.fault_code() << " stopped=" << c.stopped() << " enable=" << c.enable_command() << " mode_ok=" << c.mode_ok();
-  if (frame_) s << " deadband=" << frame_->deadband();
+  if (frame_) s << " deadband=" << frame_->deadband() << " recovering=" << c.recovering();
   return s.str();
 }
 

@@ -33,6 +33,7 @@ class SimRig {
   void press_estop() noexcept;
   void latch_fault(std::uint16_t code) noexcept;
   std::string set_deadband(double mm);  // an error message for a rig without a servo
+  std::string overtravel(double mm);    // the frame pushed toward mm from outside (an error for a shaker)
   // The enable command as the controller holds it: a reset drops it, and a Modbus server shows
   // that in the enable coil, so the host must write enable again.
   [[nodiscard]] protocols::Signal enable_signal() const noexcept {

@@ -38,6 +38,7 @@ class FakeRig final : public drivers::Rig {
   double t_base = 0;                // added to the time a read passes in (campaigns count from their start)
   double enable_delay_s = 0;        // enabled reported this long after enable (the handshake's wait)
   double heartbeat_timeout_s = 0;   // > 0: the controller's host watchdog (fault 4), timed while enabled
+  double stroke_mm = 1e9;           // beyond ±stroke_mm: fault 1; a reset there enters limit recovery (1 mm/s, inward only)
   bool shaker = false;
   std::uint16_t required_mode = 1;
   std::vector<FaultEvent> plan;
@@ -82,7 +83,8 @@ class FakeRig final : public drivers::Rig {
     if (auto ec = link()) return ec;
     ++log.resets;
     estop_cmd_ = false;
-    if (!cause_) fault_ = 0, estop_ = false, enable_ = false, limit_ = false;
+    if (!cause_ && limit_ && beyond()) fault_ = 0, estop_ = false, enable_ = false, recovering_ = true;
+    else if (!cause_) fault_ = 0, estop_ = false, enable_ = false, limit_ = false;
     return {};
   }
   std::error_code write_host_heartbeat(std::uint32_t) noexcept override {
@@ -145,6 +147,8 @@ class FakeRig final : public drivers::Rig {
   [[nodiscard]] double amplitude() const { return amp_; }  // the shaker table's
   [[nodiscard]] double now() const { return now_; }
   [[nodiscard]] bool estop_commanded() const { return estop_cmd_; }
+  [[nodiscard]] bool recovering() const { return recovering_; }
+  void place(double x) { x_ = cmd_ = setpoint_ = x; }  // the frame put there from outside (a hand set's jog)
   void clear_cause() { cause_ = false; }
   void set_cause() { cause_ = true; }
 
@@ -160,6 +164,7 @@ class FakeRig final : public drivers::Rig {
     return {};
   }
   bool frozen() const { return in(FaultEvent::freeze); }
+  bool beyond() const { return std::fabs(x_) > stroke_mm; }
   void latch_estop() {
     estop_ = true;
     if (!fault_) fault_ = 3;
@@ -185,10 +190,14 @@ class FakeRig final : public drivers::Rig {
       }
       const bool driving = enabled() && !hold_;
       const double before = x_;
-      if (driving) cmd_ += std::clamp(setpoint_ - cmd_, -std::min(rate_, rate_cap_mm_s) * dt, std::min(rate_, rate_cap_mm_s) * dt);
+      const double rate = std::min({rate_, rate_cap_mm_s, recovering_ ? 1.0 : 1e9});
+      const double target = recovering_ ? std::clamp(setpoint_, -stroke_mm, stroke_mm) : setpoint_;
+      if (driving) cmd_ += std::clamp(target - cmd_, -rate * dt, rate * dt);
       else cmd_ = x_;
       if (std::fabs(cmd_ - x_) > deadband_mm) x_ += (cmd_ - x_) * 0.2;
       moving_ = std::fabs(x_ - before) > 1e-9;
+      if (recovering_ && !beyond()) recovering_ = false, limit_ = false;
+      if (!recovering_ && beyond() && !fault_) fault_ = 1, limit_ = true;
     }
   }
   std::uint16_t status() const {
@@ -201,6 +210,7 @@ class FakeRig final : public drivers::Rig {
 
   double now_ = 0, x_ = 0, cmd_ = 0, setpoint_ = 0, rate_ = 1;
   bool enable_ = false, hold_ = false, estop_ = false, estop_cmd_ = false, cause_ = false, moving_ = false, limit_ = false;
+  bool recovering_ = false;
   double enabled_at_ = 0, heartbeat_at_ = 0, f_hz_ = 0, drive_mm_ = 0, amp_ = 0, phase_ = 0;
   std::uint16_t mode_ = 0, fault_ = 0;
   std::uint32_t counter_ = 0;

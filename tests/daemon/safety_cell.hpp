@@ -97,6 +97,7 @@ struct Cell {
   bool injected = false, moved_while_latched = false, moved_while_paused = false, saw_paused = false;
   double latched_x = NAN, paused_x = NAN, last_x = 0, top_seen = 0;
   bool hole_made = false;
+  bool reset_refused = false;
   std::vector<std::pair<double, Event>> schedule;  // run_schedule's: rig seconds from the start, in order
   bool schedule_mode = false;
   double started = NAN;
@@ -223,6 +224,7 @@ struct Cell {
   }
   void run();
   void run_idle_state();
+  void run_recovery_state();
   void check_after(const daemon::RunnerResult& r, bool ran, std::int64_t id);
   void recover_and_run_next();
   void describe(const daemon::RunnerResult& r, bool ran, int bound);

@@ -14,7 +14,8 @@ namespace hystlab::test {
 const char* to_string(State s) noexcept {
   constexpr const char* names[] = {"idle",       "queued", "arming: checking ready", "arming: enable written", "preamble", "training",
                                    "ramping",    "dwelling", "retake",               "validation",             "paused",   "safing",
-                                   "shaker control window", "shaker measuring window", "finishing", "held after restart"};
+                                   "shaker control window", "shaker measuring window", "finishing", "held after restart",
+                                   "limit recovery (latched, on the way back)"};
   return names[static_cast<int>(s)];
 }
 
@@ -29,19 +30,26 @@ const char* to_string(Event e) noexcept {
 
 namespace {
 
-bool loop_state(State s) { return s != State::idle && s != State::queued && s != State::finishing && s != State::held_after_restart; }
+bool loop_state(State s) {
+  return s != State::idle && s != State::queued && s != State::finishing && s != State::held_after_restart && s != State::limit_recovery;
+}
 
 // Why a cell has nothing to act on, or an empty string when it applies.
 std::string why_not(State s, Event e) {
-  const bool no_campaign = s == State::idle || s == State::held_after_restart;
+  const bool no_campaign = s == State::idle || s == State::held_after_restart || s == State::limit_recovery;
+  if (s == State::limit_recovery && campaign_event(e) && e != Event::dead_band && e != Event::strategy_exception && e != Event::db_busy &&
+      e != Event::db_failing && e != Event::ring_full && e != Event::finisher_failing)
+    return "no campaign runs: none arms while the frame is brought back (tests/web/test_limit_recovery.cpp)";
   if (e == Event::finisher_failing && no_campaign) return "no campaign is finished from this state";
   if ((e == Event::db_busy || e == Event::db_failing || e == Event::ring_full) && no_campaign)
     return "nothing is stored between campaigns: the idle reads never reach the database";
-  if (e == Event::dead_band && (no_campaign || s == State::queued || s == State::finishing || shaker_state(s)))
+  if (e == Event::dead_band && s != State::limit_recovery && (no_campaign || s == State::queued || s == State::finishing || shaker_state(s)))
     return shaker_state(s) ? "a shaker has no positioning dead band (its base is held in closed loop)" : "no motion is commanded in this state";
   if (e == Event::strategy_exception && !loop_state(s)) return "no strategy runs in this state";
-  if (campaign_event(e) && s == State::idle && e != Event::finisher_failing) return "there is no campaign in this state";
+  if (campaign_event(e) && (s == State::idle || s == State::limit_recovery) && e != Event::finisher_failing && e != Event::dead_band)
+    return "there is no campaign in this state";
   if (campaign_event(e) && (no_campaign || s == State::queued || s == State::finishing) && e != Event::finisher_failing &&
+      !(s == State::limit_recovery && e == Event::dead_band) &&
       !(s == State::queued && (e == Event::db_busy || e == Event::db_failing || e == Event::ring_full)) && s != State::finishing)
     return "a campaign command here goes through the daemon's main loop (route): tests/daemon/test_daemon.cpp and tests/web";
   if (s == State::finishing && (e == Event::campaign_estop || e == Event::abort || e == Event::pause || e == Event::resume || e == Event::dead_band))
@@ -53,6 +61,13 @@ std::string short_reason(const std::string& r) {
   std::string s = r.substr(0, std::min(r.find(" ("), r.find(';')));
   if (s.size() > 72) s = s.substr(0, 69) + "...";
   return s;
+}
+// A recovery's outcome in a table cell's words: "held and disabled: the rig reports fault 7".
+std::string recovery_words(std::string r) {
+  for (const std::string prefix : {"limit recovery stopped, the frame held and disabled: ", "limit recovery stopped: "})
+    if (r.rfind(prefix, 0) == 0) r = (prefix.size() > 30 ? "held and disabled: " : "stopped: ") + r.substr(prefix.size());
+  r = r.substr(0, r.find(" ("));
+  return r.size() > 90 ? r.substr(0, 87) + "..." : r;
 }
 }  // namespace
 
@@ -92,8 +107,46 @@ void Cell::run_idle_state() {
   check_after(r, ran, job ? job->id : 0);
 }
 
+// A frame that left its stroke (placed at 12.3 mm, the controller's stroke 12 mm), latched, and
+// on its way back at the safe rate (to 9.5 mm, inside the configured ±10 mm) when the event comes.
+// Watched until the recovery has ended: nothing may move once latched or held.
+void Cell::run_recovery_state() {
+  rig().stroke_mm = 12.0;
+  rig().place(12.3);
+  world.idle(2);
+  if (!sup().latched()) fail("the frame beyond its stroke did not latch");
+  auto recovering = world.w.push_rig_command(RigCommand::recover);
+  for (int k = 0; k < 40 && !(sup().recovering() && rig().enabled() && rig().position() < 12.2); ++k) world.idle(1);
+  if (!sup().recovering() || rig().position() >= 12.2) return fail("the recovery never started moving the frame");
+  event_tick = ticks;
+  inject(event);
+  double stopped_x = NAN;
+  for (int k = 0; k < 1200 && (sup().recovering() || k < 40); ++k) {  // 2 s at least: a lost link's 1.5 s is over
+    world.idle(1);
+    ++ticks;
+    if (acted_tick < 0 && Writes(rig()).safe_write_since(*at_event, rig())) acted_tick = ticks;
+    // Stopped once the rig has taken it (held, disabled or latched): a rig that cannot be reached
+    // goes on until its own host watchdog stops it (0.5 s here), as a real controller does.
+    const bool halted = sup().latched() && !sup().recovering() && (rig().held() || !rig().enabled() || rig().latched());
+    if (halted && std::isnan(stopped_x)) stopped_x = rig().position();
+    if (halted && std::fabs(rig().position() - stopped_x) > 0.02) moved_while_latched = true;
+  }
+  if (sup().recovering()) fail("the recovery never ended");
+  if (event == Event::reset) {  // refused while the frame comes back: only a stop interrupts a recovery
+    if (!answer || answer->wait_for(std::chrono::seconds(0)) != std::future_status::ready) fail("the reset was never answered");
+    else if (const CommandOutcome o = answer->get(); o.result != CommandOutcome::Result::conflict) fail("a reset during the recovery was answered " + o.reason);
+    else reset_refused = true;
+  }
+  if (event != Event::reset && event != Event::stale_counter && recovering.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    const CommandOutcome o = recovering.get();
+    if (o.result == CommandOutcome::Result::done) fail("the recovery was answered done through the event: " + o.reason);
+  }
+  check_after({}, false, 0);
+}
+
 void Cell::run() {
   world.idle(4);  // connected: the first answer re-asserts held and disabled
+  if (state == State::limit_recovery) return run_recovery_state();
   if (!loop_state(state)) return run_idle_state();
   const auto job = world.job(shaker_state(state) ? sine_plan() : fot_plan());
   const auto r = world.run(job, [this] { tick(); });
@@ -115,7 +168,7 @@ void Cell::check_after(const daemon::RunnerResult& r, bool ran, std::int64_t id)
   const bool armed_state = loop_state(state) && state != State::arming_ready && state != State::arming_enable;
   bool stop = stop_event(event);
   if (event == Event::pause && (!armed_state || state == State::paused || state == State::safing)) stop = false;
-  if ((event == Event::not_ready || event == Event::enable_dropped) && !armed_state) stop = false;
+  if ((event == Event::not_ready || event == Event::enable_dropped) && !armed_state && state != State::limit_recovery) stop = false;
   if (event == Event::abort && state == State::safing) stop = false;  // already on its way to the safe position
   // Invariants, every cell.
   if (moved_while_latched) fail("the rig moved while latched");
@@ -151,7 +204,8 @@ void Cell::check_after(const daemon::RunnerResult& r, bool ran, std::int64_t id)
   if (event == Event::ring_full && ran && loop_state(state) && r.dropped == 0) fail("the writer's ring never filled (the cell tested nothing)");
   // The bound is shown for the events whose first act is a write: the stops, and the watchdogs'
   // holds (a stale counter, a dead band's missed target, the controller's own heartbeat stop).
-  const bool shown = stop || event == Event::stale_counter || event == Event::dead_band || event == Event::heartbeat_lost;
+  const bool shown = stop || (event == Event::stale_counter && state != State::limit_recovery) || event == Event::dead_band ||
+                     event == Event::heartbeat_lost;
   describe(r, ran, shown ? bound : -1);
   recover_and_run_next();
 }
@@ -159,6 +213,7 @@ void Cell::check_after(const daemon::RunnerResult& r, bool ran, std::int64_t id)
 void Cell::describe(const daemon::RunnerResult& r, bool ran, int bound) {
   std::string o = ran ? std::string(daemon::to_string(r.end)) : "no campaign";
   if (ran && !r.reason.empty()) o += ": " + short_reason(r.reason);
+  if (state == State::limit_recovery) o = std::string(reset_refused ? "the reset refused (409), " : "") + "recovery: " + recovery_words(sup().recovery_result());
   if (closed_tick >= 0) o += " (went on; ended by an abort " + std::to_string(closing_ticks()) + " periods later)";
   // (where the loop runs when the event comes, the ring is asserted to have filled; elsewhere how
   // much of the run meets the lock is the host's timing, and the text must not depend on it)
@@ -178,14 +233,23 @@ void Cell::recover_and_run_next() {
   rig().deadband_mm = 0;
   rig().clear_cause();
   world.idle(2);  // the rig answers again: what it latched meanwhile (fault 4 after a lost link) is seen first
-  if (sup().latched()) {
+  const bool beyond = state == State::limit_recovery && (rig().position() > 10.0 || (sup().last_status().status & st::limit_tripped));
+  if (sup().latched() && !(beyond && (sup().last_status().status & st::limit_tripped))) {
     auto reset = world.w.push_rig_command(RigCommand::reset);
     world.idle(4);
     if (reset.wait_for(std::chrono::seconds(0)) != std::future_status::ready || reset.get().result != CommandOutcome::Result::done)
       fail("the operator's reset did not clear the latch");
   }
+  if (beyond) {  // the frame back into its stroke first, as the operator would
+    auto back = world.w.push_rig_command(RigCommand::recover);
+    for (int k = 0; k < 200 && back.wait_for(std::chrono::seconds(0)) != std::future_status::ready; ++k) world.idle(1);
+    if (back.wait_for(std::chrono::seconds(0)) != std::future_status::ready || back.get().result != CommandOutcome::Result::done)
+      fail("the frame was not brought back into its stroke after the event");
+  }
   world.idle(2);
-  const auto next = world.job(next_plan(rig().shaker));
+  auto plan = next_plan(rig().shaker);
+  if (state == State::limit_recovery) plan["limits"]["displacement_mm"] = {-0.5, 10};  // from 9.5 mm
+  const auto next = world.job(plan);
   const auto r = world.run(next, {});
   world.idle(1);
   (void)world.finish(false);

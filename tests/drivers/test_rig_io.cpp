@@ -495,7 +495,8 @@ TEST_CASE("controller: the e-stop and a latched fault stay until reset_faults; a
   CHECK(sim.control("fault latch 0").rfind("error fault 'latch'", 0) == 0);
 }
 
-TEST_CASE("controller: a limit trip stays latched after a reset while the frame is beyond the limit") {
+TEST_CASE("controller: beyond the limit a reset enters limit recovery: limit_tripped stays, and the frame comes back only inward, slowly") {
+  namespace st = protocols::status;
   SimProcess sim({"--port", "0", "--noise", "0", "--time-scale", "10"});
   ModbusRig rig(tcp_config(sim.modbus_port));
   REQUIRE_FALSE(rig.connect(steady_now()));
@@ -506,14 +507,22 @@ TEST_CASE("controller: a limit trip stays latched after a reset while the frame 
   REQUIRE(s.fault_code == 1);
   CHECK(rig.fault_text(1) == "displacement limit tripped");
   CHECK(s.displacement_mm > 12.0);
-  CHECK((s.status_word & protocols::status::limit_tripped) != 0);
+  CHECK((s.status_word & st::limit_tripped) != 0);
   REQUIRE_FALSE(rig.reset_faults());
   sleep_ms(20);
   s = read_now(rig);
-  CHECK(s.fault_code == 1);
-  CHECK((s.status_word & (protocols::status::limit_tripped | protocols::status::fault)) ==
-        (protocols::status::limit_tripped | protocols::status::fault));
-  CHECK(s.displacement_mm < 12.2);  // held where it tripped
+  CAPTURE(s.displacement_mm);
+  CHECK(s.fault_code == 0);
+  CHECK((s.status_word & (st::ready | st::limit_tripped | st::fault | st::enabled)) == (st::ready | st::limit_tripped));
+  CHECK(s.displacement_mm > 12.0);  // held where it tripped
+  CHECK(s.displacement_mm < 12.3);
+  REQUIRE_FALSE(rig.arm(false));
+  REQUIRE_FALSE(rig.arm(true));  // a fresh enable: outward is taken as the limit
+  s = read_until(rig, [](const RigSample& r) { return (r.status_word & st::limit_tripped) == 0; });
+  CHECK(s.fault_code == 0);
+  CHECK(s.displacement_mm <= 12.0);
+  REQUIRE_FALSE(rig.command(9.0, 50.0));  // back within the stroke: as fast as asked again
+  CHECK(read_until(rig, [](const RigSample& r) { return r.displacement_mm < 9.01; }).fault_code == 0);
 }
 
 TEST_CASE("controller: the servo dead band leaves the frame short of its target, not moving") {

@@ -128,9 +128,10 @@ TEST_CASE("load frame: a latched fault holds, shows in the status word, and need
   CHECK((f.state().status_word & protocols::status::ready) != 0);
 }
 
-TEST_CASE("load frame: a limit trip stays latched after a reset while the frame is still beyond the limit") {
+TEST_CASE("load frame: a limit trip stays latched after a reset while the frame is beyond the limit, on a controller without limit recovery") {
   LoadFrameParams p = quiet();
   p.limit_mm = 2.0;
+  p.controller.limit_recovery = false;
   LoadFrameSim f(sma(), p);
   LoadFrameCommands c{5.0, 50.0, true, false, false};
   f.set_commands(c);
@@ -143,6 +144,67 @@ TEST_CASE("load frame: a limit trip stays latched after a reset while the frame 
   CHECK(f.state().fault_code == kDisplacementLimit);
   CHECK((f.state().status_word & protocols::status::limit_tripped) != 0);
   CHECK(f.state().displacement_mm < 2.1);
+}
+
+// A frame that left its stroke fast (at the valve's speed the actuator runs up to 0.45 mm past
+// the limit in its last sample) is reset into limit recovery and may only come back, slowly.
+TEST_CASE("load frame: limit recovery: after a reset beyond the stroke the frame moves only back, at most at the recovery rate") {
+  namespace st = protocols::status;
+  LoadFrameParams p = quiet();
+  p.limit_mm = 2.0;
+  LoadFrameSim f(sma(), p);
+  LoadFrameCommands c{5.0, 500.0, true, false, false};
+  f.set_commands(c);
+  run(f, 0.5);
+  REQUIRE(f.state().fault_code == kDisplacementLimit);
+  const double tripped_at = f.state().displacement_mm;
+  CAPTURE(tripped_at);
+  REQUIRE(tripped_at > 2.05);
+  c.fault_reset = true;  // the reset, enable still written high
+  f.set_commands(c);
+  run(f, 0.2);
+  CHECK(f.state().fault_code == kNoFault);
+  CHECK((f.state().status_word & (st::ready | st::limit_tripped)) == (st::ready | st::limit_tripped));
+  CHECK((f.state().status_word & (st::fault | st::enabled)) == 0);  // enable needs a fresh rising edge
+  CHECK(f.state().displacement_mm == doctest::Approx(tripped_at));
+  c = {5.0, 500.0, false, false, false};
+  f.set_commands(c);
+  c.enable = true;  // outward, fast: taken as the limit, at the recovery rate
+  f.set_commands(c);
+  CHECK((f.state().status_word & st::enabled) != 0);
+  run(f, 0.02);
+  const double moved = tripped_at - f.state().displacement_mm;
+  CHECK(moved > 0.0);
+  CHECK(moved <= 0.02 * p.recovery_rate_mm_s + 1e-9);
+  f.overtravel(4.0);  // pushed out again from outside: trips once more
+  run(f, 0.1);
+  CHECK(f.state().fault_code == kDisplacementLimit);
+  CHECK((f.state().status_word & st::fault) != 0);
+  CHECK(f.state().displacement_mm < tripped_at + 0.2);
+  c.fault_reset = false, c.enable = false;
+  f.set_commands(c);
+  c.fault_reset = true;
+  f.set_commands(c);
+  c.fault_reset = false, c.enable = true, c.setpoint_mm = 0.0;  // back in: slowly while beyond, then as asked
+  f.set_commands(c);
+  const double x0 = f.state().displacement_mm;
+  run(f, 0.05);
+  CHECK(x0 - f.state().displacement_mm <= 0.05 * p.recovery_rate_mm_s + 1e-9);
+  run(f, 1.0);
+  CHECK((f.state().status_word & (st::limit_tripped | st::fault)) == 0);
+  CHECK(f.state().displacement_mm == doctest::Approx(0.0).epsilon(1e-3));
+}
+
+TEST_CASE("load frame: an overtravel pushes the idle frame out of its stroke and trips it there") {
+  LoadFrameParams p = quiet();
+  LoadFrameSim f(sma(), p);
+  f.overtravel(13.0);
+  run(f, 2.0);
+  CHECK(std::fabs(f.state().displacement_mm - 10.0) < 0.03);  // 5 mm/s for 2 s, nobody driving (0.025 mm of lag)
+  run(f, 1.0);
+  CHECK(f.state().fault_code == kDisplacementLimit);
+  CHECK(f.state().displacement_mm > 12.0);
+  CHECK(f.state().displacement_mm < 12.05);
 }
 
 TEST_CASE("load frame: the servo dead band leaves the frame short of the target, and not moving") {

@@ -33,7 +33,7 @@ class FakeDaemon final : public control::DaemonInterface {
     return h;
   }
   control::AcquisitionCounters rig_counters(std::size_t) const override { return {5000, 1979, 4, 0, 0, 0}; }
-  std::size_t rig_index(const std::string& name) const override {
+  std::size_t rig_index(const std::string& name, std::string_view) const override {
     if (!name.empty() && name != "fake frame") throw std::invalid_argument("rig: no rig named '" + name + "'");
     return 0;
   }

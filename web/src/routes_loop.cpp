@@ -86,7 +86,8 @@ json loop_json(db::Store& store, XYCache& cache, std::int64_t run_id, std::size_
 }
 
 json preview_json(ApiContext& c, const PlanRequest& req) {
-  const control::RigInfo rig = c.daemon.rig_info(c.daemon.rig_index(req.rig));
+  const std::string kind = req.plan.is_object() && req.plan.contains("kind") && req.plan["kind"].is_string() ? req.plan["kind"].get<std::string>() : "";
+  const control::RigInfo rig = c.daemon.rig_info(c.daemon.rig_index(req.rig, kind));
   std::unique_ptr<models::HysteresisModel> model;
   std::string source;
   if (rig.kind != "shaker") {

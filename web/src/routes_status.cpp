@@ -46,6 +46,14 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
                  {"moving", (w & stb::moving) != 0}, {"known", sv.have_sample}};
   j["resetting"] = sv.resetting;
   j["reset_refusal"] = sv.reset_refusal.empty() ? json(nullptr) : json(sv.reset_refusal);
+  j["recovering"] = sv.recovering;
+  j["recovery_result"] = sv.recovery_result.empty() ? json(nullptr) : json(sv.recovery_result);
+  // A load frame latched beyond its stroke (a reset cannot clear it), or idle outside the
+  // configured stroke: POST .../recover brings it back.
+  const json& stroke = sv.envelope.is_object() ? sv.envelope.value("stroke_mm", json()) : json();
+  const bool outside = stroke.is_array() && stroke.size() == 2 && (sv.position_mm < stroke[0].get<double>() || sv.position_mm > stroke[1].get<double>());
+  j["recoverable"] = info.kind != "shaker" && sv.have_sample && !sv.recovering &&
+                     ((sv.latched && (w & stb::limit_tripped) != 0) || (!sv.latched && sv.state == "idle" && outside));
   j["link_losses"] = sv.link_losses;
   j["transitions"] = sv.recent;
   j["envelope"] = sv.envelope;
@@ -195,10 +203,14 @@ void add_status_routes(httplib::Server& s, ApiContext& c) {
     send_json(res, rig_json(c.daemon, rig_of(c, req.matches[1].str())));
   }));
   // The operator's e-stop and reset: straight to the rig's thread, whatever runs (or nothing).
-  post_route(s, c, R"(/api/rigs/([^/]+)/(reset|estop))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+  // recover: a load frame latched beyond its stroke, brought back into it at the safe rate.
+  post_route(s, c, R"(/api/rigs/([^/]+)/(reset|estop|recover))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     const std::size_t k = rig_of(c, req.matches[1].str());
     const std::string verb = req.matches[2].str();
-    const control::CommandOutcome o = c.daemon.rig_command(k, verb == "reset" ? control::RigCommand::reset : control::RigCommand::estop);
+    const control::RigCommand command = verb == "reset"   ? control::RigCommand::reset
+                                        : verb == "estop" ? control::RigCommand::estop
+                                                          : control::RigCommand::recover;
+    const control::CommandOutcome o = c.daemon.rig_command(k, command);
     send_outcome(res, json{{"rig", c.daemon.rig_info(k).name}, {"command", verb}}, o);
   }));
   s.Get("/metrics", guarded([&c](const httplib::Request&, httplib::Response& res) {

@@ -62,9 +62,15 @@ export class RigPanel {
       reset: el('button', { class: 'reset', type: 'button', onclick: () => {
         if (window.confirm(`Reset the e-stop of "${r.name}"? Make sure the rig and the specimen are safe first.`)) this.command(r.name, 'reset');
       } }, 'Reset…'),
+      // A frame beyond its stroke (or idle outside it): back at the safe rate through the
+      // controller's limit recovery; E-STOP stops it on the way.
+      recover: el('button', { class: 'reset', type: 'button', onclick: () => {
+        if (window.confirm(`Bring "${r.name}" back into its stroke at the safe rate? Make sure nothing is in the way; E-STOP stops it.`))
+          this.command(r.name, 'recover');
+      } }, 'Bring back into stroke…'),
       error: el('div', { class: 'error' }),
     };
-    c.latch = el('div', { class: 'latch', role: 'alert' }, c.reason, ' ', c.reset, c.refusal);
+    c.latch = el('div', { class: 'latch', role: 'alert' }, c.reason, ' ', c.reset, ' ', c.recover, c.refusal);
     c.root = el('div', { class: 'rig', 'data-rig': r.name },
       el('div', { class: 'rig-head' }, c.name, c.kind, c.state, c.estop),
       el('div', { class: 'rig-live' }, c.live, c.bits), c.health, c.envelope, c.latch, c.error);
@@ -94,12 +100,15 @@ export class RigPanel {
         `longest ${round2((h.max_transaction_us || 0) / 1000)} ms, late wake-ups ${count(r.late_wakeups || 0)}`;
       const env = r.envelope || {};
       c.envelope.textContent = Object.keys(env).length ? 'envelope: ' + Object.entries(env).map(([k, v]) => envelopeItem(k, v)).join(' · ') : '';
-      c.latch.hidden = !r.latched;
+      c.latch.hidden = !r.latched && !r.recoverable && !r.recovering;
+      c.recover.hidden = !r.recoverable && !r.recovering;
+      c.recover.disabled = !!r.recovering;
+      c.recover.textContent = r.recovering ? 'bringing back…' : 'Bring back into stroke…';
       c.root.classList.toggle('latched', !!r.latched);
       c.reason.textContent = r.latched ? `LATCHED: ${r.latch_reason || 'e-stop or fault'}` + (r.fault && r.fault.text ? ` — fault ${r.fault.code}: ${r.fault.text}` : '') : '';
       c.reset.disabled = !!r.resetting;
       c.reset.textContent = r.resetting ? 'resetting…' : 'Reset…';
-      c.refusal.textContent = r.reset_refusal || '';
+      c.refusal.textContent = r.reset_refusal || (r.recoverable && !r.latched ? `outside its stroke at ${round2(r.sample ? r.sample.displacement_mm : NaN)} mm` : '');
       c.error.textContent = this.errors.get(r.name) || '';
     }
     for (const [name, c] of this.cards) if (!this.rig(name)) { c.root.remove(); this.cards.delete(name); }

@@ -108,7 +108,7 @@ class Daemon {
   [[nodiscard]] drivers::IoHealthSnapshot rig_health(std::size_t k) const;
   [[nodiscard]] RigSupervision rig_supervision(std::size_t k) const;
   // The rig by name (empty: the only rig); throws std::invalid_argument naming it.
-  [[nodiscard]] std::size_t rig_index(const std::string& name) const;
+  [[nodiscard]] std::size_t rig_index(const std::string& name, std::string_view plan_kind = {}) const;
   [[nodiscard]] db::WriterStats writer_stats() const;
   [[nodiscard]] double uptime_s() const noexcept;
 

@@ -86,6 +86,19 @@ class Supervisor {
   void begin_reset(double now);
   [[nodiscard]] bool resetting() const noexcept { return resetting_; }
   [[nodiscard]] const std::string& reset_refusal() const noexcept { return reset_refusal_; }
+  // Limit recovery, a real frame's limit override: a load frame latched for a tripped limit is
+  // reset into its controller's limit recovery, enabled, ramped at the safe rate to the nearest
+  // point 0.5 mm inside the configured stroke [stroke_min, stroke_max], then disabled, and unlatched
+  // once the rig reports it within its limits; a frame not latched but outside the configured
+  // stroke (left there by an e-stop on the way back) is ramped back alike. Every stop wins meanwhile: an e-stop latches as
+  // ever; a fault, not-ready, a dropped enable, motion away from the target, a lost link or the
+  // time running out holds and disables it, and the rig stays latched with recovery_result().
+  // Refused (the reason returned, nothing written) when it does not apply.
+  [[nodiscard]] std::optional<std::string> begin_recovery(double now, double stroke_min_mm, double stroke_max_mm);
+  [[nodiscard]] bool recovering() const noexcept { return recovery_ != Recovery::none; }
+  [[nodiscard]] const std::string& recovery_result() const noexcept { return recovery_result_; }
+  // The last status the supervisor saw (what a command that depends on it decides from).
+  [[nodiscard]] const StatusView& last_status() const noexcept { return last_; }
   // The host heartbeat, at its period (skipped for good when the rig has none), on the host's
   // monotonic clock in seconds, not the rig's: at time scale 200 a rig-time period of 100 ms came
   // every tick, doubled the Modbus traffic and gave write timeouts (stop 16's campaign tests).
@@ -105,6 +118,12 @@ class Supervisor {
   std::optional<std::string> check_bits(double now, const StatusView& v);
   void reset_step(double now, const StatusView& v);
   void disarm_at(double now, const std::string& reason);
+  enum class Recovery : std::uint8_t { none, resetting, enabling, moving };
+  void recovery_step(double now, const StatusView& v);
+  void recovery_enable(double now, const StatusView& v);
+  bool recovery_moving(double now, const StatusView& v);
+  void recovery_done(double now, const std::string& result);
+  void recovery_failed(double now, const std::string& why);
 
   drivers::Rig* rig_;
   double offset_ = 0;
@@ -129,6 +148,11 @@ class Supervisor {
   std::uint32_t heartbeat_count_ = 0;
   std::uint64_t link_losses_ = 0;
   bool estop_confirmed_ = false;
+  StatusView last_;
+  bool have_last_ = false;
+  Recovery recovery_ = Recovery::none;
+  double recovery_target_ = 0, recovery_closest_ = 0, recovery_deadline_ = 0, stroke_min_ = 0, stroke_max_ = 0;
+  std::string recovery_result_;
 };
 
 }  // namespace hystlab::daemon

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "hystlab/control/values.hpp"
@@ -25,8 +26,9 @@ class DaemonInterface {
   [[nodiscard]] virtual RigSupervision rig_supervision(std::size_t rig) const = 0;
   [[nodiscard]] virtual LinkHealth rig_health(std::size_t rig) const = 0;
   [[nodiscard]] virtual AcquisitionCounters rig_counters(std::size_t rig) const = 0;
-  // The rig by name (empty: the only rig); throws std::invalid_argument naming it.
-  [[nodiscard]] virtual std::size_t rig_index(const std::string& name) const = 0;
+  // The rig by name; empty: the only rig, or the only one that can run a plan of plan_kind (a
+  // sine plan: a shaker; any other: a load frame). Throws std::invalid_argument naming the rigs.
+  [[nodiscard]] virtual std::size_t rig_index(const std::string& name, std::string_view plan_kind = {}) const = 0;
   // reset or estop a rig: straight to its thread, which reads its commands every period in every
   // state (idle, arming, running, paused, safing, a campaign being finished). Returns once carried
   // out (an e-stop latched and seen in the rig's status word; a reset confirmed by the rig) or

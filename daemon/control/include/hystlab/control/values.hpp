@@ -29,8 +29,9 @@ struct RigInfo {
   bool simulated = false;
 };
 
-// Operator commands for a rig itself, whatever campaign runs (or none).
-enum class RigCommand { reset, estop };
+// Operator commands for a rig itself, whatever campaign runs (or none). recover: a load frame
+// latched beyond its stroke is brought back into it at the safe rate (limit recovery).
+enum class RigCommand { reset, estop, recover };
 
 // What became of an operator's command, as its answer says it (rig and campaign commands).
 struct CommandOutcome {
@@ -63,8 +64,9 @@ enum class CampaignCommand { pause, resume, abort, estop };
 // The rig's supervision (a copy, taken under a lock).
 struct RigSupervision {
   std::string state = "disconnected";  // the supervisor's RigState, as text at this edge
-  bool latched = false, resetting = false, have_sample = false;
+  bool latched = false, resetting = false, recovering = false, have_sample = false;
   std::string latch_reason, reset_refusal;
+  std::string recovery_result;  // the last limit recovery's outcome, in words
   std::uint16_t latched_fault_code = 0;  // the code that latched (0: an e-stop or none)
   std::uint16_t status_word = 0, fault_code = 0;  // the last sample's
   std::string fault_text;                          // the map's text for fault_code
