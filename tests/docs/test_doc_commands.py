@@ -2,7 +2,7 @@
 """Every command the docs give, run exactly as written against hystlabd on its embedded defaults.
 
 The commands are read from the docs themselves: every indented line of README.md and docs/*.md
-that starts with `curl ` or `build/` (a `\\` continues it on the next line). Each must be listed
+that starts with `curl `, `build/` or `mbpoll ` (a `\\` continues it on the next line). Each must be listed
 below with what its output must show, or as not run with the reason: a command added to the
 docs without a check here fails this test, so the docs cannot drift from what works.
 
@@ -37,7 +37,7 @@ def doc_commands():
         k = 0
         while k < len(lines):
             line = lines[k]
-            if re.match(r"^    (curl |build/)", line):
+            if re.match(r"^    (curl |build/|mbpoll )", line):
                 cmd = line[4:]
                 while cmd.rstrip().endswith("\\") and k + 1 < len(lines):
                     k += 1
@@ -115,17 +115,29 @@ CHECKS = {
     "curl -s $H/api/campaigns": ok_json(lambda j: [c["id"] for c in j][-2:] in ([1, 2], [2, 1]), "both campaigns listed"),
     "curl -s $H/api/campaigns/1": ok_json(lambda j: j["id"] == 1 and j["state"] == "completed" and len(j["tables"]) >= 2, "completed, with tables"),
     "curl -s $H/api/campaigns/1/nodes": ok_json(lambda j: len(j["nodes"]) >= 78, "the 78 nodes of n = 12"),
-    'curl -s "$H/api/runs/1/loop?points=2000"': ok_json(lambda j: 0 < len(j["displacement_mm"]) <= 2000, "at most 2000 points"),
-    'curl -s "$H/api/runs/1/samples?points=500"': ok_json(lambda j: 0 < len(j["t"]) <= 500, "at most 500 points"),
+    'curl -s "$H/api/runs/1/loop?points=2000"': ok_json(lambda j: 0 < len(j["x"]) <= 2000 and len(j["model"]["force_N"]) == len(j["x"]), "at most 2000 points, the model over them"),
+    'curl -s "$H/api/runs/1/samples?points=500"': ok_json(lambda j: 0 < len(j["displacement_max_mm"]) <= 500, "at most 500 buckets"),
     "curl -s -o run1.csv $H/api/runs/1/samples.csv": file_check("run1.csv", lambda d: d.count(b"\n") > 1000 and b"displacement" in d.split(b"\n")[0], "a CSV of the run"),
     "curl -s -o run1.h5 $H/api/runs/1/samples.h5": file_check("run1.h5", lambda d: d[:8] == b"\x89HDF\r\n\x1a\n", "an HDF5 file"),
-    'curl -s "$H/api/tables/2/score?run=2"': ok_json(lambda j: j["rms_N"] > 0, "a score on the validation run"),
+    'curl -s "$H/api/tables/2/score?run=2"': ok_json(lambda j: 0 < j["overall"]["rms_N"] < 20, "a score on the validation run"),
     'curl -s -OJ "$H/api/tables/1/export?format=m"': lambda rc, out, cwd: (
         assert_(rc == 0, "exit status %d" % rc), assert_(any(f.endswith(".m") for f in os.listdir(cwd)), "no .m file written")),
     "curl -s -X POST $H/api/evaluate -H 'Content-Type: application/json' -d '{\"table_id\": 1, \"displacement_mm\": [0, 1, 2, 3, 2, 1, 2]}'": ok_json(
         lambda j: len(j["force_N"]) == 7 and j["force_N"][3] > j["force_N"][1], "seven forces, rising with the input"),
     'curl -sN "$H/api/stream?rate=5"': lambda rc, out, cwd: assert_("event: hello" in out and "event: samples" in out, "hello and samples: " + out[:300]),
     "curl -s $H/metrics": lambda rc, out, cwd: assert_(rc == 0 and "hystlab_rig_latched" in out, "the rig gauges: " + out[:300]),
+    # README's models from the command line, with the reader's own files (my_path.csv,
+    # measured.csv) put where theirs would be.
+    "build/daemon/hystlab identify --model simplified --params ../shared/data/table1-params.json --range 0,4 --subdivisions 12 -o T12.json":
+        file_check("T12.json", lambda d: json.loads(d)["subdivisions"] == 12 and len(json.loads(d)["rows"]) > 0, "a table of n = 12"),
+    "build/daemon/hystlab eval --table T12.json --input my_path.csv -o predicted.csv":
+        file_check("predicted.csv", lambda d: d.count(b"\n") >= 200 and b"force_N" in d.split(b"\n")[0], "a force per input row"),
+    "build/daemon/hystlab compare --table T12.json --data measured.csv": lambda rc, out, cwd: assert_(
+        rc == 0 and re.search(r"^overall +253 +(\d+\.\d+)", out, re.M) and float(re.search(r"^overall +253 +(\d+\.\d+)", out, re.M)[1]) < 5,
+        "the table against the model it was identified from, within 5 N RMS: " + out[:400]),
+    # README's simulated frame polled with any Modbus client.
+    "build/drivers/sim/hystlab-sim --port 1502 --time-scale 1 &": lambda rc, out, cwd: assert_(rc == 0, "exit status %d" % rc),
+    "mbpoll -m tcp -0 -1 -t 3 -r 0 -c 12 -p 1502 127.0.0.1": lambda rc, out, cwd: assert_(rc == 0 and "[11]:" in out, "twelve registers: " + out[:300]),
 }
 NOT_RUN = {
     "build/daemon/hystlabd": "the daemon this test runs itself, on a free port (--port 0) instead of 8080",
@@ -138,17 +150,26 @@ def assert_(cond, why):
         raise AssertionError(why)
 
 
+BACKGROUND = []  # process groups a documented `... &` left running, stopped at the end
+
+
 def run(cmd, cwd, env, timeout=60):
-    stream = "-sN" in cmd  # an event stream never ends by itself: read 2.5 s of it
-    p = subprocess.Popen(["bash", "-c", cmd], cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
-    try:
-        out, _ = p.communicate(timeout=2.5 if stream else timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(p.pid, signal.SIGTERM)
-        out, _ = p.communicate()
-        if not stream:
-            raise AssertionError("did not finish within %d s" % timeout)
-    return p.returncode, out.decode("utf-8", "replace")
+    """Runs cmd as the docs write it, in bash; its output goes to a file (a background child may
+    hold it open). An event stream never ends by itself: 2.5 s of it are read."""
+    stream = "-sN" in cmd
+    out_path = os.path.join(cwd, ".out")
+    with open(out_path, "wb") as f:
+        p = subprocess.Popen(["bash", "-c", cmd], cwd=cwd, env=env, stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
+        if cmd.rstrip().endswith("&"):
+            BACKGROUND.append(p.pid)
+        try:
+            p.wait(timeout=2.5 if stream else timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGTERM)
+            p.wait()
+            if not stream:
+                raise AssertionError("did not finish within %d s" % timeout)
+    return p.returncode, open(out_path, "rb").read().decode("utf-8", "replace")
 
 
 def main():
@@ -160,9 +181,13 @@ def main():
     stale = [c for c in CHECKS if c not in documented]
     for c in stale:
         print("FAIL a checked command that the docs no longer give: " + c)
-    cwd = tempfile.mkdtemp(prefix="hystlab-docs-")
+    top = tempfile.mkdtemp(prefix="hystlab-docs-")  # top/main is the reader's clone, ../shared beside it
+    cwd = os.path.join(top, "main")
+    os.mkdir(cwd)
     os.symlink(os.path.join(REPO, "docs"), os.path.join(cwd, "docs"))
     os.symlink(BUILD, os.path.join(cwd, "build"))
+    os.symlink(os.path.abspath(os.path.join(REPO, "..", "shared")), os.path.join(top, "shared"))
+    readers_files(cwd)
     log = open(os.path.join(cwd, "daemon.log"), "wb")
     daemon = subprocess.Popen(["build/daemon/hystlabd", "--port", "0"], cwd=cwd, stdout=log, stderr=subprocess.STDOUT)
     failures = len(unknown) + len(stale)
@@ -179,12 +204,17 @@ def main():
             try:
                 CHECKS[cmd](rc, out, cwd)
                 print("ok   %5.2f s  %s" % (time.time() - t0, cmd))
-            except AssertionError as e:
+            except (AssertionError, KeyError, TypeError, IndexError) as e:  # a missing field is a failure too
                 failures += 1
-                print("FAIL %s\n     %s" % (cmd, e))
+                print("FAIL %s\n     %s: %s\n     output: %s" % (cmd, type(e).__name__, e, out[:300]))
         for cmd, why in NOT_RUN.items():
             print("not run: %s (%s)" % (cmd, why))
     finally:
+        for pgid in BACKGROUND:
+            try:
+                os.killpg(pgid, signal.SIGTERM)
+            except ProcessLookupError:
+                pass
         daemon.send_signal(signal.SIGTERM)
         try:
             daemon.wait(timeout=30)
@@ -196,6 +226,23 @@ def main():
     return 1 if failures else 0
 
 
+def readers_files(cwd):
+    """A displacement path (a 0-4 mm loop and a rise to 2 mm) and a 'measured' loop over it, as a
+    reader's own CSV files (docs/FORMATS.md)."""
+    xs = [4 * k / 100 for k in range(101)] + [4 - 4 * k / 100 for k in range(101)] + [2 * k / 50 for k in range(51)]
+    with open(os.path.join(cwd, "my_path.csv"), "w") as f:
+        f.write("displacement_mm\n" + "".join("%.4f\n" % x for x in xs))
+    # The 'measurement': the simplified model (Table 1) along that path, as a rig would give it.
+    subprocess.run(["build/daemon/hystlab", "eval", "--model", "simplified", "--params", "../shared/data/table1-params.json",
+                    "--input", "my_path.csv", "-o", "measured.csv"], cwd=cwd, check=True, stdout=subprocess.DEVNULL)
+
+
+def port_open(port):
+    import socket
+    with socket.socket() as s:
+        return s.connect_ex(("127.0.0.1", port)) == 0
+
+
 def before(cmd, h):
     """What the user would do between the documented commands (through the API, not a doc line)."""
     if "/campaigns/1/pause" in cmd:
@@ -205,6 +252,8 @@ def before(cmd, h):
         api(h, "/api/campaigns/1/resume", "POST")
     if cmd == "curl -s $H/api/campaigns":
         api(h, "/api/campaigns/2/abort", "POST")
+    if cmd.startswith("mbpoll "):
+        wait("hystlab-sim on port 1502", lambda: port_open(1502), 20)
     if cmd == "curl -s $H/api/campaigns/1":
         wait("campaign 1 to complete", lambda: api(h, "/api/campaigns/1").get("final"), 600)
 
