@@ -32,6 +32,7 @@ class FakeRig final : public drivers::Rig {
   struct Log {
     int setpoints_while_latched = 0, enables_while_latched = 0, resets = 0, hold_writes = 0, estop_writes = 0;
     int mode_writes = 0, heartbeats = 0, disables = 0, drive_writes = 0, drives_while_latched = 0;
+    int zero_drives = 0;  // a shaker's drive written with zero amplitude (its hold)
     std::vector<double> setpoints;
   } log;
   double deadband_mm = 0, rate_cap_mm_s = 500, dt = 0.001;
@@ -98,6 +99,7 @@ class FakeRig final : public drivers::Rig {
     if (!shaker) return RigError::unsupported;
     if (auto ec = link()) return ec;
     ++log.drive_writes;
+    if (amplitude_mm == 0) ++log.zero_drives;
     if ((estop_ || fault_) && amplitude_mm > 0) ++log.drives_while_latched;
     if (enable && !enable_) enabled_at_ = now_;
     if (!enable) ++log.disables;

@@ -54,13 +54,13 @@ bool stop_event(Event e) {
 
 // What the host has written so far, to see the first safe write after an event.
 struct Writes {
-  int estops = 0, holds = 0, disables = 0, drives = 0;
+  int estops = 0, holds = 0, disables = 0, zero_drives = 0;
   std::size_t setpoints = 0;
   explicit Writes(const FakeRig& r)
-      : estops(r.log.estop_writes), holds(r.log.hold_writes), disables(r.log.disables), drives(r.log.drive_writes), setpoints(r.log.setpoints.size()) {}
+      : estops(r.log.estop_writes), holds(r.log.hold_writes), disables(r.log.disables), zero_drives(r.log.zero_drives), setpoints(r.log.setpoints.size()) {}
   bool safe_write_since(const Writes& b, const FakeRig& r) const {
     if (estops > b.estops || holds > b.holds || disables > b.disables) return true;
-    if (r.shaker) return drives > b.drives;
+    if (r.shaker) return zero_drives > b.zero_drives;  // the shaker's hold: zero amplitude (a new drive level is no stop)
     return setpoints > b.setpoints && std::fabs(r.log.setpoints.back()) < 1e-9;  // the safe ramp (to 0 mm)
   }
 };

@@ -167,31 +167,36 @@ TEST_CASE("the documented commands as written: curl -d '' reaches the e-stop; a 
   CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "aborted"; }, 30));
 }
 
-TEST_CASE("kill -9 loses at most 250 ms of samples wherever it lands (hystlabd at 1 kHz in real time: ramping, dwelling, paused)") {
-  for (const std::string phase : {"ramping", "dwelling", "paused"}) {
+TEST_CASE("kill -9 loses at most 250 ms of samples wherever it lands (hystlabd at 1 kHz in real time: preamble, training, ramping, "
+          "dwelling, paused, validation, safing)") {
+  for (const std::string phase : {"preamble", "training", "ramping", "dwelling", "paused", "validation", "safing"}) {
     CAPTURE(phase);
     test_support::DaemonProcess d(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1, "noise_N": 0}}]})");
     httplib::Client c("127.0.0.1", d.port());
     c.set_read_timeout(10, 0);
     json p = plan();
     p["sample_rate_hz"] = 1000;
+    p["training_cycles"] = 1;
+    p["validation"] = {{"reversals", 2}};
     auto r = c.Post("/api/campaigns", json{{"plan", p}}.dump(), "application/json");
     REQUIRE(r);
     REQUIRE(r->status == 201);
     auto rig = [&] { return json::parse(c.Get("/api/rigs/sim%20frame")->body); };
     auto wait_for = [&](const std::string& ph) {
-      for (int k = 0; k < 4000; ++k) {
+      for (int k = 0; k < 8000; ++k) {  // the validation run comes after about 20 s
         if (rig().value("phase", "") == ph) return true;
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
       return false;
     };
-    if (phase == "paused") {
+    if (phase == "paused" || phase == "safing") {
       REQUIRE(wait_for("ramping"));
-      REQUIRE(c.Post("/api/campaigns/1/pause", "", "application/json"));
+      if (phase == "safing") std::this_thread::sleep_for(std::chrono::milliseconds(800));  // 0.8 mm up: a safe ramp of 0.8 s
+      REQUIRE(c.Post(phase == "paused" ? "/api/campaigns/1/pause" : "/api/campaigns/1/abort", "", "application/json"));
     }
     REQUIRE(wait_for(phase));
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // some batches committed in the phase
+    // Some batches committed in the phase (the preamble's dwell and the abort's ramp are short).
+    std::this_thread::sleep_for(std::chrono::milliseconds(phase == "preamble" || phase == "safing" ? 100 : 300));
     const json now = rig();
     REQUIRE(now["sample"].is_object());
     const double acquired_t = now["sample"]["t"].get<double>();
