@@ -24,8 +24,9 @@ void on_signal(int) { g_stop = true; }
 const char* kHelp = R"(usage: hystlabd [--config hystlab.json] [--db PATH] [--port N] [--bind ADDRESS]
 
 Runs campaigns on rigs and stores everything in one SQLite file, and serves the HTTP/JSON API and
-the page (http://127.0.0.1:8080/ by default; --port 0 picks a free port). Without a config: one
-simulated load frame (hystlab-sim, started and supervised) and ./hystlab.db. Binding beyond
+the page (http://127.0.0.1:8080/ by default; --port 0 picks a free port). Without a config: a
+simulated load frame (time scale 10) and a simulated shaker (real time), each a hystlab-sim started
+and supervised, and ./hystlab.db; a plan without a rig goes to the one of its kind. Binding beyond
 loopback needs a token (http.token in the config, or $HYSTLAB_TOKEN). Submit and follow
 campaigns from the page, the API (docs/API.md) or 'hystlab campaign ...'. SIGTERM or SIGINT
 stops it cleanly.
