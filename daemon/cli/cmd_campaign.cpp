@@ -110,6 +110,9 @@ int print_preview(const nlohmann::json& p) {
   std::cout << p.value("kind", "") << " on '" << p.value("rig", "") << "': " << round_g(p.value("duration_s", 0.0)) << " s, "
             << p.value("samples", std::int64_t{0}) << " samples at " << round_g(p.value("sample_rate_hz", 0.0)) << " Hz";
   if (p.value("nodes", 0) > 0) std::cout << ", " << p.value("nodes", 0) << (p.value("kind", "") == "sine" ? " steps" : " FOT nodes");
+  if (const double scale = p.value("time_scale", 1.0); scale > 1)  // a simulator faster than real time
+    std::cout << "\n  the simulator runs " << round_g(scale) << "x faster than real time: " << round_g(p.value("wall_s", 0.0)) << " s of wall time, "
+              << p.value("stored_samples", std::int64_t{0}) << " samples stored (" << round_g(p.value("stored_rate_hz", 0.0)) << " Hz of rig time)";
   std::cout << "\n  peak speed " << round_g(p.value("peak_speed_mm_s", 0.0)) << " mm/s";
   if (p.contains("peak_force_N") && p["peak_force_N"].is_number())
     std::cout << ", peak force " << round_g(p["peak_force_N"].get<double>()) << " N (limit " << round_g(p.value("force_limit_N", 0.0)) << " N; from "

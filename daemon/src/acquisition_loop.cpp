@@ -102,6 +102,7 @@ void Loop::check_gap(double t) {
   ++result.gaps;
   result.gap_total_s += hole;
   result.longest_gap_s = std::max(result.longest_gap_s, hole);
+  mark.longest_gap_s = std::max(mark.longest_gap_s, hole);
   if (hole > 0.02) event("gap", {{"from_s", t - dt}, {"to_s", t}, {"length_ms", hole * 1e3}});
 }
 
@@ -433,23 +434,6 @@ void leave_rig(Loop& L) {
   sup.disarm(t, std::string("campaign ") + to_string(L.result.end) + (L.result.reason.empty() ? "" : ": " + L.result.reason));
 }
 
-// What the run's data can be trusted for, stored with it (the API shows it beside each result):
-// samples, missed deadlines, late wake-ups, samples the controller's buffer lost, I/O errors and
-// reconnects during the run, holes in the time axis, and the rate stored in rig time.
-void record_quality(Loop& L) {
-  const drivers::IoHealthSnapshot h = L.ctx.rig.health();
-  const RunnerResult& r = L.result;
-  const double span = std::isnan(L.last_t) ? 0.0 : L.last_t;
-  L.event("quality", {{"run", r.run_id}, {"samples", r.samples}, {"missed_deadlines", r.missed_deadlines}, {"late_wakeups", r.late_wakeups},
-                      {"dropped", r.dropped}, {"lost_samples", h.lost_samples - L.health0.lost_samples},
-                      {"io_errors", h.total_errors() - L.health0.total_errors()},
-                      {"timeouts", h.errors_of(drivers::RigError::timeout) - L.health0.errors_of(drivers::RigError::timeout)},
-                      {"reconnects", h.reconnects - L.health0.reconnects}, {"gaps", r.gaps}, {"gap_total_s", r.gap_total_s},
-                      {"longest_gap_s", r.longest_gap_s}, {"rig_seconds", span},
-                      {"rate_hz", span > 0 && r.samples > 1 ? static_cast<double>(r.samples - 1) / span : 0.0},
-                      {"requested_rate_hz", L.plan.sample_rate_hz}});
-}
-
 // drove: the loop ran on the rig (a resume with nothing left to drive has no quality of its own).
 void hand_off(Loop& L, Strategy& strategy, bool drove = true) {
   FinishJob fj;
@@ -503,14 +487,14 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
     return L.result;
   }
   L.state(db::CampaignState::arming, "started by the daemon");
-  const std::uint64_t dropped_before = ctx.writer.stats().dropped_full;
-  if (create_run(L) && arm(L)) {
+  L.dropped_before = ctx.writer.stats().dropped_full;
+  if (create_run(L) && (mark_run(L, L.result.run_id), arm(L))) {
     L.state(db::CampaignState::running, "armed");
     run_ticks(L, *strategy);
   }
   L.show_phase(CampaignPhase::none);
   leave_rig(L);
-  L.result.dropped = ctx.writer.stats().dropped_full - dropped_before;
+  L.result.dropped = ctx.writer.stats().dropped_full - L.dropped_before;
   if (L.result.gaps > 0 && L.result.end == CampaignEnd::completed)
     L.result.reason = std::to_string(L.result.gaps) + " gap(s) in the data, the longest " + std::to_string(static_cast<int>(L.result.longest_gap_s * 1e3)) + " ms";
   hand_off(L, *strategy);

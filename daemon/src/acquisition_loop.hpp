@@ -57,6 +57,15 @@ struct Loop {
   CampaignEnd safing_end = CampaignEnd::aborted;
   double last_t = NAN, spacing = 0;  // the time axis: the last sample's time and the expected spacing
   drivers::IoHealthSnapshot health0;  // the rig's I/O counters when the run began (the run's own are the difference)
+  // The run the quality figures are gathered for, and the counters when it began: the campaign's
+  // run and its validation run each get a record of their own (run_quality.cpp).
+  struct RunMark {
+    std::int64_t run = 0;
+    std::uint64_t samples = 0, missed = 0, late = 0, dropped = 0, gaps = 0;
+    double gap_total_s = 0, longest_gap_s = 0, t0 = 0;
+    drivers::IoHealthSnapshot health;
+  } mark;
+  std::uint64_t dropped_before = 0;  // the writer's drops when the campaign began
 
   [[nodiscard]] double rig_time() { return (ctx.clock.now() - wall0) * ctx.time_scale; }
   // The first end wins: a trip during an abort stays an abort with both reasons said.
@@ -87,5 +96,12 @@ struct Loop {
   static constexpr int kMaxLostCommands = 3;
   int lost_commands = 0;
 };
+
+// From here on the quality figures belong to `run` (the campaign's run, then its validation run).
+void mark_run(Loop& L, std::int64_t run);
+// The figures since mark_run, stored as the run's "quality" event: samples, missed deadlines,
+// late wake-ups, samples dropped or lost by the controller's buffer, I/O errors and reconnects,
+// holes in the time axis, and the rate stored in rig time.
+void record_quality(Loop& L);
 
 }  // namespace hystlab::daemon

@@ -325,6 +325,7 @@ void Daemon::run(const std::atomic<bool>& stop) {
 }
 
 const DaemonConfig& Daemon::config() const noexcept { return impl_->config; }
+double Daemon::rig_time_scale(std::size_t k) const { return impl_->workers.at(k)->entry.time_scale; }
 std::size_t Daemon::rig_count() const noexcept { return impl_->workers.size(); }
 const RigInfo& Daemon::rig_info(std::size_t k) const { return impl_->workers.at(k)->info; }
 const RigLive& Daemon::rig_live(std::size_t k) const { return impl_->workers.at(k)->live; }

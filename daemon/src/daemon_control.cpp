@@ -52,7 +52,10 @@ class DaemonControl final : public control::DaemonInterface {
 
   std::int64_t submit(const std::string& rig, const nlohmann::json& plan) override { return d_.submit(rig, plan); }
   control::PlanPreview preview(const std::string& rig, const nlohmann::json& plan, models::HysteresisModel* model) const override {
-    return preview_plan(d_.check_plan(rig, plan).first, model);
+    const auto [p, k] = d_.check_plan(rig, plan);
+    control::PlanPreview v = preview_plan(p, model);
+    v.time_scale = d_.rig_time_scale(k);
+    return v;
   }
   std::optional<control::FotGrid> fot_grid(const nlohmann::json& stored_plan) const override {
     const Plan p = parse_plan(stored_plan);

@@ -184,6 +184,8 @@ class RampStrategy final : public Strategy {
     validating_ = true;
     campaign_run_ = L.result.run_id;
     if (L.result.validation_run_id > 0) {
+      record_quality(L);  // the campaign's run is over: its figures, then the validation run's own
+      mark_run(L, L.result.validation_run_id);
       L.result.run_id = L.result.validation_run_id;
       L.next_seq = 0;
     }

@@ -54,6 +54,11 @@ TEST_CASE("a run's loop keeps every descent, with the model's force from the ser
   CHECK(p["duration_s"].get<double>() > 2 * 4.0);  // at least the four rises and descents of the top row
   CHECK(p["peak_force_N"].get<double>() > 10);
   CHECK(p["force_source"].get<std::string>().find("simplified") != std::string::npos);
+  // The rig is a simulator 20x faster than real time: the wall time and what is stored in rig time.
+  CHECK(p["time_scale"] == 20);
+  CHECK(p["wall_s"].get<double>() == doctest::Approx(p["duration_s"].get<double>() / 20));
+  CHECK(p["stored_rate_hz"].get<double>() == doctest::Approx(25));
+  CHECK(std::llabs(p["stored_samples"].get<long long>() - p["samples"].get<long long>() / 20) <= 1);
   json bad = test::fot_plan(4);
   bad["ramp_rate_mm_s"] = 1e6;
   r = post_json(c, "/api/plans/preview", {{"plan", bad}});
@@ -76,6 +81,19 @@ TEST_CASE("a run's loop keeps every descent, with the model's force from the ser
   CHECK(q["requested_rate_hz"] == 500);
   CHECK(q["warnings"].is_array());
   CHECK(camp["tables"][0]["warnings"].is_array());
+  // Quality per run: the campaign's run and the validation run each with its own figures, which
+  // count that run's stored samples (until stop 27 the first counted both and the second none).
+  REQUIRE(camp["runs"].size() == 2);
+  CHECK(camp["runs"][1]["role"] == "validation");
+  for (const json& run_j : camp["runs"]) {
+    CAPTURE(run_j.dump());
+    REQUIRE(run_j["quality"].is_object());
+    CHECK(run_j["quality"]["samples"] == run_j["samples"]);
+    // the simulator runs 20x faster than real time: 500 Hz of wall time is 25 Hz of rig time, as expected (no warning)
+    CHECK(run_j["quality"]["rate_hz"].get<double>() == doctest::Approx(25).epsilon(0.05));
+    CHECK(run_j["quality"]["expected_rate_hz"].get<double>() == doctest::Approx(25));
+    CHECK(run_j["quality"]["warnings"].empty());
+  }
 
   r = c.Get(("/api/runs/" + std::to_string(run) + "/loop?points=400").c_str());
   REQUIRE(r);

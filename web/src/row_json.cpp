@@ -33,9 +33,13 @@ json warnings_of(const json& q) {
   if (const auto gaps = count(q, "gaps"))
     w.push_back(std::to_string(gaps) + (gaps == 1 ? " hole" : " holes") + " in the time axis: longest " + round_s(q.value("longest_gap_s", 0.0)) +
                 ", " + round_s(q.value("gap_total_s", 0.0)) + " in all");
+  // A simulator faster than real time gives the plan's rate in wall time, time_scale times less
+  // in rig time: expected, said beside the rate, and no warning unless that was not kept either.
   const double rate = q.value("rate_hz", 0.0), asked = q.value("requested_rate_hz", 0.0);
-  if (rate > 0 && asked > 0 && std::abs(rate / asked - 1) > 0.05)
-    w.push_back("stored " + hz(rate) + " of rig time; the plan asked " + hz(asked));
+  const double scale = q.value("time_scale", 1.0), expected = q.value("expected_rate_hz", asked);
+  if (rate > 0 && expected > 0 && std::abs(rate / expected - 1) > 0.05)
+    w.push_back("stored " + hz(rate) + " of rig time; the plan asked " + hz(asked) +
+                (scale > 1 ? " (" + hz(expected) + " of rig time at this simulator's time scale)" : ""));
   return w;
 }
 }  // namespace

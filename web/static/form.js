@@ -294,11 +294,15 @@ function sinePlan(v) {
 }
 
 // "about 2 min 10 s · 45 nodes · peak speed 0.5 mm/s · peak force ≈ 380 N (from table #3)"; a sweep: steps and peak acceleration.
+// On a simulator faster than real time, the wall time it takes and what it stores in rig time.
 export function previewText(p) {
-  const parts = [`about ${duration(p.duration_s)}`];
+  const fast = p.time_scale > 1;
+  const parts = [fast ? `about ${duration(p.wall_s)} (${duration(p.duration_s)} of rig time: the simulator runs ${num(p.time_scale)}× faster than real time)`
+                      : `about ${duration(p.duration_s)}`];
   if (p.nodes != null) parts.push(`${count(p.nodes)} ${p.kind === 'sine' ? 'steps' : 'nodes'}`);
   if (p.peak_accel_m_s2 != null) parts.push(`peak acceleration ${num(p.peak_accel_m_s2, 2)} m/s² (${num(p.peak_accel_m_s2 / 9.80665, 2)} g)`);
-  if (p.samples != null) parts.push(`${count(p.samples)} samples`);
+  if (fast && p.stored_samples != null) parts.push(`${count(p.stored_samples)} samples (${num(p.stored_rate_hz)} Hz of rig time)`);
+  else if (p.samples != null) parts.push(`${count(p.samples)} samples`);
   if (p.peak_speed_mm_s != null) parts.push(`peak speed ${num(p.peak_speed_mm_s, 2)} mm/s`);
   if (p.peak_force_N != null) parts.push(`peak force ≈ ${round2(p.peak_force_N)} N${p.force_source ? ` (from ${p.force_source})` : ''}`);
   return parts.join(' · ');

@@ -6,11 +6,14 @@ import { el, count, num, plural } from './fmt.js';
 
 function rateText(q) {
   if (!Number.isFinite(q.rate_hz)) return null;
-  const asked = q.requested_rate_hz;
-  // Within 5 %: the plan's rate was kept; say so only when it was not.
-  if (Number.isFinite(asked) && Math.abs(q.rate_hz - asked) > 0.05 * asked)
-    return el('span', { class: 'bad', text: `stored ${num(q.rate_hz)} Hz of rig time (plan asked ${num(asked)} Hz)` });
-  return `${num(q.rate_hz)} Hz`;
+  const asked = q.requested_rate_hz, scale = q.time_scale > 1 ? q.time_scale : 1;
+  // What the rig can give: the plan's rate, or, on a simulator faster than real time, the plan's
+  // rate in wall time (time_scale times less in rig time). Within 5 % of it: kept.
+  const expected = Number.isFinite(q.expected_rate_hz) ? q.expected_rate_hz : asked;
+  const scaled = scale > 1 ? ` of rig time (the plan's ${num(asked)} Hz in wall time: a simulator ${num(scale)}× faster than real time)` : '';
+  if (Number.isFinite(expected) && Math.abs(q.rate_hz - expected) > 0.05 * expected)
+    return el('span', { class: 'bad', text: `stored ${num(q.rate_hz)} Hz of rig time (plan asked ${num(asked)} Hz${scale > 1 ? `, ${num(expected)} Hz at this time scale` : ''})` });
+  return `${num(q.rate_hz)} Hz${scaled}`;
 }
 const figure = (n, one, many) => el('span', { class: n ? 'bad' : '', text: plural(n || 0, one, many) });
 

@@ -109,6 +109,8 @@ class Daemon {
   [[nodiscard]] RigSupervision rig_supervision(std::size_t k) const;
   // The rig by name (empty: the only rig); throws std::invalid_argument naming it.
   [[nodiscard]] std::size_t rig_index(const std::string& name, std::string_view plan_kind = {}) const;
+  // Rig seconds per wall second of rig k (a simulator's time scale; 1 for a real rig).
+  [[nodiscard]] double rig_time_scale(std::size_t k) const;
   [[nodiscard]] db::WriterStats writer_stats() const;
   [[nodiscard]] double uptime_s() const noexcept;
 

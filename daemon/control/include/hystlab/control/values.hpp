@@ -115,6 +115,10 @@ struct PlanPreview {
   double peak_accel_m_s2 = 0;  // of the base (shakers)
   double samples = 0;          // duration × sample rate
   double sample_rate_hz = 0, force_limit_N = 0;  // the plan's
+  // Rig seconds per wall second (a simulator faster than real time): the campaign then takes
+  // duration_s / time_scale of wall time, and the host, sampling at sample_rate_hz of wall time,
+  // stores sample_rate_hz / time_scale of rig time.
+  double time_scale = 1;
 };
 
 // A FOT plan's grid: its nodes are on n = subdivisions steps of [lo_mm, hi_mm], or nodes_mm (a
