@@ -108,7 +108,10 @@ export class RigPanel {
       c.reason.textContent = r.latched ? `LATCHED: ${r.latch_reason || 'e-stop or fault'}` + (r.fault && r.fault.text ? ` — fault ${r.fault.code}: ${r.fault.text}` : '') : '';
       c.reset.disabled = !!r.resetting;
       c.reset.textContent = r.resetting ? 'resetting…' : 'Reset…';
-      c.refusal.textContent = r.reset_refusal || (r.recoverable && !r.latched ? `outside its stroke at ${round2(r.sample ? r.sample.displacement_mm : NaN)} mm` : '');
+      const at = `${round2(r.sample ? r.sample.displacement_mm : NaN)} mm`, rate = (r.supervision || {}).safe_rate_mm_s;
+      c.refusal.textContent = r.reset_refusal || (!r.recoverable ? '' : r.latched
+        ? `The frame is beyond its stroke at ${at}: a reset cannot clear that. Bring it back at the safe rate${rate ? ` (${num(rate)} mm/s)` : ''}; E-STOP stops it.`
+        : `The frame is outside its configured stroke at ${at}.`);
       c.error.textContent = this.errors.get(r.name) || '';
     }
     for (const [name, c] of this.cards) if (!this.rig(name)) { c.root.remove(); this.cards.delete(name); }
