@@ -144,6 +144,13 @@ std::vector<std::string> Store::event_details(std::int64_t campaign, const std::
   return all<std::string>(st, [](Statement& s) { return s.column_text(0); });
 }
 
+std::string Store::state_reason(std::int64_t campaign, CampaignState state) {
+  Statement st(db_, "SELECT coalesce(detail, '') FROM events WHERE campaign_id = ? AND kind = 'state' AND to_state = ? ORDER BY id DESC LIMIT 1");
+  st.bind(1, campaign);
+  st.bind(2, std::string_view(to_string(state)));
+  return st.step() ? st.column_text(0) : std::string();
+}
+
 std::vector<EventInfo> Store::events_after(std::int64_t id, int limit) {
   Statement st(db_, "SELECT id, coalesce(campaign_id, 0), at, kind, coalesce(from_state, ''), coalesce(to_state, ''), coalesce(detail, '') "
                     "FROM events WHERE id > ? ORDER BY id LIMIT ?");

@@ -130,6 +130,9 @@ TEST_CASE("operator e-stop in every phase of a campaign (hystlabd, hystlab-sim o
     CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["final"] == true; }, 30));
     const json camp = json::parse(c.Get(("/api/campaigns/" + std::to_string(id)).c_str())->body);
     CHECK((camp["state"] == "aborted" || camp["state"] == "failed"));
+    CHECK(camp["reason"].get<std::string>().find("e-stop") != std::string::npos);  // why, beside the state
+    const json listed = json::parse(c.Get("/api/campaigns")->body);
+    CHECK(listed.back()["reason"] == camp["reason"]);
     const auto reset = c.Post("/api/rigs/sim%20frame/reset", "", "application/json");
     REQUIRE(reset);
     CAPTURE(reset->body);

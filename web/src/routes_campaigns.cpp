@@ -75,6 +75,9 @@ json campaign_json(const control::DaemonInterface& d, db::Store& store, const db
   j["commands"] = commands;
   j["active"] = db::is_active(row.state);
   j["final"] = db::is_final(row.state);
+  // Why it is in this state (why it ended, was held, failed), beside the state wherever it is shown.
+  const std::string why = store.state_reason(row.id, row.state);
+  j["reason"] = why.empty() ? json(nullptr) : json(why);
   if (!details) {
     j["tables"] = store.table_count(row.id);
     return j;

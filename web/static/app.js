@@ -61,7 +61,8 @@ async function refreshList() {
   S.campaigns = await api('/api/campaigns');
   $('campaigns').replaceChildren(...S.campaigns.slice().reverse().map(c => {
     const li = el('li', { 'data-id': c.id, class: c.id === S.selected ? 'selected' : '',
-                          text: `#${c.id} ${c.kind} — ${c.state}` + (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : '') });
+                          text: `#${c.id} ${c.kind} — ${c.state}` + (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : ''),
+                          title: c.reason ? `${c.state}: ${c.reason}` : '' });
     li.addEventListener('click', serial(() => { S.follow = false; return select(c.id); }));
     return li;
   }));
@@ -110,6 +111,8 @@ async function refreshDetail() {
   $('title').textContent = `Campaign #${d.id}: ${d.kind} on ${d.rig}`;
   $('state').textContent = d.state;
   $('state').className = 'state ' + d.state;
+  // Why it is in that state, beside it (an aborted or failed campaign's reason, not at the bottom of the events).
+  $('state-reason').textContent = $('state-reason').title = d.reason && (d.final || d.state === 'held' || d.state === 'interrupted' || d.state === 'paused') ? d.reason : '';
   // The server says which commands apply in this state (GET /api/campaigns/ID: commands).
   const can = cmd => (d.commands || []).includes(cmd);
   $('pause').disabled = !can('pause');

@@ -167,6 +167,8 @@ class Store {
   [[nodiscard]] std::vector<LoopInfo> loops(std::int64_t campaign_id);  // every run's, by run and order of closing
   // Details of a campaign's events of one kind, oldest first.
   [[nodiscard]] std::vector<std::string> event_details(std::int64_t campaign_id, const std::string& kind);
+  // Why the campaign is in `state`: the reason of its newest transition there ("" when none).
+  [[nodiscard]] std::string state_reason(std::int64_t campaign_id, CampaignState state);
   // Records since an id, across campaigns, oldest first, at most limit (the event stream).
   [[nodiscard]] std::vector<EventInfo> events_after(std::int64_t id, int limit);
   [[nodiscard]] std::vector<NodeInfo> nodes_after(std::int64_t id, int limit);
