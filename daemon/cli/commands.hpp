@@ -21,6 +21,7 @@ int run_loops(const Args& args);
 int run_demo(const Args& args);
 int run_campaign_cmd(const Args& args);
 int run_rig_cmd(const Args& args);
+int run_report(const Args& args);
 int run_tables_cmd(const Args& args);
 int run_runs_cmd(const Args& args);
 int run_simulate(const Args& args);

@@ -79,6 +79,22 @@ nlohmann::json post_to_daemon(const DaemonAddress& to, const std::string& path, 
   return j;
 }
 
+std::string get_from_daemon(const DaemonAddress& to, const std::string& path) {
+  httplib::Client client(to.url);
+  client.set_connection_timeout(kConnectSeconds, 0);
+  client.set_read_timeout(kAnswerSeconds, 0);
+  httplib::Headers headers;
+  if (!to.token.empty()) headers.emplace("Authorization", "Bearer " + to.token);
+  const auto r = client.Get(path.c_str(), headers);
+  if (!r)
+    throw CliError("no hystlabd answers at " + to.url + " (" + failure_words(r.error()) +
+                   "): start it, or give its address with --daemon URL or $HYSTLAB_DAEMON");
+  if (r->status == 401)
+    throw CliError("hystlabd at " + to.url + " needs its token (" + api_reason(*r) + "): give it with --token or $HYSTLAB_TOKEN");
+  if (r->status < 200 || r->status >= 300) throw CliError(api_reason(*r));
+  return r->body;
+}
+
 std::string url_segment(const std::string& text) {
   static const char* hex = "0123456789ABCDEF";
   std::string out;

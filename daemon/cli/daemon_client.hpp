@@ -25,6 +25,9 @@ inline constexpr const char* kDefaultDaemonUrl = "http://127.0.0.1:8080";
 // user's words, when no daemon answers, or it refuses (the API's detail, which names the field).
 nlohmann::json post_to_daemon(const DaemonAddress& to, const std::string& path, const std::string& body);
 
+// GETs path and returns the answer's body (a report's HTML); CliErrors as post_to_daemon's.
+std::string get_from_daemon(const DaemonAddress& to, const std::string& path);
+
 // A path segment with everything but unreserved characters percent-encoded (a rig's name).
 [[nodiscard]] std::string url_segment(const std::string& text);
 

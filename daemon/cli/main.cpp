@@ -37,7 +37,8 @@ usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
   tables     list and export the tables hystlabd identified
   runs       export a run's samples as CSV, or a run or campaign as HDF5
   simulate   the base-excited isolator (sdof): time histories, transmissibility sweeps
-  export     a table or parameters as JSON, CSV, MATLAB/Octave or a C header
+  export     a table or parameters as JSON, CSV, MATLAB/Octave, a C header or an FMU
+  report     a campaign's report (HTML, or PDF through Chromium) from the running hystlabd
 )";
 
 int dispatch(const std::string& verb, const Args& args) {
@@ -56,6 +57,7 @@ int dispatch(const std::string& verb, const Args& args) {
   if (verb == "runs") return run_runs_cmd(args);
   if (verb == "simulate") return run_simulate(args);
   if (verb == "export") return run_export(args);
+  if (verb == "report") return run_report(args);
   throw CliError("unknown verb '" + verb + "' (hystlab --help lists them)");
 }
 }  // namespace

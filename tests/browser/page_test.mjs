@@ -99,6 +99,29 @@ async function checkServerFieldError(page) {
   await page.fill('input[name=hi]', '4');
 }
 
+// The sticky header (the rigs with their E-STOP, the campaign's controls) leaves the screen to
+// the work: at most about 12 % of the viewport from 800 px up, every E-STOP inside it; a rig's
+// card opened (▸) shows its status bits, link and envelope.
+async function checkHeaderShare(page) {
+  const before = page.viewportSize();
+  for (const [w, h] of [[800, 700], [1280, 800], [2560, 1440]]) {
+    await page.setViewportSize({ width: w, height: h });
+    await page.waitForTimeout(200);
+    const m = await page.evaluate(() => {
+      const top = document.getElementById('top').getBoundingClientRect();
+      const stops = [...document.querySelectorAll('#top button.estop')].map(b => b.getBoundingClientRect());
+      return { header: top.height, inside: stops.every(b => b.bottom <= top.bottom && b.right <= window.innerWidth), height: window.innerHeight };
+    });
+    await page.screenshot({ path: path.join(outDir, `header-${w}x${h}.png`) });
+    check(m.header / m.height <= 0.13 && m.inside, `the header takes ${Math.round(m.header)} px of ${m.height} at ${w}x${h} (${(100 * m.header / m.height).toFixed(1)} %), every E-STOP in it`);
+  }
+  const card = page.locator('.rig[data-rig="sim frame"]');
+  await card.locator('button.more').click();
+  check(await card.locator('.health').isVisible() && await card.locator('.bits').isVisible(), 'an opened rig card shows its status bits and link health');
+  await card.locator('button.more').click();
+  await page.setViewportSize(before);
+}
+
 // E-STOP from the rig panel **while a campaign runs** (it once did nothing then: the rig's
 // commands were read only between campaigns): the campaign ends aborted, the rig latches, the page
 // shows it within a second, the reason shown, Submit refused; Reset asks first, then the latch
@@ -381,6 +404,7 @@ try {
   check(await wait(page, () => window.hystlab.rigs().length === 2 && document.querySelectorAll('.rig button.estop').length === 2, null, 'rig panel'),
         'the rig panel shows both rigs, each with its E-STOP');
   check(/x -?\d+\.\d+ mm · F -?\d+\.\d N/.test(await page.textContent('.rig[data-rig="sim frame"] .live')), 'the rig panel shows the live position and force');
+  await checkHeaderShare(page);
 
   if (!only.length) {
     // 0. The form checks its fields before sending anything.

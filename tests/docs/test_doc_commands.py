@@ -17,6 +17,7 @@ usage: test_doc_commands.py REPO BUILD_DIR
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -126,6 +127,9 @@ CHECKS = {
         lambda j: len(j["force_N"]) == 7 and j["force_N"][3] > j["force_N"][1], "seven forces, rising with the input"),
     'curl -sN "$H/api/stream?rate=5"': lambda rc, out, cwd: assert_("event: hello" in out and "event: samples" in out, "hello and samples: " + out[:300]),
     "curl -s $H/metrics": lambda rc, out, cwd: assert_(rc == 0 and "hystlab_rig_latched" in out, "the rig gauges: " + out[:300]),
+    "curl -s -o report1.html $H/api/campaigns/1/report.html": file_check(
+        "report1.html", lambda d: b"<h2>Identification</h2>" in d and b"Recommended: table #" in d and d.count(b"<svg") >= 2, "the report's sections and figures"),
+    "build/daemon/hystlab report 1 -o report1.pdf": lambda rc, out, cwd: pdf_pages(rc, out, cwd, "report1.pdf"),
     # README's models from the command line, with the reader's own files (my_path.csv,
     # measured.csv) put where theirs would be.
     "build/daemon/hystlab identify --model simplified --params ../shared/data/table1-params.json --range 0,4 --subdivisions 12 -o T12.json":
@@ -143,6 +147,20 @@ NOT_RUN = {
     "build/daemon/hystlabd": "the daemon this test runs itself, on a free port (--port 0) instead of 8080",
     "build/daemon/hystlabd --config hystlab.json": "the reader's own config file; docs/examples/hystlab.json is parsed by tests/daemon/test_daemon.cpp",
 }
+
+
+def pdf_pages(rc, out, cwd, name):
+    """A PDF that Chromium printed, turned into PNG pages (pdftoppm, when installed) kept in the
+    build tree to be looked at: BUILD/tests/doc_commands/NAME-N.png."""
+    assert_(rc == 0, "exit status %d: %s" % (rc, out[:300]))
+    data = open(os.path.join(cwd, name), "rb").read()
+    assert_(data[:5] == b"%PDF-" and len(data) > 20000, "not a PDF of a report (%d bytes)" % len(data))
+    if shutil.which("pdftoppm"):
+        keep = os.path.join(BUILD, "tests", "doc_commands")
+        os.makedirs(keep, exist_ok=True)
+        subprocess.run(["pdftoppm", "-png", "-r", "60", os.path.join(cwd, name), os.path.join(keep, name[:-4])], check=True)
+        pages = [f for f in os.listdir(keep) if f.startswith(name[:-4]) and f.endswith(".png")]
+        assert_(len(pages) >= 2, "the report printed on %d page(s)" % len(pages))
 
 
 def assert_(cond, why):
@@ -222,6 +240,7 @@ def main():
             daemon.kill()
         if failures:
             print(open(os.path.join(cwd, "daemon.log"), errors="replace").read()[-4000:])
+        shutil.rmtree(top, ignore_errors=True)
     print("%d documented commands, %d checked, %d failed" % (len(documented), len(CHECKS), failures))
     return 1 if failures else 0
 

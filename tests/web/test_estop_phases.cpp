@@ -133,6 +133,9 @@ TEST_CASE("operator e-stop in every phase of a campaign (hystlabd, hystlab-sim o
     CHECK(camp["reason"].get<std::string>().find("e-stop") != std::string::npos);  // why, beside the state
     const json listed = json::parse(c.Get("/api/campaigns")->body);
     CHECK(listed.back()["reason"] == camp["reason"]);
+    // Its report says how it ended and why.
+    const std::string report = c.Get(("/api/campaigns/" + std::to_string(id) + "/report.html").c_str())->body;
+    CHECK(report.find("<span class=\"state\">" + camp["state"].get<std::string>() + "</span> " + camp["reason"].get<std::string>()) != std::string::npos);
     const auto reset = c.Post("/api/rigs/sim%20frame/reset", "", "application/json");
     REQUIRE(reset);
     CAPTURE(reset->body);

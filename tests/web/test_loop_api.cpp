@@ -95,6 +95,33 @@ TEST_CASE("a run's loop keeps every descent, with the model's force from the ser
     CHECK(run_j["quality"]["warnings"].empty());
   }
 
+  // The report: every section, and the numbers the API gives, rounded for people.
+  const auto report = c.Get("/api/campaigns/1/report.html");
+  REQUIRE(report);
+  CHECK(report->status == 200);
+  const std::string& html = report->body;
+  for (const char* part : {"Campaign #1: FOT identification on sim frame", "<h2>Rig and plan</h2>", "Data quality, per run", "<h2>Identification</h2>",
+                           "The Everett table measured by the FOT input", "Tables, scored on the held-out validation run", "Loop figures, per closed cycle",
+                           "<h2>Record</h2>", "(recommended)"}) {
+    CAPTURE(part);
+    CHECK(html.find(part) != std::string::npos);
+  }
+  CHECK(html.find("<svg") != std::string::npos);
+  REQUIRE(camp["recommendation"].is_object());
+  CHECK(html.find("Recommended: table #" + std::to_string(camp["recommendation"]["table"].get<int>())) != std::string::npos);
+  for (const json& t : camp["tables"]) {
+    char rms[32];
+    std::snprintf(rms, sizeof rms, "%.3g N", t["accuracy"]["held_out"]["overall"]["rms_N"].get<double>());
+    CAPTURE(rms);
+    CHECK(html.find(rms) != std::string::npos);  // each table's held-out RMS, as the API gives it
+  }
+  const json loops = json::parse(c.Get("/api/campaigns/1/loops")->body);
+  const std::size_t cycles_at = html.find("Loop figures, per closed cycle");
+  std::size_t tr = 0;
+  for (std::size_t at = html.find("<tr>", cycles_at); at != std::string::npos && at < html.find("</table>", cycles_at); at = html.find("<tr>", at + 1)) ++tr;
+  CHECK(tr == loops.size() + 1);  // a row per closed cycle, and the header
+  CHECK(c.Get("/api/campaigns/99/report.html")->status == 404);
+
   r = c.Get(("/api/runs/" + std::to_string(run) + "/loop?points=400").c_str());
   REQUIRE(r);
   REQUIRE(r->status == 200);

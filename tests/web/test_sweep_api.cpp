@@ -38,6 +38,18 @@ TEST_CASE("a sweep through the API: points, prediction, resonance report, CSVs w
   CHECK(sweep["measured"]["curves"][0]["amplitude_mm"] == 0.005);
   CHECK(sweep["measured"]["compared"] == 1);
   CHECK(sweep["predicted"].is_object());
+  // The report: the transmissibility and phase as vector graphics, the resonance table, the jumps.
+  const auto report = c.Get(("/api/campaigns/" + id + "/report.html").c_str());
+  REQUIRE(report);
+  CHECK(report->status == 200);
+  CHECK(report->get_header_value("Content-Type").find("text/html") == 0);
+  for (const char* part : {"<h2>Transmissibility</h2>", "<h3>Resonances</h3>", "<h3>Jumps (up against down)</h3>", "Data quality, per run", "(predicted)"}) {
+    CAPTURE(part);
+    CHECK(report->body.find(part) != std::string::npos);
+  }
+  CHECK(std::count(report->body.begin(), report->body.end(), '<') > 100);
+  CHECK(report->body.find("<svg") != std::string::npos);
+  CHECK(report->body.find("<script") == std::string::npos);  // self-contained, nothing runs
   CHECK(sweep["jump_threshold"] == doctest::Approx(0.10));
   r = c.Get(("/api/campaigns/" + id + "/sweep.csv").c_str());
   REQUIRE(r->status == 200);

@@ -62,6 +62,7 @@ HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg) : 
   add_loop_routes(s, m.ctx);
   add_sweep_routes(s, m.ctx);
   add_h5_routes(s, m.ctx);
+  add_report_routes(s, m.ctx);
   add_stream_route(s, m.ctx);
   const std::string vendor = default_dir(cfg.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT), root = default_dir(cfg.web_root, "", HYSTLAB_WEB_ROOT);
   if (!s.set_mount_point("/vendor/uplot", vendor))

@@ -43,6 +43,8 @@ json last_fit(db::Store& store, std::int64_t campaign) {
   return fits.empty() ? json(nullptr) : parse_or_text(fits.back());
 }
 
+}  // namespace
+
 json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row) {
   json nodes = json::array();
   for (const db::NodeInfo& n : store.nodes(row.id)) nodes.push_back(node_json(n));
@@ -64,7 +66,26 @@ json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::C
   out["coverage"] = static_cast<double>(seen.size()) / static_cast<double>(required);
   return out;
 }
-}  // namespace
+
+json events_json(db::Store& store, std::int64_t campaign) {
+  json out = json::array();
+  for (const auto& e : store.events(campaign))
+    out.push_back({{"id", e.id}, {"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", parse_or_text(e.detail)}});
+  return out;
+}
+
+json loops_json(db::Store& store, std::int64_t campaign) {
+  json out = json::array();
+  for (const db::LoopInfo& l : store.loops(campaign)) {
+    json j = parse_or_text(l.figures_json);
+    if (!j.is_object()) continue;
+    j["run"] = l.run;
+    j["k"] = l.k;
+    j["phase"] = l.phase;
+    out.push_back(std::move(j));
+  }
+  return out;
+}
 
 json campaign_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row, bool details) {
   json j{{"id", row.id}, {"rig", store.rig_name(row.rig_id)}, {"kind", db::to_string(row.kind)}, {"state", db::to_string(row.state)},
@@ -143,11 +164,7 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   }));
   s.Get(R"(/api/campaigns/(\d+)/events)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
-    const auto row = campaign_or_404(store, path_id(req));
-    json out = json::array();
-    for (const auto& e : store.events(row.id))
-      out.push_back({{"id", e.id}, {"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", parse_or_text(e.detail)}});
-    send_json(res, out);
+    send_json(res, events_json(store, campaign_or_404(store, path_id(req)).id));
   }));
   s.Get(R"(/api/campaigns/(\d+)/nodes)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
@@ -155,16 +172,7 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   }));
   s.Get(R"(/api/campaigns/(\d+)/loops)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
-    json out = json::array();
-    for (const db::LoopInfo& l : store.loops(campaign_or_404(store, path_id(req)).id)) {
-      json j = parse_or_text(l.figures_json);
-      if (!j.is_object()) continue;
-      j["run"] = l.run;
-      j["k"] = l.k;
-      j["phase"] = l.phase;
-      out.push_back(std::move(j));
-    }
-    send_json(res, out);
+    send_json(res, loops_json(store, campaign_or_404(store, path_id(req)).id));
   }));
   s.Get(R"(/api/campaigns/(\d+)/runs)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);

@@ -14,7 +14,6 @@
 #include "routes.hpp"
 
 namespace hystlab::web {
-namespace {
 // A run's two columns, read once and then only what was added (a live run grows): a completed
 // run of 10^7 samples is read from SQLite once, then every request decimates from memory.
 struct RunXY {
@@ -47,6 +46,9 @@ class XYCache {
   std::map<std::int64_t, std::shared_ptr<RunXY>> runs_;
 };
 
+std::shared_ptr<XYCache> make_xy_cache() { return std::make_shared<XYCache>(); }
+
+namespace {
 double rounded(double v) { return std::round(v * 1e4) / 1e4; }  // 0.1 µm, 0.1 mN: the JSON stays short
 
 std::unique_ptr<models::HysteresisModel> table_model(db::Store& store, std::int64_t table_id) {
@@ -54,6 +56,8 @@ std::unique_ptr<models::HysteresisModel> table_model(db::Store& store, std::int6
   if (!doc) return nullptr;
   return std::make_unique<models::PreisachModel>(std::make_shared<const models::EverettTable>(models::table_from_json(*doc).table));
 }
+
+}  // namespace
 
 json loop_json(db::Store& store, XYCache& cache, std::int64_t run_id, std::size_t points) {
   const auto run = store.run(run_id);
@@ -85,6 +89,7 @@ json loop_json(db::Store& store, XYCache& cache, std::int64_t run_id, std::size_
   return out;
 }
 
+namespace {
 json preview_json(ApiContext& c, const PlanRequest& req) {
   const std::string kind = req.plan.is_object() && req.plan.contains("kind") && req.plan["kind"].is_string() ? req.plan["kind"].get<std::string>() : "";
   const control::RigInfo rig = c.daemon.rig_info(c.daemon.rig_index(req.rig, kind));

@@ -26,48 +26,6 @@ json health_json(const control::LinkHealth& h) {
           {"latency_histogram_us", h.latency_histogram_us}};
 }
 
-json rig_json(const control::DaemonInterface& d, std::size_t k) {
-  const control::RigInfo info = d.rig_info(k);
-  const control::AcquisitionCounters live = d.rig_counters(k);
-  json j{{"id", info.id}, {"index", k}, {"name", info.name}, {"kind", info.kind}, {"description", info.description},
-         {"simulated", info.simulated}, {"campaign", live.campaign}, {"phase", live.phase}, {"samples", live.samples},
-         {"missed_deadlines", live.missed_deadlines}, {"late_wakeups", live.late_wakeups}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
-  const control::RigSupervision sv = d.rig_supervision(k);
-  j["state"] = sv.state;
-  j["latched"] = sv.latched;
-  j["latch_reason"] = sv.latch_reason.empty() ? json(nullptr) : json(sv.latch_reason);
-  j["fault"] = sv.fault_code == 0 && sv.latched_fault_code == 0
-                   ? json(nullptr)
-                   : json{{"code", sv.fault_code ? sv.fault_code : sv.latched_fault_code}, {"text", sv.fault_text}};
-  const unsigned w = sv.status_word;
-  namespace stb = protocols::status;
-  j["status"] = {{"word", w}, {"ready", (w & stb::ready) != 0}, {"enabled", (w & stb::enabled) != 0}, {"holding", (w & stb::holding) != 0},
-                 {"estop", (w & stb::estop) != 0}, {"limit_tripped", (w & stb::limit_tripped) != 0}, {"fault", (w & stb::fault) != 0},
-                 {"moving", (w & stb::moving) != 0}, {"known", sv.have_sample}};
-  j["resetting"] = sv.resetting;
-  j["reset_refusal"] = sv.reset_refusal.empty() ? json(nullptr) : json(sv.reset_refusal);
-  j["recovering"] = sv.recovering;
-  j["recovery_result"] = sv.recovery_result.empty() ? json(nullptr) : json(sv.recovery_result);
-  // A load frame latched beyond its stroke (a reset cannot clear it), or idle outside the
-  // configured stroke: POST .../recover brings it back.
-  const json& stroke = sv.envelope.is_object() ? sv.envelope.value("stroke_mm", json()) : json();
-  const bool outside = stroke.is_array() && stroke.size() == 2 && (sv.position_mm < stroke[0].get<double>() || sv.position_mm > stroke[1].get<double>());
-  j["recoverable"] = info.kind != "shaker" && sv.have_sample && !sv.recovering &&
-                     ((sv.latched && (w & stb::limit_tripped) != 0) || (!sv.latched && sv.state == "idle" && outside));
-  j["link_losses"] = sv.link_losses;
-  j["transitions"] = sv.recent;
-  j["envelope"] = sv.envelope;
-  j["supervision"] = sv.supervision;
-  const std::uint64_t h = d.live_head(k);
-  std::vector<control::LiveSample> last;
-  if (h > 0) (void)d.read_live(k, h - 1, 1, last);
-  if (!last.empty()) {
-    const control::LiveSample& s = last.back();
-    const auto& n = info.kind == "shaker" ? db::kLiveShakerSignals : db::kLiveFrameSignals;
-    j["sample"] = {{"t", s.t}, {n[0], s.cmd}, {n[1], s.disp}, {n[2], s.force}, {"status", s.status}, {"run", s.run}};
-  }
-  return j;
-}
 
 // A rig by its id or its name.
 std::size_t rig_of(ApiContext& c, const std::string& key) {
@@ -174,6 +132,49 @@ struct StatusCache {
   std::chrono::steady_clock::time_point at{};
 };
 }  // namespace
+
+json rig_json(const control::DaemonInterface& d, std::size_t k) {
+  const control::RigInfo info = d.rig_info(k);
+  const control::AcquisitionCounters live = d.rig_counters(k);
+  json j{{"id", info.id}, {"index", k}, {"name", info.name}, {"kind", info.kind}, {"description", info.description},
+         {"simulated", info.simulated}, {"campaign", live.campaign}, {"phase", live.phase}, {"samples", live.samples},
+         {"missed_deadlines", live.missed_deadlines}, {"late_wakeups", live.late_wakeups}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
+  const control::RigSupervision sv = d.rig_supervision(k);
+  j["state"] = sv.state;
+  j["latched"] = sv.latched;
+  j["latch_reason"] = sv.latch_reason.empty() ? json(nullptr) : json(sv.latch_reason);
+  j["fault"] = sv.fault_code == 0 && sv.latched_fault_code == 0
+                   ? json(nullptr)
+                   : json{{"code", sv.fault_code ? sv.fault_code : sv.latched_fault_code}, {"text", sv.fault_text}};
+  const unsigned w = sv.status_word;
+  namespace stb = protocols::status;
+  j["status"] = {{"word", w}, {"ready", (w & stb::ready) != 0}, {"enabled", (w & stb::enabled) != 0}, {"holding", (w & stb::holding) != 0},
+                 {"estop", (w & stb::estop) != 0}, {"limit_tripped", (w & stb::limit_tripped) != 0}, {"fault", (w & stb::fault) != 0},
+                 {"moving", (w & stb::moving) != 0}, {"known", sv.have_sample}};
+  j["resetting"] = sv.resetting;
+  j["reset_refusal"] = sv.reset_refusal.empty() ? json(nullptr) : json(sv.reset_refusal);
+  j["recovering"] = sv.recovering;
+  j["recovery_result"] = sv.recovery_result.empty() ? json(nullptr) : json(sv.recovery_result);
+  // A load frame latched beyond its stroke (a reset cannot clear it), or idle outside the
+  // configured stroke: POST .../recover brings it back.
+  const json& stroke = sv.envelope.is_object() ? sv.envelope.value("stroke_mm", json()) : json();
+  const bool outside = stroke.is_array() && stroke.size() == 2 && (sv.position_mm < stroke[0].get<double>() || sv.position_mm > stroke[1].get<double>());
+  j["recoverable"] = info.kind != "shaker" && sv.have_sample && !sv.recovering &&
+                     ((sv.latched && (w & stb::limit_tripped) != 0) || (!sv.latched && sv.state == "idle" && outside));
+  j["link_losses"] = sv.link_losses;
+  j["transitions"] = sv.recent;
+  j["envelope"] = sv.envelope;
+  j["supervision"] = sv.supervision;
+  const std::uint64_t h = d.live_head(k);
+  std::vector<control::LiveSample> last;
+  if (h > 0) (void)d.read_live(k, h - 1, 1, last);
+  if (!last.empty()) {
+    const control::LiveSample& s = last.back();
+    const auto& n = info.kind == "shaker" ? db::kLiveShakerSignals : db::kLiveFrameSignals;
+    j["sample"] = {{"t", s.t}, {n[0], s.cmd}, {n[1], s.disp}, {n[2], s.force}, {"status", s.status}, {"run", s.run}};
+  }
+  return j;
+}
 
 void add_status_routes(httplib::Server& s, ApiContext& c) {
   auto cache = std::make_shared<StatusCache>();

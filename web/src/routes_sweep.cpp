@@ -98,6 +98,16 @@ std::string points_csv(const std::vector<db::TransmissibilityInfo>& rows) {
 }
 }  // namespace
 
+json sweep_json(db::Store& store, const db::CampaignRow& row) {
+  const auto rows = store.transmissibility(row.id);
+  const double threshold = jump_threshold(row.plan);
+  json points = json::array();
+  for (const db::TransmissibilityInfo& t : rows) points.push_back(point_json(t));
+  const bool any_prediction = std::any_of(rows.begin(), rows.end(), [](const auto& t) { return std::isfinite(t.predicted_ratio); });
+  return {{"campaign", row.id}, {"jump_threshold", threshold}, {"points", points}, {"measured", report_json(rows, points, threshold, false)},
+          {"predicted", any_prediction ? report_json(rows, points, threshold, true) : json()}};
+}
+
 void add_sweep_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/campaigns/(\d+)/transmissibility)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
@@ -109,14 +119,8 @@ void add_sweep_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/campaigns/(\d+)/sweep)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
     const auto row = campaign_or_404(store, path_id(req));
-    const auto rows = store.transmissibility(row.id);
-    const double threshold = jump_threshold(row.plan);
-    json points = json::array();
-    for (const db::TransmissibilityInfo& t : rows) points.push_back(point_json(t));
-    const bool any_prediction = std::any_of(rows.begin(), rows.end(), [](const auto& t) { return std::isfinite(t.predicted_ratio); });
     res.set_header("Content-Disposition", "inline; filename=\"sweep-" + std::to_string(row.id) + ".json\"");
-    send_json(res, {{"campaign", row.id}, {"jump_threshold", threshold}, {"points", points}, {"measured", report_json(rows, points, threshold, false)},
-                    {"predicted", any_prediction ? report_json(rows, points, threshold, true) : json()}});
+    send_json(res, sweep_json(store, row));
   }));
   s.Get(R"(/api/campaigns/(\d+)/sweep\.csv)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);

@@ -71,9 +71,14 @@ export class RigPanel {
       error: el('div', { class: 'error' }),
     };
     c.latch = el('div', { class: 'latch', role: 'alert' }, c.reason, ' ', c.reset, ' ', c.recover, c.refusal);
+    // One line in the sticky header (name, state, live values, E-STOP); the status bits, the link's
+    // health and the envelope below it when the operator opens the card (▸), so that the header
+    // leaves the screen to the work. A latch always shows, whatever is open.
+    c.more = el('button', { class: 'more', type: 'button', title: `status bits, link and envelope of ${r.name}`, 'aria-expanded': 'false',
+                            onclick: () => { const open = c.root.classList.toggle('open'); c.more.setAttribute('aria-expanded', String(open)); c.more.textContent = open ? '▾' : '▸'; } }, '▸');
     c.root = el('div', { class: 'rig', 'data-rig': r.name },
-      el('div', { class: 'rig-head' }, c.name, c.kind, c.state, c.estop),
-      el('div', { class: 'rig-live' }, c.live, c.bits), c.health, c.envelope, c.latch, c.error);
+      el('div', { class: 'rig-head' }, c.more, c.name, c.kind, c.state, c.live, c.estop),
+      el('div', { class: 'rig-more' }, c.bits, c.health, c.envelope), c.latch, c.error);
     this.cards.set(r.name, c);
     this.root.append(c.root);
     return c;
