@@ -42,6 +42,7 @@ std::optional<std::string> Supervisor::begin_recovery(double now, double stroke_
   recovery_target_ = std::clamp(last_.position_mm, stroke_min_mm + margin, stroke_max_mm - margin);
   recovery_ = Recovery::resetting;  // unlatched, the first status finds it clear and enables
   recovery_result_.clear();
+  recovered_ = false;
   reset_refusal_.clear();
   if (intended_ == RigState::estopped) intended_ = RigState::faulted;  // the reset released it: never re-sent
   recovery_deadline_ = deadline(now, s_.reset_timeout_s);
@@ -121,6 +122,7 @@ bool Supervisor::recovery_moving(double now, const StatusView& v) {
 
 void Supervisor::recovery_done(double now, const std::string& result) {
   recovery_ = Recovery::none;
+  recovered_ = true;
   recovery_result_ = result;
   latch_reason_.clear();
   fault_code_ = 0;

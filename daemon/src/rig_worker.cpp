@@ -158,7 +158,9 @@ bool RigWorker::settled(const PendingCommand& c) {
   }
   if (c.command == RigCommand::recover) {
     if (sup.recovering()) return false;
-    answer(c, sup.latched() ? R::refused : R::done, sup.recovery_result());
+    // Refused when it was stopped on the way, latched or not (a frame left outside the configured
+    // stroke is not latched, and its recovery can still be stopped).
+    answer(c, sup.recovered() ? R::done : R::refused, sup.recovery_result());
     return true;
   }
   if (sup.resetting()) return false;

@@ -83,15 +83,22 @@ TEST_CASE("limit recovery: a frame beyond its stroke is refused a reset, brought
   REQUIRE(sub->status == 201);
   const std::string id = std::to_string(json::parse(sub->body)["id"].get<std::int64_t>());
   json ended;
-  REQUIRE(ld.wait_json("/api/campaigns/" + id, [&](const json& j) { return ended = j, j["active"] == false; }, 120));
+  REQUIRE(ld.wait_json("/api/campaigns/" + id, [&](const json& j) { return ended = j, j["final"] == true; }, 120));
   CAPTURE(ended.dump());
   CHECK(ended["state"] == "completed");
 
   // Out the other side, and an e-stop while it comes back: latched, nothing moves after it.
   REQUIRE(sim.control("fault overtravel -13").rfind("ok", 0) == 0);
-  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["recoverable"] == true; }, 30));
+  // Tripped, not merely outside the configured ±10 mm on the way out (recoverable too, but pushed on).
+  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["recoverable"] == true && j["latched"] == true; }, 30));
   const double start = rig(c)["sample"]["displacement_mm"].get<double>();
-  std::thread recover([&] {
+  struct Joined : std::thread {  // joined on every way out, a failed REQUIRE's too
+    using std::thread::thread;
+    ~Joined() {
+      if (joinable()) join();
+    }
+  };
+  Joined recover([&] {
     auto c2 = ld.client();
     c2.set_read_timeout(40, 0);
     const auto r = c2.Post("/api/rigs/sim%20frame/recover", "", "application/json");  // CHECKs only off the main thread

@@ -97,6 +97,8 @@ class Supervisor {
   [[nodiscard]] std::optional<std::string> begin_recovery(double now, double stroke_min_mm, double stroke_max_mm);
   [[nodiscard]] bool recovering() const noexcept { return recovery_ != Recovery::none; }
   [[nodiscard]] const std::string& recovery_result() const noexcept { return recovery_result_; }
+  // The last recovery brought the frame back (false: it was stopped, or none ran).
+  [[nodiscard]] bool recovered() const noexcept { return recovered_; }
   // The last status the supervisor saw (what a command that depends on it decides from).
   [[nodiscard]] const StatusView& last_status() const noexcept { return last_; }
   // The host heartbeat, at its period (skipped for good when the rig has none), on the host's
@@ -153,6 +155,7 @@ class Supervisor {
   Recovery recovery_ = Recovery::none;
   double recovery_target_ = 0, recovery_closest_ = 0, recovery_deadline_ = 0, stroke_min_ = 0, stroke_max_ = 0;
   std::string recovery_result_;
+  bool recovered_ = false;
 };
 
 }  // namespace hystlab::daemon
