@@ -155,7 +155,11 @@ Plan parse_plan(const json& j) {
   const auto parsed_kind = db::campaign_kind_from(kind);
   if (!parsed_kind) fail("kind", "must be \"fot\", \"waveform\" or \"sine\" (got \"" + kind + "\")");
   p.kind = *parsed_kind;
-  static const char* common[] = {"kind", "ramp_rate_mm_s", "dwell_s", "sample_rate_hz", "limits", "name"};
+  static const char* common[] = {"kind", "ramp_rate_mm_s", "dwell_s", "sample_rate_hz", "limits", "name", "specimen", "notes"};
+  // What the lab records with the campaign (the report, the lists and the exports show them).
+  for (const auto& [field, most] : {std::pair<const char*, std::size_t>{"specimen", 200}, {"notes", 4000}})
+    if (j.contains(field) && (!j[field].is_string() || j[field].get<std::string>().size() > most))
+      fail(field, "must be text of at most " + std::to_string(most) + " characters");
   auto known = [&](const std::vector<std::string>& extra) {
     for (const auto& [k, _] : j.items()) {
       bool ok = std::find(std::begin(common), std::end(common), k) != std::end(common);

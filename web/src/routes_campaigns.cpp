@@ -96,6 +96,8 @@ json campaign_json(const control::DaemonInterface& d, db::Store& store, const db
   j["commands"] = commands;
   j["active"] = db::is_active(row.state);
   j["final"] = db::is_final(row.state);
+  const json plan = json::parse(row.plan, nullptr, false);  // the specimen the lab named at submission
+  j["specimen"] = plan.is_object() && plan.contains("specimen") && plan["specimen"].is_string() ? plan["specimen"] : json(nullptr);
   // Why it is in this state (why it ended, was held, failed), beside the state wherever it is shown.
   const std::string why = store.state_reason(row.id, row.state);
   j["reason"] = why.empty() ? json(nullptr) : json(why);

@@ -61,7 +61,8 @@ async function refreshList() {
   S.campaigns = await api('/api/campaigns');
   $('campaigns').replaceChildren(...S.campaigns.slice().reverse().map(c => {
     const li = el('li', { 'data-id': c.id, class: c.id === S.selected ? 'selected' : '',
-                          text: `#${c.id} ${c.kind} — ${c.state}` + (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : ''),
+                          text: `#${c.id} ${c.kind} — ${c.state}` + (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : '') +
+                                (c.specimen ? ` · ${c.specimen}` : ''),
                           title: c.reason ? `${c.state}: ${c.reason}` : '' });
     li.addEventListener('click', serial(() => { S.follow = false; return select(c.id); }));
     return li;
@@ -108,7 +109,7 @@ async function refreshDetail() {
   // The campaign's own run (the newest, after a resume), not the validation run beside it.
   const own = d.runs.filter(r => r.role !== 'validation');
   S.runId = own.length ? own[own.length - 1].id : null;
-  $('title').textContent = `Campaign #${d.id}: ${d.kind} on ${d.rig}`;
+  $('title').textContent = `Campaign #${d.id}: ${d.kind} on ${d.rig}` + (d.specimen ? ` · ${d.specimen}` : '');
   $('state').textContent = d.state;
   $('state').className = 'state ' + d.state;
   // Why it is in that state, beside it (an aborted or failed campaign's reason, not at the bottom of the events).
