@@ -57,23 +57,37 @@ DaemonAddress daemon_address(const Options& opt) {
   return a;
 }
 
-nlohmann::json post_to_daemon(const DaemonAddress& to, const std::string& path, const std::string& body) {
-  httplib::Client client(to.url);
-  client.set_connection_timeout(kConnectSeconds, 0);
-  client.set_read_timeout(kAnswerSeconds, 0);
+namespace {
+httplib::Headers token_headers(const DaemonAddress& to) {
   httplib::Headers headers;
   if (!to.token.empty()) headers.emplace("Authorization", "Bearer " + to.token);
-  const auto r = body.empty() ? client.Post(path.c_str(), headers) : client.Post(path.c_str(), headers, body, "application/json");
-  if (!r && r.error() == httplib::Error::Read)  // it may have acted: a blind retry could queue a campaign twice
-    throw CliError("hystlabd at " + to.url + " did not answer within " + std::to_string(kAnswerSeconds) + " s; it may still carry the request out: check with 'hystlab campaign list' before sending it again");
-  if (!r && r.error() == httplib::Error::Write)
-    throw CliError("hystlabd at " + to.url + " closed the connection while the request was sent (a plan larger than its http.max_body_bytes?)");
+  return headers;
+}
+void set_waits(httplib::Client& client) {
+  client.set_connection_timeout(kConnectSeconds, 0);
+  client.set_read_timeout(kAnswerSeconds, 0);
+}
+// No answer, a token asked for, a refusal: each a CliError in the user's words.
+void check_answer(const DaemonAddress& to, const httplib::Result& r) {
   if (!r)
     throw CliError("no hystlabd answers at " + to.url + " (" + failure_words(r.error()) +
                    "): start it, or give its address with --daemon URL or $HYSTLAB_DAEMON");
   if (r->status == 401)
     throw CliError("hystlabd at " + to.url + " needs its token (" + api_reason(*r) + "): give it with --token or $HYSTLAB_TOKEN");
   if (r->status < 200 || r->status >= 300) throw CliError(api_reason(*r));
+}
+}  // namespace
+
+nlohmann::json post_to_daemon(const DaemonAddress& to, const std::string& path, const std::string& body) {
+  httplib::Client client(to.url);
+  set_waits(client);
+  const httplib::Headers headers = token_headers(to);
+  const auto r = body.empty() ? client.Post(path.c_str(), headers) : client.Post(path.c_str(), headers, body, "application/json");
+  if (!r && r.error() == httplib::Error::Read)  // it may have acted: a blind retry could queue a campaign twice
+    throw CliError("hystlabd at " + to.url + " did not answer within " + std::to_string(kAnswerSeconds) + " s; it may still carry the request out: check with 'hystlab campaign list' before sending it again");
+  if (!r && r.error() == httplib::Error::Write)
+    throw CliError("hystlabd at " + to.url + " closed the connection while the request was sent (a plan larger than its http.max_body_bytes?)");
+  check_answer(to, r);
   const auto j = nlohmann::json::parse(r->body, nullptr, false);
   if (j.is_discarded()) throw CliError("hystlabd at " + to.url + " answered " + std::to_string(r->status) + " with no JSON: is it hystlabd?");
   return j;
@@ -81,17 +95,9 @@ nlohmann::json post_to_daemon(const DaemonAddress& to, const std::string& path, 
 
 std::string get_from_daemon(const DaemonAddress& to, const std::string& path) {
   httplib::Client client(to.url);
-  client.set_connection_timeout(kConnectSeconds, 0);
-  client.set_read_timeout(kAnswerSeconds, 0);
-  httplib::Headers headers;
-  if (!to.token.empty()) headers.emplace("Authorization", "Bearer " + to.token);
-  const auto r = client.Get(path.c_str(), headers);
-  if (!r)
-    throw CliError("no hystlabd answers at " + to.url + " (" + failure_words(r.error()) +
-                   "): start it, or give its address with --daemon URL or $HYSTLAB_DAEMON");
-  if (r->status == 401)
-    throw CliError("hystlabd at " + to.url + " needs its token (" + api_reason(*r) + "): give it with --token or $HYSTLAB_TOKEN");
-  if (r->status < 200 || r->status >= 300) throw CliError(api_reason(*r));
+  set_waits(client);
+  const auto r = client.Get(path.c_str(), token_headers(to));
+  check_answer(to, r);
   return r->body;
 }
 

@@ -124,14 +124,8 @@ void Supervisor::recovery_done(double now, const std::string& result) {
   recovery_ = Recovery::none;
   recovered_ = true;
   recovery_result_ = result;
-  latch_reason_.clear();
-  fault_code_ = 0;
-  intended_ = RigState::idle;
-  (void)write_disable();
-  verify_disabled_ = true;
-  verify_deadline_ = deadline(now, s_.arm_timeout_s);
   if (state_ == RigState::idle && observer_) observer_({now, state_, state_, result});  // never latched: no transition to show it
-  go(now, RigState::idle, result);
+  unlatch_idle(now, result);
 }
 
 void Supervisor::recovery_failed(double now, const std::string& why) {

@@ -269,17 +269,22 @@ void Supervisor::begin_reset(double now) {
   if (intended_ == RigState::estopped) intended_ = RigState::faulted;  // never re-send the e-stop the reset released
 }
 
+// The latch cleared (a reset confirmed, a frame brought back): disabled, verified, idle.
+void Supervisor::unlatch_idle(double now, const std::string& why) {
+  latch_reason_.clear();
+  fault_code_ = 0;
+  intended_ = RigState::idle;
+  (void)write_disable();
+  verify_disabled_ = true;
+  verify_deadline_ = deadline(now, s_.arm_timeout_s);
+  go(now, RigState::idle, why);
+}
+
 void Supervisor::reset_step(double now, const StatusView& v) {
   const bool clear = (v.status & st::ready) && !(v.status & (st::estop | st::fault | st::limit_tripped));
   if (clear) {
     resetting_ = false;
-    latch_reason_.clear();
-    fault_code_ = 0;
-    intended_ = RigState::idle;
-    (void)write_disable();
-    verify_disabled_ = true;
-    verify_deadline_ = deadline(now, s_.arm_timeout_s);
-    go(now, RigState::idle, "reset by the operator: the rig reports ready");
+    unlatch_idle(now, "reset by the operator: the rig reports ready");
     return;
   }
   if (now > reset_deadline_) {

@@ -119,6 +119,7 @@ class Supervisor {
   void reassert(double now);
   std::optional<std::string> check_bits(double now, const StatusView& v);
   void reset_step(double now, const StatusView& v);
+  void unlatch_idle(double now, const std::string& why);
   void disarm_at(double now, const std::string& reason);
   enum class Recovery : std::uint8_t { none, resetting, enabling, moving };
   void recovery_step(double now, const StatusView& v);
