@@ -1,7 +1,9 @@
 #include <filesystem>
 #include "cli_support.hpp"
+#include "hystlab/models/document_source.hpp"
 #include "hystlab/models/text_forms.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
@@ -117,6 +119,34 @@ std::string read_file(const std::string& path) {
   return s.str();
 }
 
+JsonFile read_json_file(const std::string& path, const std::string& what) {
+  JsonFile f;
+  f.text = read_file(path);
+  try {
+    f.json = models::parse_document(f.text, models::file_source(what, path));
+  } catch (const models::FormatError& e) {
+    throw CliError(e.what());
+  }
+  return f;
+}
+
+// (models/document_source.hpp names the file in the document's own errors too.)
+models::TableDocument read_table_file(const std::string& path) {
+  try {
+    return models::table_from_source(read_file(path), models::file_source("table file", path));
+  } catch (const models::FormatError& e) {
+    throw CliError(e.what());
+  }
+}
+
+models::SmaParameters read_params_file(const std::string& path) {
+  try {
+    return models::params_from_source(read_file(path), models::file_source("parameter file", path));
+  } catch (const models::FormatError& e) {
+    throw CliError(e.what());
+  }
+}
+
 void write_file(const std::string& path, const std::string& text) {
   // Write beside the target and rename, so a failure never leaves half a file.
   const std::string tmp = path + ".tmp";
@@ -222,12 +252,47 @@ std::string to_csv(const std::vector<std::string>& header, const std::vector<std
 
 std::string now_iso8601() { return models::iso8601_utc(std::time(nullptr)); }
 
+std::string utc_time(const std::string& iso) {
+  // YYYY-MM-DDTHH:MM:SS[.fff]Z
+  const bool ok = iso.size() >= 20 && iso[4] == '-' && iso[7] == '-' && iso[10] == 'T' && iso[13] == ':' && iso[16] == ':' && iso.back() == 'Z';
+  return ok ? iso.substr(0, 10) + " " + iso.substr(11, 8) + " UTC" : iso;
+}
+
+namespace {
+std::size_t characters(const std::string& s) {
+  std::size_t n = 0;
+  for (const char c : s) n += (static_cast<unsigned char>(c) & 0xC0) != 0x80 ? 1 : 0;
+  return n;
+}
+}  // namespace
+
+std::string aligned_table(const std::vector<Column>& columns, const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::size_t> width(columns.size());
+  for (std::size_t c = 0; c < columns.size(); ++c) width[c] = characters(columns[c].title);
+  for (const auto& r : rows)
+    for (std::size_t c = 0; c < columns.size() && c < r.size(); ++c) width[c] = std::max(width[c], characters(r[c]));
+  std::string out;
+  const auto line = [&](const auto& cell) {
+    std::string l;
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      const std::string& text = cell(c);
+      const std::string pad(width[c] - characters(text), ' ');
+      l += (c ? "  " : "") + (columns[c].right ? pad + text : text + pad);
+    }
+    out += l.substr(0, l.find_last_not_of(' ') + 1) + "\n";
+  };
+  line([&](std::size_t c) -> const std::string& { return columns[c].title; });
+  static const std::string none;
+  for (const auto& r : rows) line([&](std::size_t c) -> const std::string& { return c < r.size() ? r[c] : none; });
+  return out;
+}
+
 LoadedModel load_model(const Options& opt) {
   LoadedModel m;
   if (opt.has("table")) {
     if (opt.has("model")) throw CliError("give either --table or --model, not both");
     const std::string path = opt.require("table");
-    auto doc = models::table_from_json(read_file(path));
+    auto doc = read_table_file(path);
     m.lo = doc.table.grid().lo;
     m.hi = doc.table.grid().hi;
     m.description = "Everett table " + path + " (n = " + std::to_string(doc.table.grid().n) + ")";
@@ -241,7 +306,7 @@ LoadedModel load_model(const Options& opt) {
   m.description = "simplified SMA model, Table 1 parameters (built in)";
   if (opt.has("params")) {
     const std::string path = opt.require("params");
-    p = models::params_from_json(read_file(path));
+    p = read_params_file(path);
     m.description = "simplified SMA model, parameters " + path;
   }
   m.model = std::make_unique<models::SimplifiedSmaModel>(p);

@@ -3,12 +3,14 @@
 // printed as one line by main() with exit code 2.
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "hystlab/db/store.hpp"
+#include "hystlab/models/formats.hpp"
 #include "hystlab/models/hysteresis_model.hpp"
 
 namespace hystlab::cli {
@@ -37,6 +39,19 @@ class Options {
 };
 
 [[nodiscard]] std::string read_file(const std::string& path);
+
+// Every JSON file the user names (a table, parameters, a plan) is read here. what: "table file",
+// "parameter file", "plan file". A file that is not JSON is one CliError naming the file, the
+// place and the fault: "table file 'x.txt' is not JSON: line 1, column 1: unexpected 'h'".
+struct JsonFile {
+  std::string text;  // as read: the documents' numbers are parsed from it, not from a re-dump
+  nlohmann::json json;
+};
+[[nodiscard]] JsonFile read_json_file(const std::string& path, const std::string& what);
+// A table or parameter document from its file: JSON as above, then the document's own checks,
+// named by the file ("table file 'T.json': unknown format version 7").
+[[nodiscard]] models::TableDocument read_table_file(const std::string& path);
+[[nodiscard]] models::SmaParameters read_params_file(const std::string& path);
 // --db must name hystlabd's database: a CliError when no such file (a mistyped path would
 // otherwise create an empty database).
 void require_database(const std::string& path);
@@ -66,6 +81,17 @@ class Csv {
 [[nodiscard]] std::string format_number(double v);
 [[nodiscard]] std::string to_csv(const std::vector<std::string>& header, const std::vector<std::vector<double>>& cols);
 [[nodiscard]] std::string now_iso8601();
+// A stored time ("2026-11-26T04:41:08.123Z", as hystlabd writes them) with its zone, for people:
+// "2026-11-26 04:41:08 UTC"; a text of another form is returned as it is.
+[[nodiscard]] std::string utc_time(const std::string& iso);
+
+// A table for the terminal: each column as wide as its widest cell (counted in characters, not
+// UTF-8 bytes), two spaces apart, numbers (right) ending at the same place; no trailing blanks.
+struct Column {
+  std::string title;
+  bool right = false;
+};
+[[nodiscard]] std::string aligned_table(const std::vector<Column>& columns, const std::vector<std::vector<std::string>>& rows);
 
 // --model simplified [--params P.json] or --table T.json
 struct LoadedModel {

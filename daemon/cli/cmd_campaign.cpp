@@ -1,5 +1,6 @@
 // hystlab campaign / tables (runs: cmd_runs.cpp). Submitting and commanding a campaign go to the running
 // hystlabd over its HTTP API (daemon_client.hpp); its records are read from the database file.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,8 @@
 #include "hystlab/db/signals.hpp"
 #include "commands.hpp"
 #include "daemon_client.hpp"
+#include "event_text.hpp"
+#include "hystlab/db/campaign_record.hpp"
 #include "hystlab/db/store.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
@@ -21,6 +24,7 @@ namespace {
 const char* kCampaignHelp = R"(usage: hystlab campaign submit --plan P.json [--rig NAME] [--daemon URL] [--token T]
        hystlab campaign preview --plan P.json [--rig NAME] [--daemon URL] [--token T]
        hystlab campaign pause|resume|abort|estop ID [--daemon URL] [--token T]
+       hystlab campaign record ID [--specimen TEXT] [--notes TEXT | --notes-file F] [--daemon URL] [--token T]
        hystlab campaign list [--db hystlab.db]
        hystlab campaign show ID [--json] [--db hystlab.db]
 
@@ -30,7 +34,10 @@ with the daemon's token when it has one ($HYSTLAB_TOKEN, or --token, which other
 (an error names the field) and queues it; preview says what it would do (duration, samples, peak
 speed and force) without queueing it; pause holds the rig; resume continues (after a long pause,
 or for an interrupted or held campaign, with a wipe-out preamble and the rows not yet measured);
-abort drives to the safe position; estop triggers the rig's e-stop at once (no motion). The rig
+abort drives to the safe position; estop triggers the rig's e-stop at once (no motion). record
+changes what the lab records with a campaign, in any state: its specimen (one line, at most 200
+characters) and notes (at most 4000), set at submission by the plan's "specimen" and "notes";
+each change is kept in its events. The rig
 defaults to the only one the daemon has. A waveform plan may give "points_csv": a CSV file
 (beside the plan) whose displacement_mm column is the input, e.g. a random validation path.
 list and show read the daemon's database file, with or without a daemon running.
@@ -38,6 +45,11 @@ list and show read the daemon's database file, with or without a daemon running.
 const char* kTablesHelp = R"(usage: hystlab tables list [--db hystlab.db]
        hystlab tables export ID [--format json|csv|m|h|fmu] [-o FILE] [--db hystlab.db]
 
+list: every table hystlabd identified, one a row: its campaign, method, n and range; its error
+on its own samples (RMS and max in N, RMS in % of the force range) and held out, on its
+campaign's validation run, which no table was built from; * marks the table its campaign
+recommends, - a figure there is none of. export writes one (docs/FORMATS.md): json (the stored
+document as it is), csv, m (MATLAB/Octave), h (C header) or fmu (FMI 2.0, needs -o FILE.fmu).
 --db must name hystlabd's database (it is never created here).
 )";
 
@@ -70,12 +82,7 @@ std::filesystem::path points_file(const std::string& plan_path, const nlohmann::
 // The plan file as JSON, a waveform's points_csv read into points_mm (the daemon has no access to
 // the user's files); the daemon checks the plan itself and names the field that is wrong.
 nlohmann::json load_plan(const std::string& path) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(read_file(path));
-  } catch (const nlohmann::json::exception& e) {
-    throw CliError(path + ": not valid JSON (" + e.what() + ")");
-  }
+  nlohmann::json j = read_json_file(path, "plan file").json;
   if (j.is_object() && j.contains("points_csv")) {
     j["points_mm"] = Csv::load(points_file(path, j["points_csv"]).string()).column("displacement_mm");
     j.erase("points_csv");
@@ -89,21 +96,62 @@ std::string round_g(double v) {
   return b;
 }
 
-// One line of a table's accuracy on its own samples: "RMS 3.2 N (0.4 % of range), max 12 N", or "".
-std::string accuracy_line(const std::string& json_text) {
+// A table's scores as stored (table_score.hpp's accuracy_json): on its own samples, and held out
+// (on its campaign's validation run, which no table was built from). Empty: not scored.
+struct Scores {
+  std::string rms, rms_pct, max, held_rms, held_max;
+  bool recommended = false;
+};
+
+Scores scores_of(const std::string& json_text) {
+  Scores s;
   const auto a = nlohmann::json::parse(json_text, nullptr, false);
-  if (a.is_discarded() || !a.is_object() || !a.contains("overall")) return "";
-  const auto& o = a["overall"];
-  return "RMS " + round_g(o.value("rms_N", 0.0)) + " N (" + round_g(100 * o.value("rms_norm", 0.0)) + " % of range), max " +
-         round_g(o.value("max_N", 0.0)) + " N";
+  if (a.is_discarded() || !a.is_object()) return s;
+  if (a.contains("overall") && a["overall"].is_object()) {
+    const auto& o = a["overall"];
+    s.rms = round_g(o.value("rms_N", 0.0)), s.rms_pct = round_g(100 * o.value("rms_norm", 0.0)), s.max = round_g(o.value("max_N", 0.0));
+  }
+  if (a.contains("held_out") && a["held_out"].is_object() && a["held_out"].contains("overall")) {
+    const auto& o = a["held_out"]["overall"];
+    s.held_rms = round_g(o.value("rms_N", 0.0)), s.held_max = round_g(o.value("max_N", 0.0));
+  }
+  s.recommended = a.value("recommended", false);
+  return s;
 }
 
-// The held-out figures (on the validation run): "RMS 1.1 N, max 4 N *" (* recommended), or "-".
+// One line of a table's accuracy on its own samples: "RMS 3.2 N (0.4 % of range), max 12 N", or "".
+std::string accuracy_line(const std::string& json_text) {
+  const Scores s = scores_of(json_text);
+  return s.rms.empty() ? "" : "RMS " + s.rms + " N (" + s.rms_pct + " % of range), max " + s.max + " N";
+}
+
+// The held-out figures (on the validation run): "RMS 1.1 N, max 4 N (recommended)", or "".
 std::string heldout_line(const std::string& json_text) {
-  const auto a = nlohmann::json::parse(json_text, nullptr, false);
-  if (a.is_discarded() || !a.is_object() || !a.contains("held_out") || !a["held_out"].contains("overall")) return "-";
-  const auto& o = a["held_out"]["overall"];
-  return "RMS " + round_g(o.value("rms_N", 0.0)) + " N, max " + round_g(o.value("max_N", 0.0)) + " N" + (a.value("recommended", false) ? " *" : "");
+  const Scores s = scores_of(json_text);
+  return s.held_rms.empty() ? "" : "RMS " + s.held_rms + " N, max " + s.held_max + " N" + (s.recommended ? " (recommended)" : "");
+}
+
+// hystlab tables list: one row a table, the columns aligned, and what its marks mean below it.
+void list_tables(db::Store& store) {
+  const std::vector<Column> columns{{"id", true},       {"campaign", true},        {"method"},
+                                    {"n", true},        {"range (mm)"},            {"RMS (N)", true},
+                                    {"% range", true},  {"max (N)", true},         {"held-out RMS (N)", true},
+                                    {"held-out max (N)", true}, {""},              {"created"}};
+  std::vector<std::vector<std::string>> rows;
+  bool star = false, dash = false;
+  const auto or_dash = [&dash](const std::string& v) { return v.empty() ? (dash = true, std::string("-")) : v; };
+  for (const auto& t : store.tables()) {
+    const Scores s = scores_of(t.accuracy_json);
+    star = star || s.recommended;
+    rows.push_back({std::to_string(t.id), or_dash(t.campaign ? std::to_string(*t.campaign) : ""), t.method, std::to_string(t.n),
+                    round_g(t.range_lo) + ".." + round_g(t.range_hi), or_dash(s.rms), or_dash(s.rms_pct), or_dash(s.max), or_dash(s.held_rms),
+                    or_dash(s.held_max), s.recommended ? "*" : "", utc_time(t.created_at)});
+  }
+  std::cout << aligned_table(columns, rows);
+  std::string legend;
+  if (star) legend += "*: the table its campaign recommends (the lowest held-out error)";
+  if (dash) legend += std::string(legend.empty() ? "" : "   ") + "-: none (no campaign, or not scored)";
+  if (!legend.empty()) std::cout << legend << "\n";
 }
 
 int print_preview(const nlohmann::json& p) {
@@ -158,35 +206,75 @@ void print_sweep(db::Store& store, const db::CampaignRow& row) {
   }
 }
 
+void show_json(db::Store& store, const db::CampaignRow& row) {
+  const auto plan = nlohmann::json::parse(row.plan, nullptr, false);
+  const std::string why = store.state_reason(row.id, row.state);
+  nlohmann::json j{{"id", row.id}, {"kind", db::to_string(row.kind)}, {"rig", store.rig_name(row.rig_id)}, {"state", db::to_string(row.state)},
+                   {"reason", why.empty() ? nlohmann::json() : nlohmann::json(why)}, {"created_at", row.created_at}, {"updated_at", row.updated_at},
+                   {"plan", plan}, {"runs", nlohmann::json::array()}, {"tables", nlohmann::json::array()}, {"events", nlohmann::json::array()}};
+  const db::CampaignRecord record = db::campaign_record(store, row);  // the plan's, or as changed since
+  j["specimen"] = record.specimen.empty() ? nlohmann::json() : nlohmann::json(record.specimen);
+  j["notes"] = record.notes.empty() ? nlohmann::json() : nlohmann::json(record.notes);
+  for (const auto& r : store.runs(row.id)) j["runs"].push_back({{"id", r.id}, {"role", r.role}, {"state", r.state}, {"samples", r.samples}, {"nodes", r.nodes}});
+  j["loops"] = nlohmann::json::array();
+  for (const auto& l : store.loops(row.id)) {
+    auto fig = nlohmann::json::parse(l.figures_json, nullptr, false);
+    if (!fig.is_object()) continue;
+    fig["run"] = l.run, fig["phase"] = l.phase;
+    j["loops"].push_back(std::move(fig));
+  }
+  for (const auto& t : store.tables(row.id))
+    j["tables"].push_back({{"id", t.id}, {"method", t.method}, {"n", t.n}, {"accuracy", nlohmann::json::parse(t.accuracy_json, nullptr, false)}});
+  for (const auto& e : store.events(row.id)) j["events"].push_back({{"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", e.detail}});
+  std::cout << j.dump(2) << "\n";
+}
+
+// The campaign's first lines: what, where, its state and why, when; the specimen and the notes
+// the lab recorded with it (with the plan, or changed since: db/campaign_record.hpp).
+void print_heading(db::Store& store, const db::CampaignRow& row) {
+  const std::string why = store.state_reason(row.id, row.state);
+  std::cout << "campaign " << row.id << ": " << db::to_string(row.kind) << " on " << store.rig_name(row.rig_id) << ", " << db::to_string(row.state)
+            << (why.empty() ? "" : ": " + why) << "\n"
+            << "  created " << utc_time(row.created_at) << ", updated " << utc_time(row.updated_at) << "\n";
+  const db::CampaignRecord record = db::campaign_record(store, row);
+  if (!record.specimen.empty()) std::cout << "  specimen: " << record.specimen << "\n";
+  if (!record.notes.empty()) {
+    std::string notes = record.notes;  // its lines under its first
+    for (std::size_t at = notes.find('\n'); at != std::string::npos; at = notes.find('\n', at + 1)) notes.insert(at + 1, "         ");
+    std::cout << "  notes: " << notes << "\n";
+  }
+  if (!record.changed_at.empty()) std::cout << "  (record changed " << utc_time(record.changed_at) << ")\n";
+}
+
+// Every event, a sentence each, under the date it happened (UTC).
+void print_events(db::Store& store, const db::CampaignRow& row) {
+  std::cout << "  events (oldest first; times in UTC):\n";
+  auto events = store.events(row.id);
+  std::erase_if(events, [](const db::EventRow& e) { return e.kind == "gap"; });  // one per hole: the "gaps" summary says it in one line
+  std::size_t width = 0;
+  for (const auto& e : events) width = std::max(width, e.kind.size());
+  std::string day;
+  for (const auto& e : events) {
+    if (const std::string d = e.at.substr(0, 10); d != day) std::cout << "    " << (day = d) << "\n";
+    std::cout << "      " << event_line(e, width) << "\n";
+  }
+}
+
 int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
-  const auto runs = store.runs(row.id);
-  const auto tables = store.tables(row.id);
   if (as_json) {
-    nlohmann::json j{{"id", row.id}, {"kind", db::to_string(row.kind)}, {"state", db::to_string(row.state)}, {"plan", nlohmann::json::parse(row.plan, nullptr, false)},
-                     {"runs", nlohmann::json::array()}, {"tables", nlohmann::json::array()}, {"events", nlohmann::json::array()}};
-    for (const auto& r : runs) j["runs"].push_back({{"id", r.id}, {"role", r.role}, {"state", r.state}, {"samples", r.samples}, {"nodes", r.nodes}});
-    j["loops"] = nlohmann::json::array();
-    for (const auto& l : store.loops(row.id)) {
-      auto fig = nlohmann::json::parse(l.figures_json, nullptr, false);
-      if (!fig.is_object()) continue;
-      fig["run"] = l.run, fig["phase"] = l.phase;
-      j["loops"].push_back(std::move(fig));
-    }
-    for (const auto& t : tables) j["tables"].push_back({{"id", t.id}, {"method", t.method}, {"n", t.n}, {"accuracy", nlohmann::json::parse(t.accuracy_json, nullptr, false)}});
-    for (const auto& e : store.events(row.id)) j["events"].push_back({{"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", e.detail}});
-    std::cout << j.dump(2) << "\n";
+    show_json(store, row);
     return 0;
   }
-  std::cout << "campaign " << row.id << ": " << db::to_string(row.kind) << " on " << store.rig_name(row.rig_id) << ", " << db::to_string(row.state) << " (updated " << row.updated_at << ")\n";
-  for (const auto& r : runs)
+  print_heading(store, row);
+  for (const auto& r : store.runs(row.id))
     std::cout << "  run " << r.id << (r.role == "validation" ? " (validation)" : "") << ": " << r.state << ", " << r.samples << " samples, "
               << r.nodes << " FOT nodes\n";
   for (const std::string& d : store.event_details(row.id, "training"))
     std::cout << "  training: " << nlohmann::json::parse(d, nullptr, false).value("why", std::string("?")) << "\n";
-  for (const auto& t : tables) {
+  for (const auto& t : store.tables(row.id)) {
     const std::string acc = accuracy_line(t.accuracy_json), held = heldout_line(t.accuracy_json);
     std::cout << "  table " << t.id << ": " << t.method << ", n = " << t.n << ", " << round_g(t.range_lo) << "–" << round_g(t.range_hi) << " mm"
-              << (acc.empty() ? "" : ", own samples " + acc) << (held == "-" ? "" : "; held-out " + held) << "\n";
+              << (acc.empty() ? "" : ", own samples " + acc) << (held.empty() ? "" : "; held-out " + held) << "\n";
   }
   for (const std::string& d : store.event_details(row.id, "recommendation")) {
     const auto r = nlohmann::json::parse(d, nullptr, false);
@@ -195,13 +283,22 @@ int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
   if (const auto loops = store.loops(row.id); !loops.empty())
     std::cout << "  " << loops.size() << " closed cycle(s) with their figures (--json, or hystlab loops on a run's CSV)\n";
   print_sweep(store, row);
-  std::cout << "  events (newest last):\n";
-  for (const auto& e : store.events(row.id)) {
-    if (e.kind == "gap") continue;  // one per hole: the "gaps" summary says it in one line
-    std::cout << "    " << e.at.substr(0, 19) << "  " << e.kind << (e.to_state.empty() ? "" : " -> " + e.to_state);
-    if (!e.detail.empty() && e.detail.size() < 160) std::cout << ": " << e.detail;
-    std::cout << "\n";
-  }
+  print_events(store, row);
+  return 0;
+}
+// hystlab campaign record ID --specimen ... --notes ...: POST /api/campaigns/ID/record.
+int record_cmd(const Args& args, std::int64_t id) {
+  refuse_db_option(args, "campaign record");
+  const Options opt(rest(args, 2), {"specimen", "notes", "notes-file", "daemon", "token"}, {});
+  if (opt.has("notes") && opt.has("notes-file")) throw CliError("give --notes or --notes-file, not both");
+  nlohmann::json body = nlohmann::json::object();
+  if (opt.has("specimen")) body["specimen"] = opt.get("specimen");
+  if (opt.has("notes")) body["notes"] = opt.get("notes");
+  if (opt.has("notes-file")) body["notes"] = read_file(opt.get("notes-file"));
+  if (body.empty()) throw CliError("campaign record: give --specimen, --notes (or --notes-file), or both");
+  const auto c = post_to_daemon(daemon_address(opt), "/api/campaigns/" + std::to_string(id) + "/record", body.dump());
+  const auto text = [&](const char* k) { return c.contains(k) && c[k].is_string() ? "'" + c[k].get<std::string>() + "'" : std::string("none"); };
+  std::cout << "campaign " << id << " recorded: specimen " << text("specimen") << ", notes " << text("notes") << "\n";
   return 0;
 }
 }  // namespace
@@ -228,13 +325,15 @@ int run_campaign_cmd(const Args& args) {
   if (verb == "list") {
     const Options opt(rest(args, 1), {"db"}, {});
     db::Store store = open_store(opt);
-    std::printf("%6s  %-9s %-12s %s\n", "id", "kind", "state", "updated");
-    for (const auto& c : store.campaigns()) std::printf("%6lld  %-9s %-12s %s\n", static_cast<long long>(c.id), db::to_string(c.kind), db::to_string(c.state), c.updated_at.c_str());
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& c : store.campaigns()) rows.push_back({std::to_string(c.id), db::to_string(c.kind), db::to_string(c.state), utc_time(c.updated_at)});
+    std::cout << aligned_table({{"id", true}, {"kind"}, {"state"}, {"updated"}}, rows);
     return 0;
   }
   const bool command = verb == "pause" || verb == "resume" || verb == "abort" || verb == "estop";
-  if (!command && verb != "show") throw CliError("unknown campaign verb '" + verb + "' (see --help)");
+  if (!command && verb != "show" && verb != "record") throw CliError("unknown campaign verb '" + verb + "' (see --help)");
   const std::int64_t id = id_arg(args, 1, "campaign ID");
+  if (verb == "record") return record_cmd(args, id);
   if (command) {
     refuse_db_option(args, "campaign " + verb);
     const Options opt(rest(args, 2), {"daemon", "token"}, {});
@@ -257,15 +356,7 @@ int run_tables_cmd(const Args& args) {
   if (args[0] == "list") {
     const Options opt(rest(args, 1), {"db"}, {});
     db::Store store = open_store(opt);
-    // Held-out: on the campaign's validation run, which no table was built from (* the one it recommends).
-    std::printf("%6s %9s  %-8s %4s  %-12s  %-44s %-26s %s\n", "id", "campaign", "method", "n", "range (mm)", "accuracy (own samples)",
-                "held-out (validation run)", "created");
-    for (const auto& t : store.tables()) {
-      const std::string range = round_g(t.range_lo) + ".." + round_g(t.range_hi), acc = accuracy_line(t.accuracy_json);
-      std::printf("%6lld %9s  %-8s %4lld  %-12s  %-44s %-26s %s\n", static_cast<long long>(t.id), t.campaign ? std::to_string(*t.campaign).c_str() : "-",
-                  t.method.c_str(), static_cast<long long>(t.n), range.c_str(), acc.empty() ? "-" : acc.c_str(),
-                  heldout_line(t.accuracy_json).c_str(), t.created_at.c_str());
-    }
+    list_tables(store);
     return 0;
   }
   if (args[0] != "export") throw CliError("unknown tables verb '" + args[0] + "' (see --help)");

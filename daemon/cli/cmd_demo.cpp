@@ -90,7 +90,7 @@ int run_demo(const Args& args) {
   const std::filesystem::path dir = opt.get("out", "hystlab-demo");
   const auto seed = static_cast<std::uint64_t>(opt.integer("seed", 1, 0, 1 << 30));
   models::SmaParameters params = models::table1_parameters();
-  if (opt.has("params")) params = models::params_from_json(read_file(opt.require("params")));
+  if (opt.has("params")) params = read_params_file(opt.require("params"));
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw CliError("cannot create '" + dir.string() + "': " + ec.message());

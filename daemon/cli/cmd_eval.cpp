@@ -53,7 +53,7 @@ int run_invert(const Args& args) {
   if (print_help_if_asked(args, kInvertHelp)) return 0;
   const Options opt(args, {"table", "input", "output"}, {});
   const std::string path = opt.require("table");
-  models::PreisachModel model(models::table_from_json(read_file(path)).table);
+  models::PreisachModel model(read_table_file(path).table);
   const models::Grid& g = model.table().grid();
   const Csv csv = Csv::load(opt.require("input"));
   const std::vector<double> target = csv.column("force_N");

@@ -35,7 +35,11 @@ int run_export(const Args& args) {
   const std::string format = opt.require("format");
   if (!fmu::is_export_format(format)) throw CliError("--format: '" + format + "' is not " + std::string(fmu::kExportFormats));
   const bool table = opt.has("table");
-  const std::string doc = read_file(opt.get(table ? "table" : "params"));
+  const std::string path = opt.get(table ? "table" : "params");
+  // The document checked as its file first: a fault names the file (the export re-reads the text).
+  if (table) (void)read_table_file(path);
+  else (void)read_params_file(path);
+  const std::string doc = read_file(path);
   write_export(doc, format, opt.get("name", table ? "hystlab_table" : "hystlab_params"), opt.get("output"),
                table ? models::ElementKind::Table : models::ElementKind::Params);
   return 0;

@@ -190,7 +190,7 @@ int run_calibrate(const Args& args) {
   const std::string out = opt.require("output"), path = opt.require("data");
   models::SmaCalibrationOptions co;
   if (opt.has("initial")) {
-    const models::SmaParameters p = models::params_from_json(read_file(opt.require("initial")));
+    const models::SmaParameters p = read_params_file(opt.require("initial"));
     co.C = p.C;
     co.T = p.T;
   } else if (!opt.has("temperature") || !opt.has("clausius")) {

@@ -25,9 +25,10 @@ or --token, which others see in ps).
 }  // namespace
 
 int run_rig_cmd(const Args& args) {
-  if (print_help_if_asked(args, kRigHelp) || args.size() < 2) {
-    if (args.size() < 2) std::cout << kRigHelp;
-    return args.size() < 2 ? 2 : 0;
+  if (print_help_if_asked(args, kRigHelp)) return 0;
+  if (args.size() < 2) {  // a verb without its rig: the usage, as a refusal
+    std::cout << kRigHelp;
+    return 2;
   }
   const std::string verb = args[0], name = args[1];
   if (verb != "reset" && verb != "estop" && verb != "recover") throw CliError("unknown rig verb '" + verb + "' (reset, estop or recover)");

@@ -1,6 +1,7 @@
 // hystlab runs export: a run's samples as CSV, streamed to the output as they are read (a 10^7-
 // sample run never sits in memory), or a run or a whole campaign as HDF5 (docs/FORMATS.md).
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -8,20 +9,20 @@
 
 #include "cli_support.hpp"
 #include "commands.hpp"
+#include "hystlab/db/run_csv.hpp"
 #include "hystlab/db/run_h5.hpp"
-#include "hystlab/db/signals.hpp"
 #include "hystlab/db/store.hpp"
-#include "hystlab/models/text_forms.hpp"
 
 namespace hystlab::cli {
 namespace {
 const char* kRunsUsage = R"(usage: hystlab runs export RUN_ID [--format csv|h5] [-o FILE] [--db hystlab.db]
        hystlab runs export --campaign ID --format h5 -o FILE [--db hystlab.db]
 
-csv (the default) writes the run's samples, to FILE or stdout: a load frame's
-time_s,command_mm,displacement_mm,force_N,status; a shaker's time_s,drive_frequency_hz,
-drive_amplitude_mm,base_displacement_mm,mass_displacement_mm,base_accel_m_s2,mass_accel_m_s2,status.
-Numbers are in the shortest form that reads back exactly.
+csv (the default) writes the run's samples, to FILE or stdout, as GET /api/runs/ID/samples.csv
+does (docs/FORMATS.md, "Runs as CSV"): a load frame's seq,t_s,command_mm,displacement_mm,force_N,
+status; a shaker's seq,t_s,drive_frequency_hz,drive_amplitude_mm,base_displacement_mm,
+mass_displacement_mm,base_accel_m_s2,mass_accel_m_s2,status. Numbers are in the shortest form that
+reads back exactly.
 
 h5 writes an HDF5 file (docs/FORMATS.md, "Runs as HDF5"): the run's samples, one dataset per
 signal with its units, and its campaign's plan, rig, events, FOT nodes and tables. With
@@ -37,59 +38,25 @@ std::int64_t whole_number(const std::string& text, const std::string& what) {
   return v;
 }
 
-// The CSV's rows, appended to a buffer written out every MiB: bounded memory at any length.
-class CsvStream {
- public:
-  CsvStream(std::FILE* f, std::string name) : f_(f), name_(std::move(name)) { buf_.reserve(kFlushAt + 4096); }
-  void text(const char* s) { buf_ += s; }
-  void number(double v) { models::append_exact(buf_, v); }
-  void integer(std::int64_t v) { buf_ += std::to_string(v); }
-  void end_row() {
-    buf_ += '\n';
-    if (buf_.size() >= kFlushAt) flush();
+// The run's CSV (db/run_csv.hpp: the API's layout and bytes), written a window of samples at a
+// time: bounded memory at any length.
+void write_csv_rows(db::Store& store, std::int64_t id, bool shaker, std::FILE* f, const std::string& name) {
+  std::string buf = db::run_csv_header(shaker);
+  const std::int64_t last = db::last_seq(store, id, shaker);
+  for (std::int64_t seq0 = 0; seq0 <= last; seq0 += db::kRunCsvWindow) {
+    (void)db::append_csv_rows(store, id, shaker, seq0, seq0 + db::kRunCsvWindow - 1, buf);
+    if (std::fwrite(buf.data(), 1, buf.size(), f) != buf.size()) throw CliError("cannot write " + name + ": " + std::strerror(errno));
+    buf.clear();
   }
-  void flush() {
-    if (!buf_.empty() && std::fwrite(buf_.data(), 1, buf_.size(), f_) != buf_.size())
-      throw CliError("cannot write " + name_ + ": " + std::strerror(errno));
-    buf_.clear();
-  }
-
- private:
-  static constexpr std::size_t kFlushAt = 1U << 20;
-  std::FILE* f_;
-  std::string name_, buf_;
-};
-
-void write_csv_rows(db::Store& store, std::int64_t id, bool shaker, CsvStream& out) {
-  out.text("time_s");
-  if (shaker) {
-    for (const db::SignalName& n : db::kShakerSignals) out.text(","), out.text(n.name);
-    out.text(",status");
-    out.end_row();
-    store.for_each_shaker_sample(id, 0, std::int64_t{1} << 50, [&out](const db::ShakerRow& r) {
-      out.number(r.t);
-      for (const double v : r.v) out.text(","), out.number(v);
-      out.text(","), out.integer(r.status), out.end_row();
-    });
-  } else {
-    for (const db::SignalName& n : db::kFrameSignals) out.text(","), out.text(n.name);
-    out.text(",status");
-    out.end_row();
-    store.for_each_sample(id, 0, std::int64_t{1} << 50, [&out](const db::SampleRow& r) {
-      out.number(r.t), out.text(","), out.number(r.cmd), out.text(","), out.number(r.disp), out.text(",");
-      out.number(r.force), out.text(","), out.integer(r.status), out.end_row();
-    });
-  }
-  out.flush();
 }
 
 // To stdout, or to FILE.tmp renamed to FILE once complete (a failure leaves no half file).
 void export_csv(db::Store& store, std::int64_t id, const std::string& path) {
-  const bool shaker = store.max_seq(id) < 0 && store.max_shaker_seq(id) >= 0;  // a shaker's run: its own columns
-  if (store.max_seq(id) < 0 && !shaker) throw CliError("no samples for run " + std::to_string(id));
+  const db::RunSamples where = db::run_samples(store, id);
+  if (where == db::RunSamples::none) throw CliError("no samples for run " + std::to_string(id));
+  const bool shaker = where == db::RunSamples::shaker;  // a shaker's run: its own columns
   if (path.empty() || path == "-") {
-    CsvStream out(stdout, "to stdout");
-    write_csv_rows(store, id, shaker, out);
+    write_csv_rows(store, id, shaker, stdout, "to stdout");
     if (std::fflush(stdout) != 0) throw CliError(std::string("cannot write to stdout: ") + std::strerror(errno));
     return;
   }
@@ -97,8 +64,7 @@ void export_csv(db::Store& store, std::int64_t id, const std::string& path) {
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (f == nullptr) throw CliError("-o: cannot write '" + path + "': " + std::strerror(errno));
   try {
-    CsvStream out(f, "'" + path + "'");
-    write_csv_rows(store, id, shaker, out);
+    write_csv_rows(store, id, shaker, f, "'" + path + "'");
   } catch (...) {
     std::fclose(f);
     std::remove(tmp.c_str());

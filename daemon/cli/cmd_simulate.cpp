@@ -176,7 +176,7 @@ int run_simulate(const Args& args) {
       throw CliError("--tables gives one table per spring: no --table, --model, --linear or --springs with it");
     std::stringstream in(opt.get("tables"));
     for (std::string path; std::getline(in, path, ',');) {
-      const auto doc = models::table_from_json(read_file(path));
+      const auto doc = read_table_file(path);
       protos.push_back(std::make_shared<models::PreisachModel>(doc.table));
     }
     what = std::to_string(protos.size()) + " calibrated tables";

@@ -2,9 +2,12 @@
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <string>
+#include <string_view>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
+#include "hystlab/fmu/element_export.hpp"
 
 namespace hystlab::cli {
 
@@ -18,28 +21,49 @@ bool print_help_if_asked(const Args& args, const char* text) {
 }
 
 namespace {
+// Every verb and sub-command, and every export format ({formats}: fmu::kExportFormatList, the
+// list the exports accept).
 const char* kUsage = R"(hystlab: identify and use hysteresis models (Preisach/Everett tables, simplified SMA model)
 
-usage: hystlab <verb> [options]     (hystlab <verb> --help for each)
+usage: hystlab <verb> [options]     (hystlab <verb> --help for each; hystlab --version)
 
+On files:
   eval       run a table or the simplified model on a displacement series
   identify   a table from a model (virtual FOT campaign) or from measured FOT nodes
   fit        a table from any displacement/force record (least squares, prior decided by held-out data)
   calibrate  simplified-model parameters from one measured loop
   invert     displacements that produce requested forces (force control)
   check      wiping-out and congruency of a record, as numbers
-  compare    accuracy of a table or model against a record
+  compare    accuracy of a table or model against a record (or of a stored table on a stored run)
   loops      the material figures of every closed cycle of a record (energy, damping, plateaus, ...)
   demo       the paper's §3.3 study on Table 1, with a report and plots
-  campaign   submit, preview, pause, resume, abort, estop campaigns of the running hystlabd
-             (over its HTTP API); list and show them from its db file
-  rig        estop, reset or recover one of the running hystlabd's rigs (over its HTTP API)
-  tables     list and export the tables hystlabd identified
-  runs       export a run's samples as CSV, or a run or campaign as HDF5
-  simulate   the base-excited isolator (sdof): time histories, transmissibility sweeps
-  export     a table or parameters as JSON, CSV, MATLAB/Octave, a C header or an FMU
-  report     a campaign's report (HTML, or PDF through Chromium) from the running hystlabd
+  simulate sdof
+             the base-excited isolator (sdof): time histories, transmissibility sweeps
+  export --format {formats}
+             a table or parameters as JSON, CSV, MATLAB/Octave script, C header or FMI 2.0 FMU
+
+With hystlabd (commands over its HTTP API; records read from its database file):
+  campaign submit|preview|pause|resume|abort|estop|record
+             submit or preview a plan; command a campaign of the running daemon; record its specimen and notes
+  campaign list|show
+             the campaigns, from the daemon's database file
+  rig estop|reset|recover NAME
+             e-stop, reset or recover one of the running daemon's rigs
+  tables list|export --format {formats}
+             list and export the tables the daemon identified
+  runs export --format csv|h5
+             a run's samples as CSV or HDF5, or a whole campaign as HDF5 (--campaign ID)
+  report ID -o FILE.html|FILE.pdf
+             a campaign's report (HTML, or PDF through Chromium) from the running daemon
 )";
+
+// kUsage with the export formats filled in.
+std::string usage() {
+  std::string formats, text = kUsage;
+  for (const std::string_view f : fmu::kExportFormatList) formats += (formats.empty() ? "" : "|") + std::string(f);
+  for (std::size_t at = text.find("{formats}"); at != std::string::npos; at = text.find("{formats}", at)) text.replace(at, 9, formats);
+  return text;
+}
 
 int dispatch(const std::string& verb, const Args& args) {
   if (verb == "eval") return run_eval(args);
@@ -66,7 +90,7 @@ int dispatch(const std::string& verb, const Args& args) {
 int main(int argc, char** argv) {
   using namespace hystlab::cli;
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
-    std::cout << kUsage;
+    std::cout << usage();
     return argc < 2 ? 2 : 0;
   }
   if (std::strcmp(argv[1], "--version") == 0) {

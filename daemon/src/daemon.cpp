@@ -13,7 +13,9 @@
 #include <thread>
 
 #include "finisher.hpp"
+#include "monotonic_clock.hpp"
 #include "hystlab/daemon/plan.hpp"
+#include "hystlab/db/campaign_record.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "rig_worker.hpp"
 
@@ -42,6 +44,7 @@ struct Daemon::Impl {
     return finishing.count(id) > 0;
   }
   double db_backoff_s = 0;            // a busy or failing database: retried, reported once per episode
+  bool redispatch = true;             // queued rows to hand over (start-up, a resume, a failed pass)
 
   explicit Impl(const DaemonConfig& c) : config(c), store(c.db_path) {}
 
@@ -102,6 +105,7 @@ struct Daemon::Impl {
       store.transition(campaign, S::queued,
                        row->state == S::held ? "released by the operator" : "re-queued to resume: wipe-out preamble, then the rows not yet measured",
                        now_iso());
+      redispatch = true;  // to its rig on this loop's next pass (its earlier samples read there, not in this call)
       return {R::done, false, false, "queued", "queued to resume", 0};
     }
     if ((cmd == C::abort || cmd == C::estop) && !db::is_final(row->state)) {
@@ -128,8 +132,29 @@ struct Daemon::Impl {
     return nullptr;
   }
 
+  // A campaign just submitted: its plan, parsed once by submit() and checked against the rig's
+  // envelope, goes to the rig's thread as it is (no second parse, no database round trip: the
+  // row is the record, and the source only at a restart or a resume).
+  // The envelope in force when the campaign was handed to its rig (the HDF5 export's
+  // /campaign/envelope): the rig's config row is rewritten at every start and holds none.
+  void record_envelope(const RigWorker& w, std::int64_t id) {
+    store.add_event(id, "envelope", envelope_json(w.entry.envelope, w.info.kind == "shaker").dump(), now_iso());
+  }
+
+  void dispatch_new(RigWorker& w, std::int64_t id, Plan plan, double submitted_mono) {
+    record_envelope(w, id);
+    CampaignJob job;
+    job.isolator = w.entry.isolator;
+    job.id = id;
+    job.submitted_mono = submitted_mono;
+    job.plan = std::move(plan);
+    dispatched.insert(id);
+    w.push_job(std::move(job));
+  }
+
   // Hands queued campaigns to their rigs' threads, once each, with the plan checked against the
-  // rig's envelope and what earlier runs measured.
+  // rig's envelope and what earlier runs measured: at start-up, on a resume, and again after a
+  // pass the database refused (redispatch).
   void dispatch() {
     for (auto& w : workers)
       for (const std::int64_t id : store.queued_campaigns(w->info.id)) {
@@ -153,6 +178,7 @@ struct Daemon::Impl {
       store.transition(id, db::CampaignState::failed, e.what(), now_iso());
       return std::nullopt;
     }
+    record_envelope(w, id);
     for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) job.prior_nodes.push_back({a, b, fa, fab});
     if (job.plan.kind == db::CampaignKind::fot && !job.prior_nodes.empty()) {  // the fits after a resume use every run
       for (const std::int64_t run : store.runs_of_campaign(id, db::RunRole::campaign)) {  // never the validation runs
@@ -198,11 +224,14 @@ struct Daemon::Impl {
   // the database). A busy or failing database is retried with back-off and reported once per
   // episode; it never ends run().
   void poll_database() {
+    if (!redispatch) return;
     try {
+      redispatch = false;
       dispatch();
       if (db_backoff_s > 0) spdlog::info("the database answers again");
       db_backoff_s = 0;
     } catch (const std::exception& e) {
+      redispatch = true;
       if (db_backoff_s == 0) spdlog::error("the database refused the main loop ({}); retrying with back-off", e.what());
       db_backoff_s = std::min(2.0, std::max(0.1, 2 * db_backoff_s));
     }
@@ -368,7 +397,13 @@ std::pair<Plan, std::size_t> Daemon::check_plan(const std::string& rig_name, con
   return {std::move(plan), k};
 }
 
+Limits Daemon::applied_limits(const Plan& plan, std::size_t k) const {
+  const RigWorker& rig = *impl_->workers.at(k);
+  return check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, rig.info.kind == "shaker");
+}
+
 std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) {
+  const double called = mono_now();  // for the submission latency (RigLive::submit_latency_s)
   const auto [plan, k] = check_plan(rig_name, plan_json);
   RigWorker& rig = *impl_->workers.at(k);
   if (const RigSupervision s = rig.snapshot(); s.latched)
@@ -376,7 +411,33 @@ std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) 
   const std::int64_t rig_id = rig.info.id;
   const db::CampaignKind kind = plan.kind;
   const std::string text = plan_json.dump();
-  return impl_->on_main<std::int64_t>([this, rig_id, kind, text] { return impl_->store.create_campaign(rig_id, kind, text, now_iso()); });
+  Plan checked = plan;
+  checked.limits = applied_limits(plan, k);
+  // On the main loop: the row first (the record), then the parsed job straight to the rig.
+  return impl_->on_main<std::int64_t>([this, rig_id, kind, text, &rig, called, checked = std::move(checked)]() mutable {
+    const std::int64_t id = impl_->store.create_campaign(rig_id, kind, text, now_iso());
+    impl_->dispatch_new(rig, id, std::move(checked), called);
+    return id;
+  });
+}
+
+void Daemon::set_record(std::int64_t campaign_id, const json& changes) {
+  if (!changes.is_object() || changes.empty()) throw control::PlanError("", "record: give the specimen, the notes or both");
+  for (const auto& [field, value] : changes.items()) {
+    const auto problem = value.is_string() ? db::record_field_problem(field, value.get<std::string>())
+                                           : db::record_field_problem(field, "").value_or("must be text");
+    if (problem) throw control::PlanError(field, field + " " + *problem);
+  }
+  impl_->on_main<bool>([this, campaign_id, changes] {
+    auto& store = impl_->store;
+    const auto row = store.campaign(campaign_id);
+    if (!row) throw std::out_of_range("campaign " + std::to_string(campaign_id) + " does not exist");
+    db::CampaignRecord r = db::campaign_record(store, *row);
+    if (changes.contains("specimen")) r.specimen = changes["specimen"].get<std::string>();
+    if (changes.contains("notes")) r.notes = changes["notes"].get<std::string>();
+    (void)store.add_event(campaign_id, "record", db::record_detail(r), now_iso());
+    return true;
+  });
 }
 
 CommandOutcome Daemon::command(std::int64_t campaign_id, CampaignCommand cmd) {

@@ -36,7 +36,8 @@ class DaemonControl final : public control::DaemonInterface {
   control::AcquisitionCounters rig_counters(std::size_t k) const override {
     const RigLive& live = d_.rig_live(k);
     return {live.samples.load(), live.missed_deadlines.load(), live.late_wakeups.load(),
-            live.campaign.load(), live.run.load(), live.sample_rate_hz.load(), to_string(static_cast<CampaignPhase>(live.phase.load()))};
+            live.campaign.load(), live.run.load(), live.sample_rate_hz.load(), to_string(static_cast<CampaignPhase>(live.phase.load())),
+            live.submit_latency_s.load()};
   }
   std::size_t rig_index(const std::string& name, std::string_view plan_kind) const override { return d_.rig_index(name, plan_kind); }
   // A recovery ramps the frame at the safe rate (a few seconds): its answer waits for the outcome.
@@ -55,6 +56,7 @@ class DaemonControl final : public control::DaemonInterface {
     const auto [p, k] = d_.check_plan(rig, plan);
     control::PlanPreview v = preview_plan(p, model);
     v.time_scale = d_.rig_time_scale(k);
+    v.limits_applied = limits_tightened(p, d_.applied_limits(p, k));
     return v;
   }
   std::optional<control::FotGrid> fot_grid(const nlohmann::json& stored_plan) const override {
@@ -63,6 +65,7 @@ class DaemonControl final : public control::DaemonInterface {
     return control::FotGrid{p.lo_mm, p.hi_mm, p.subdivisions, p.nodes_mm};
   }
   control::CommandOutcome command(std::int64_t campaign, control::CampaignCommand c) override { return d_.command(campaign, c); }
+  void set_record(std::int64_t campaign, const nlohmann::json& changes) override { d_.set_record(campaign, changes); }
 
   control::WriterCounters writer() const override {
     const db::WriterStats w = d_.writer_stats();

@@ -135,6 +135,21 @@ void check_frame(const Plan& p, const RigEnvelope& e) {
 }
 }  // namespace
 
+std::vector<std::string> limits_tightened(const Plan& p, const Limits& a) {
+  std::vector<std::string> out;
+  const json lim = p.source.value("limits", json::object());
+  auto given = [&](const char* k) { return lim.is_object() && lim.contains(k); };
+  const Limits& asked = p.limits;
+  if (given("force_N") && asked.force_max_N > a.force_max_N)
+    out.push_back("force limit: the rig's " + num(a.force_max_N) + " N applies (the plan asked " + num(asked.force_max_N) + " N)");
+  if (given("rate_mm_s") && asked.rate_max_mm_s > a.rate_max_mm_s)
+    out.push_back("rate limit: the rig's " + num(a.rate_max_mm_s) + " mm/s applies (the plan asked " + num(asked.rate_max_mm_s) + " mm/s)");
+  if (given("displacement_mm") && (asked.displacement_min_mm < a.displacement_min_mm || asked.displacement_max_mm > a.displacement_max_mm))
+    out.push_back("displacement limits: " + num(a.displacement_min_mm) + " to " + num(a.displacement_max_mm) + " mm apply, within the rig's stroke (the plan asked " +
+                  num(asked.displacement_min_mm) + " to " + num(asked.displacement_max_mm) + " mm)");
+  return out;
+}
+
 Limits check_plan_against(const Plan& p, const RigEnvelope& e, const SupervisionSettings& s, bool shaker) {
   Limits l = p.limits;
   if (shaker) {

@@ -1,4 +1,6 @@
 #include "hystlab/daemon/plan.hpp"
+
+#include "hystlab/db/campaign_record.hpp"
 #include "plan_fields.hpp"
 
 #include <cmath>
@@ -157,9 +159,11 @@ Plan parse_plan(const json& j) {
   p.kind = *parsed_kind;
   static const char* common[] = {"kind", "ramp_rate_mm_s", "dwell_s", "sample_rate_hz", "limits", "name", "specimen", "notes"};
   // What the lab records with the campaign (the report, the lists and the exports show them).
-  for (const auto& [field, most] : {std::pair<const char*, std::size_t>{"specimen", 200}, {"notes", 4000}})
-    if (j.contains(field) && (!j[field].is_string() || j[field].get<std::string>().size() > most))
-      fail(field, "must be text of at most " + std::to_string(most) + " characters");
+  for (const char* field : {"specimen", "notes"}) {  // checked as a later change is (db/campaign_record.hpp)
+    if (!j.contains(field)) continue;
+    if (!j[field].is_string()) fail(field, "must be text");
+    if (const auto problem = db::record_field_problem(field, j[field].get<std::string>())) fail(field, *problem);
+  }
   auto known = [&](const std::vector<std::string>& extra) {
     for (const auto& [k, _] : j.items()) {
       bool ok = std::find(std::begin(common), std::end(common), k) != std::end(common);

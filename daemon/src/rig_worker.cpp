@@ -324,6 +324,7 @@ void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void
     try {
       w.service(rig_time());
       if (auto job = w.pop_job()) {
+        if (job->submitted_mono > 0) w.live.submit_latency_s = mono_now() - job->submitted_mono;
         run_job(w, std::move(*job), writer, finish, stop, t0);
         w.idle_misses = 0;
         w.running_campaign = 0;

@@ -7,6 +7,7 @@
 
 #include "h5_file.hpp"
 #include "h5_layout.hpp"
+#include "hystlab/db/campaign_record.hpp"
 #include "hystlab/db/run_h5.hpp"
 #include "hystlab/db/store.hpp"
 
@@ -22,6 +23,18 @@ std::pair<std::string, std::string> rig_record(Store& store, std::int64_t rig_id
   return {st.column_text(0), st.column_text(1)};
 }
 
+// The envelope the campaign ran under: its newest "envelope" event (the rig's envelope as the
+// daemon had it when it started the campaign: the rig's row holds only today's config, rewritten
+// at every start of hystlabd), else the envelope the rig's stored config names; "null" when neither.
+std::string envelope_in_force(Store& store, std::int64_t campaign, const std::string& config) {
+  if (const auto recorded = store.event_details(campaign, "envelope"); !recorded.empty()) {
+    const auto e = nlohmann::json::parse(recorded.back(), nullptr, false);
+    if (e.is_object()) return e.dump();
+  }
+  const auto j = nlohmann::json::parse(config, nullptr, false);
+  return j.is_object() && j.contains("envelope") && j["envelope"].is_object() ? j["envelope"].dump() : "null";
+}
+
 void write_campaign_group(Store& store, hid_t file, const CampaignRow& c) {
   const Handle g = h5::create_group(file, "campaign");
   h5::attr_int(g.get(), "id", c.id);
@@ -29,13 +42,15 @@ void write_campaign_group(Store& store, hid_t file, const CampaignRow& c) {
   h5::attr_text(g.get(), "state", to_string(c.state));
   h5::attr_text(g.get(), "created_at", c.created_at);
   h5::attr_text(g.get(), "updated_at", c.updated_at);
+  // What the lab recorded with it (at submission or since: db/campaign_record.hpp).
+  const CampaignRecord record = campaign_record(store, c);
+  h5::attr_text(g.get(), "specimen", record.specimen);
+  h5::attr_text(g.get(), "notes", record.notes);
   const auto [rig, config] = rig_record(store, c.rig_id);
   h5::attr_text(g.get(), "rig", rig);
   h5::dataset_text(g.get(), "plan", c.plan);
   h5::dataset_text(g.get(), "rig_config", config);
-  // The envelope the rig's config sets; "null" when it sets none (hystlabd's defaults applied).
-  const auto j = nlohmann::json::parse(config, nullptr, false);
-  h5::dataset_text(g.get(), "envelope", j.is_object() && j.contains("envelope") ? j["envelope"].dump() : "null");
+  h5::dataset_text(g.get(), "envelope", envelope_in_force(store, c.id, config));
   // The limits the campaign ran under (the envelope tightened by the plan's limits), as it recorded them.
   const auto limits = store.event_details(c.id, "limits");
   h5::dataset_text(g.get(), "limits", limits.empty() ? "null" : limits.back());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -55,6 +56,19 @@ std::optional<double> crossing(std::span<const double> x, std::span<const double
   return std::nullopt;
 }
 
+// Where the unloading branch dn0..dn1 first comes down to the start's force (1 % of the cycle's
+// force range above it), interpolated, as a distance from the start's displacement.
+double residual_of(std::span<const double> x, std::span<const double> f, const LoopFigures& L, std::size_t dn0, std::size_t dn1) {
+  if (L.starts_at_max) return std::numeric_limits<double>::quiet_NaN();
+  const double level = L.force_at_min_N + 0.01 * (L.peak_force_N - L.force_at_min_N);
+  for (std::size_t k = dn0; k < dn1; ++k)
+    if (f[k] > level && f[k + 1] <= level) {
+      const double w = (f[k] - level) / (f[k] - f[k + 1]);
+      return std::max(0.0, x[k] + w * (x[k + 1] - x[k]) - L.min_mm);
+    }
+  return 0.0;
+}
+
 std::optional<SmaTransitions> transformation_of(const LoopFigures& L) {
   if (!L.loading || !L.unloading || !L.loading->has_plateau() || !L.unloading->has_plateau()) return std::nullopt;
   SmaTransitions t;
@@ -97,6 +111,7 @@ LoopFigures loop_figures(std::span<const double> x, std::span<const double> f, s
     const auto up = crossing(x, f, up0, up1, at, true), down = crossing(x, f, dn0, dn1, at, false);
     if (up && down) L.plateaus.push_back({at, *up, *down});
   }
+  L.residual_mm = residual_of(x, f, L, dn0, dn1);
   L.loading = fit_branch_knees(x.subspan(up0, up1 - up0 + 1), f.subspan(up0, up1 - up0 + 1));
   L.unloading = fit_branch_knees(x.subspan(dn0, dn1 - dn0 + 1), f.subspan(dn0, dn1 - dn0 + 1));
   L.transformation = transformation_of(L);

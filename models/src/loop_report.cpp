@@ -20,6 +20,7 @@ json loop_json(const LoopFigures& L) {
          {"force_at_max_N", L.force_at_max_N},
          {"peak_force_N", L.peak_force_N},
          {"return_N", L.return_N},
+         {"residual_mm", std::isfinite(L.residual_mm) ? json(L.residual_mm) : json(nullptr)},
          {"energy_Nmm", L.energy_Nmm},
          {"secant_stiffness_N_mm", L.secant_stiffness_N_mm},
          {"strain_energy_Nmm", L.strain_energy_Nmm},

@@ -10,7 +10,7 @@
 // that database (one simulated rig, idle) to the page.
 //
 // One measurement: the page shows the other campaign, fully rendered; the campaign's entry in
-// the list is clicked (what an operator does; the page has no address for a campaign), and the
+// the list is clicked (what an operator does), and the
 // time runs from just before that click (performance.now() in the page) to the first animation
 // frame at whose start the page is fully rendered. "Fully rendered" means all of:
 //   - the page's model: window.hystlab.selected() is the campaign and state() is "completed";
@@ -27,6 +27,10 @@
 // medians. The first renders, when the daemon reads each run from SQLite into memory for its
 // first loop request, are printed apart: the page's load (it shows the newest campaign, the big
 // one, by itself; timed from the navigation's start) and the small one's first selection.
+//
+// Then the campaign report (GET /api/campaigns/ID/report.html, 3 times each, medians; and the PDF
+// through `hystlab report ID -o report.pdf`, Chromium printing it, once each) of both campaigns:
+// the 10^6-sample one against the 1,000-sample one. It asserts the report has its sections.
 // usage: node bench_page.mjs HYSTLABD BENCH_LOOP OUT_DIR
 import { execFileSync } from 'node:child_process';
 import { startDaemon, stopDaemon } from '../browser/hystlabd.mjs';
@@ -57,7 +61,9 @@ for (const n of [SMALL, BIG]) {
 
 // The daemon, on that database, with one simulated rig (as in page_test.mjs).
 fs.writeFileSync(path.join(outDir, 'hystlab.json'), JSON.stringify({ rigs: [{ name: 'sim frame', simulate: { time_scale: 10, noise_N: 0.05 } }] }));
-const { proc: daemon, port: daemonPort } = startDaemon(daemonPath, ['--config', path.join(outDir, 'hystlab.json'), '--db', db, '--port', '0'], { cwd: outDir });
+let log = '';  // what the daemon printed, shown when a check fails
+const { proc: daemon, port: daemonPort } = startDaemon(daemonPath, ['--config', path.join(outDir, 'hystlab.json'), '--db', db, '--port', '0'],
+                                                       { cwd: outDir, onOutput: d => { log += d; } });
 const port = await daemonPort;
 const base = `http://127.0.0.1:${port}`;
 const getJSON = async p => {
@@ -173,6 +179,29 @@ function reversals(x) {
   return n;
 }
 
+// The report of each campaign, as HTML (the API) and as PDF (the CLI, through Chromium).
+const reportTimes = new Map();
+async function timeReports() {
+  const cli = path.join(path.dirname(daemonPath), 'hystlab');
+  for (const c of [small, big]) {
+    const html = [];
+    for (let k = 0; k < 3; k++) {
+      const t0 = performance.now();
+      const r = await fetch(`${base}/api/campaigns/${c.id}/report.html`, { signal: AbortSignal.timeout(TIMEOUT_MS) });
+      const text = await r.text();
+      html.push(performance.now() - t0);
+      if (k === 0) check(r.status === 200 && /Data quality, per run/.test(text) && /Loop figures, per closed cycle|Identification/.test(text) && /<svg/.test(text),
+                         `campaign #${c.id}'s report has its sections and vector figures (${text.length.toLocaleString('en-US')} bytes)`);
+    }
+    const pdf = path.join(outDir, `report-${c.id}.pdf`);
+    const t0 = performance.now();
+    execFileSync(cli, ['report', String(c.id), '-o', pdf, '--daemon', base], { timeout: TIMEOUT_MS, stdio: ['ignore', 'pipe', 'pipe'] });
+    const pdfMs = performance.now() - t0;
+    check(fs.statSync(pdf).size > 10000 && fs.readFileSync(pdf).subarray(0, 5).toString() === '%PDF-', `campaign #${c.id}'s report printed to PDF (${fs.statSync(pdf).size.toLocaleString('en-US')} bytes)`);
+    reportTimes.set(c.id, { html: median(html), pdf: pdfMs });
+  }
+}
+
 const times = new Map(campaigns.map(c => [c.id, []]));
 const cold = new Map();
 try {
@@ -216,6 +245,7 @@ try {
     }
   }
   check(errors.length === 0, 'no script errors on the page' + (errors.length ? ': ' + errors.join(' | ') : ''));
+  await timeReports();
 } catch (e) {
   console.log('FAIL ' + (e.stack || e));
   checks.failures++;
@@ -239,6 +269,11 @@ if (tb.length === REPEATS && ts.length === REPEATS) {
               `campaign #${small.id} first selected in ${ms(cold.get(small.id))}`);
   console.log(`page first render, ${label}-sample campaign: median ${ms(mb)} (baseline 1,000-sample campaign: ${ms(msm)}, ratio ${(mb / msm).toFixed(2)}) ` +
               `(target < 1.5 s: ${mb < 1500 ? 'met' : 'NOT met'})`);
+}
+if (reportTimes.size === 2) {
+  const b = reportTimes.get(big.id), s = reportTimes.get(small.id);
+  console.log(`report of the ${big.samples.toLocaleString('en-US')}-sample campaign: HTML median ${ms(b.html)} (1,000-sample campaign: ${ms(s.html)}, ratio ${(b.html / s.html).toFixed(2)}); ` +
+              `PDF ${ms(b.pdf)} (1,000-sample campaign: ${ms(s.pdf)}, ratio ${(b.pdf / s.pdf).toFixed(2)})`);
 }
 if (checks.failures) console.log('the daemon printed (last 3000 characters):\n' + log.slice(-3000));
 console.log(checks.failures ? `${checks.failures} check(s) failed (screenshots in ${outDir})` : `all checks passed (screenshots in ${outDir})`);

@@ -99,6 +99,12 @@ async function checkRunning(page) {
   // A reload halfway: the points, the step and the signals are back.
   await wait(page, () => window.hystlab.transmissibilityCurves().reduce((n, c) => n + c.points, 0) >= 5, null, 'five points', 60000);
   const before = await page.evaluate(() => window.hystlab.transmissibilityCurves().reduce((n, c) => n + c.points, 0));
+  // The live mass-against-base plot: no "identified model" offered (a shaker has none), and tick
+  // labels that say different numbers (a 0.005 mm sine once read "0.01, 0.01, 0.00").
+  const loop = await page.evaluate(() => ({ legend: [...document.querySelectorAll('#loop-plot .u-legend .u-series')].filter(e => e.style.display !== 'none').map(e => e.textContent.trim()),
+                                             ticks: window.hystlab.loopTicks() }));
+  check(!loop.legend.some(t => /identified model/.test(t)) && loop.ticks.every(a => a.length > 1 && new Set(a).size === a.length),
+        `the live mass-against-base plot offers no model and its ticks differ (legend ${JSON.stringify(loop.legend)}; ticks ${JSON.stringify(loop.ticks)})`);
   await page.reload();
   check(await wait(page, n => window.hystlab.online() && window.hystlab.transmissibilityCurves().reduce((k, c) => k + c.points, 0) >= n &&
                    window.hystlab.sineStatus() && window.hystlab.sineStatus().k > 0 && window.hystlab.timeAxes().points > 0, before, 'the running sweep restored', 30000),
@@ -128,6 +134,9 @@ async function checkEnded(page, when) {
         `${when}: the resonance table: ${h.rows.slice(0, 4).map(r => r.join(' / ')).join('; ')}`);
   check(h.time.yAxes === 1 && h.time.envelope > 1000, `${when}: the whole stored run against time, as an envelope (${h.time.envelope} values)`);
   check(new RegExp(`^${STEPS} of ${STEPS} steps measured`).test(h.progress) && h.eta === '', `${when}: the header says "${h.progress}"`);
+  // Acceleration is a live view (the stored overview keeps displacements): not offered empty.
+  check(await page.evaluate(() => document.querySelector('#time-mode option[value=accel]').disabled && document.getElementById('time-mode').value === 'disp'),
+        `${when}: the ended sweep does not offer an empty acceleration view`);
 }
 
 async function checkWarnings(page, id) {

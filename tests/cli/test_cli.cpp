@@ -281,7 +281,7 @@ TEST_CASE("cli: every error is one line naming the problem, exit code 2") {
   w.write("nonmono.json", bad.dump());
   check_error(w.run("eval --table nonmono.json --input X.csv"), "non-monotone grid");
   w.write("broken.json", "{\"format\": ");
-  check_error(w.run("eval --table broken.json --input X.csv"), "not valid JSON");
+  check_error(w.run("eval --table broken.json --input X.csv"), "table file 'broken.json' is not JSON: line 1, column 12");
 
   check_error(w.run("identify --model simplified --range 0,4 --subdivisions 0 -o U.json"), "--subdivisions");
   check_error(w.run("identify --model simplified --range 4,0 --subdivisions 4 -o U.json"), "greater than the start");
@@ -320,7 +320,7 @@ TEST_CASE("cli: the daemon's records, read from its file with no daemon running"
   const Result shown = w.run("campaign show 1 --json --db d.db");
   const auto j = nlohmann::json::parse(shown.out);
   CHECK(j["plan"]["points_mm"] == nlohmann::json::parse("[0,2.5,1,3,0]"));
-  CHECK(w.run("tables list --db d.db").out.find("accuracy") != std::string::npos);
+  CHECK(w.run("tables list --db d.db").out.find("held-out RMS (N)") != std::string::npos);
   check_error(w.run("tables export 1 --format xls --db d.db"), "--format: 'xls'");
   CHECK(w.run("--version").out.rfind("hystlab ", 0) == 0);
   check_error(w.run("campaign show 99 --db d.db"), "no campaign 99");
@@ -354,11 +354,11 @@ TEST_CASE("cli: a validation run re-scored against a stored table, as the campai
   }
   const Result list = w.run("tables list --db d.db");
   CAPTURE(list.out);
-  CHECK(list.out.find("held-out (validation run)") != std::string::npos);
   char rms[32];
   std::snprintf(rms, sizeof rms, "%.4g", acc["held_out"]["overall"]["rms_N"].get<double>());
-  CHECK(list.out.find(std::string("RMS ") + rms + " N, max") != std::string::npos);
-  CHECK(list.out.find(" *") != std::string::npos);
+  CHECK(list.out.find(std::string(" ") + rms + "  ") != std::string::npos);
+  CHECK(list.out.find("  *  ") != std::string::npos);  // recommended, and said so below the table
+  CHECK(list.out.find("*: the table its campaign recommends") != std::string::npos);
   const Result cmp = w.run("compare --table-id 1 --run 2 --db d.db");
   REQUIRE(cmp.code == 0);
   CAPTURE(cmp.out);

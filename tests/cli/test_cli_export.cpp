@@ -92,8 +92,8 @@ TEST_CASE("cli: export a table and parameters as JSON, CSV, MATLAB and a C heade
   CHECK(w.run("export --params P.json --format m").out.find("P.Af0 = 21.5;") != std::string::npos);
   check_error(w.run("export --table T.json --format xlsx"), "xlsx");
   check_error(w.run("export --table T.json --params P.json --format h"), "one of");
-  check_error(w.run("export --params T.json --format fmu -o T.fmu"), "parameters");  // the kind named is the kind read
-  check_error(w.run("export --table P.json --format fmu"), "table");
+  check_error(w.run("export --params T.json --format fmu -o T.fmu"), "parameter file 'T.json': missing field");  // the kind named is the kind read
+  check_error(w.run("export --table P.json --format fmu"), "table file 'P.json': missing field 'format'");
   check_error(w.run("export --table T.json --format fmu"), "-o FILE.fmu");
   check_error(w.run("export --table T.json --format h --name 9lives"), "not a C identifier");
 }

@@ -52,6 +52,10 @@ def check_root(f, path):
     check(attr(f, "scope") in ("run", "campaign"), path + ": scope")
 
 
+# The CSV's column names that differ from the datasets' (the CSV keeps the API's t_s).
+CSV_TO_H5 = {"t_s": "time_s"}
+
+
 def check_run(f, name, path):
     g = f["runs"][name]
     rid = int(g.attrs["id"])
@@ -60,12 +64,14 @@ def check_run(f, name, path):
     rows = [line.split(",") for line in csv[1:]]
     n = int(g.attrs["samples"])
     check(n == len(rows) and n > 0, "%s run %d: %d samples in the file, %d in the CSV" % (path, rid, n, len(rows)))
+    check(header[:2] == ["seq", "t_s"] and header[-1] == "status", "%s run %d: the CSV's header %s (docs/FORMATS.md, \"Runs as CSV\")" % (path, rid, header))
     for k, col in enumerate(header):
+        col = CSV_TO_H5.get(col, col)
         ds = g[col]
         check(ds.shape == (n,), "%s run %d: %s has shape %s" % (path, rid, col, ds.shape))
         check(ds.chunks is not None and ds.compression == "gzip" and ds.maxshape == (None,), "%s: %s is not chunked, deflated, extendable" % (path, col))
-        if col == "status":
-            check(np.array_equal(ds[()], np.array([int(r[k]) for r in rows], dtype=np.int64)), "%s run %d: status differs" % (path, rid))
+        if col in ("seq", "status"):  # integers
+            check(ds.dtype == np.int64 and np.array_equal(ds[()], np.array([int(r[k]) for r in rows], dtype=np.int64)), "%s run %d: %s differs" % (path, rid, col))
             continue
         want = np.array([float(r[k]) for r in rows])  # the shortest form reads back to the same double
         got = ds[()]
@@ -130,7 +136,15 @@ def check_campaign(f, path):
     c = f["campaign"]
     check(json.loads(text(c["plan"])) == shown["plan"], path + ": plan")
     check(attr(c, "kind") == shown["kind"] and attr(c, "state") == shown["state"], path + ": kind, state")
-    json.loads(text(c["rig_config"])), json.loads(text(c["envelope"])), json.loads(text(c["limits"]))
+    json.loads(text(c["rig_config"])), json.loads(text(c["limits"]))
+    # The envelope in force: the one hystlabd recorded when it handed the campaign to its rig.
+    envelope = json.loads(text(c["envelope"]))
+    recorded = [e["detail"] for e in shown["events"] if e["kind"] == "envelope"]
+    check(recorded and envelope == json.loads(recorded[-1]) and ("stroke_mm" in envelope or "displacement_mm" in envelope),
+          path + ": envelope %r, the campaign recorded %s" % (envelope, recorded[-1] if recorded else "none"))
+    # What the lab recorded with it, as `campaign show` says.
+    check(attr(c, "specimen") == (shown.get("specimen") or "") and attr(c, "notes") == (shown.get("notes") or ""),
+          path + ": specimen %r and notes as the campaign's" % attr(c, "specimen"))
     ev = f["events"]
     kinds = [v.decode() for v in ev["kind"][()]]
     check(kinds == [e["kind"] for e in shown["events"]], path + ": events")

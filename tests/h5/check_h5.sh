@@ -22,7 +22,7 @@ mkdir tmp
 fail() { echo "FAIL: $*"; [ -f d.log ] && tail -n 20 d.log; exit 1; }
 
 echo '{"rigs": [{"name": "sim frame", "simulate": {"time_scale": 10, "noise_N": 0.05}}]}' > cfg.json
-echo '{"kind": "fot", "range_mm": [0, 2], "subdivisions": 4, "ramp_rate_mm_s": 1, "sample_rate_hz": 500, "validation": {"reversals": 6, "seed": 3}}' > uniform.json
+echo '{"kind": "fot", "range_mm": [0, 2], "subdivisions": 4, "ramp_rate_mm_s": 1, "sample_rate_hz": 500, "validation": {"reversals": 6, "seed": 3}, "specimen": "NiTi S-h5", "notes": "two lines\nof notes"}' > uniform.json
 echo '{"kind": "fot", "nodes_mm": [0, 0.3, 0.8, 1.1, 2], "ramp_rate_mm_s": 1, "sample_rate_hz": 500, "validation": false}' > refined.json
 # The HTTP export writes its temporary file beside the database (h.db here); nothing may be left
 # there, nor in TMPDIR, after any request.
@@ -73,7 +73,8 @@ done
 echo "h5dump: layout, units and compression as documented"
 
 # A shaker's run has its own signals: a sine campaign's run of 3,000 samples, stored beside the
-# daemon's (the test's own SQL; a real sweep takes minutes of real time).
+# daemon's (the test's own SQL; a real sweep takes minutes of real time), with the envelope it ran
+# under recorded as an event (the envelope in force, which the export carries: /campaign/envelope).
 "$py" - <<'PY'
 import math, sqlite3
 c = sqlite3.connect("h.db")
@@ -83,6 +84,8 @@ rid = c.execute("INSERT INTO runs(campaign_id, started_at, wall_anchor_unix, mon
 c.executemany("INSERT INTO shaker_samples VALUES(?,?,?,?,?,?,?,?,?,?)",
               [(rid, k, k / 1000, 12.0, 0.5, 0.5 * math.sin(0.0754 * k), 1.3 * math.sin(0.0754 * k - 0.4), -2.8 * math.sin(0.0754 * k),
                 -7.4 * math.sin(0.0754 * k - 0.4), k % 3) for k in range(3000)])
+c.execute("INSERT INTO events(campaign_id, at, kind, detail) VALUES(?, 't', 'envelope', ?)",
+          (cid, '{"accel_g":10.0,"displacement_mm":4.5,"frequency_hz":[1.0,200.0],"velocity_mm_s":300.0}'))
 c.commit()
 open("shaker_run", "w").write(str(rid))
 PY
@@ -91,10 +94,19 @@ h5dump -a "/runs/run_$(cat shaker_run)/base_accel_m_s2/units" shaker.h5 | grep -
 
 # h5py: every sample, every table, every record.
 "$py" "$here/check_h5.py" "$cli" h.db run1.h5 campaign1.h5 campaign2.h5 http1.h5 httpc2.h5 shaker.h5
+"$py" -c 'import h5py, json, sys; e = json.loads(h5py.File("shaker.h5")["campaign/envelope"][()].decode()); sys.exit(0 if e and e["displacement_mm"] == 4.5 else "the envelope: %r" % (e,))' \
+  || fail "shaker.h5: /campaign/envelope is not the envelope the campaign recorded"
+# One CSV layout (docs/FORMATS.md, "Runs as CSV"): the CLI's and the API's bytes are the same.
+for run in 1 "$(cat shaker_run)"; do
+  "$cli" runs export "$run" --db h.db > cli.csv
+  curl -s -o api.csv "$api/api/runs/$run/samples.csv"
+  cmp -s cli.csv api.csv || fail "run $run: the CLI's CSV and GET /api/runs/$run/samples.csv differ: $(head -1 cli.csv) / $(head -1 api.csv)"
+done
+echo "csv: the CLI's and the API's are the same bytes (a load frame's run and a shaker's)"
 
 # Octave 7's load reads the datasets (not the attributes): the forces are the CSV's.
 if [ -n "$octave" ]; then
-  "$cli" runs export 1 --db h.db | tail -n +2 | cut -d, -f4 > csv_force.txt
+  "$cli" runs export 1 --db h.db | tail -n +2 | cut -d, -f5 > csv_force.txt  # seq,t_s,command_mm,displacement_mm,force_N,status
   "$octave" --no-gui --quiet --norc --eval "x = load('run1.h5'); printf('%.17g\n', x.runs.run_1.force_N); t = x.tables.table_1; E = t.everett_N'; if ~isnan(E(1,2)) || E(2,1) == 0, exit(1); end" > octave_force.txt 2> octave.err \
     || fail "octave could not load run1.h5: $(head -5 octave.err)"
   "$py" - <<'PY' || fail "Octave's forces differ from the CSV's"

@@ -66,6 +66,8 @@ TEST_CASE("loop figures of a hand-drawn superelastic loop") {
   CHECK(L.strain_energy_Nmm == doctest::Approx(0.5 * 55.0 * 4.0));
   CHECK(L.damping_ratio == doctest::Approx(area / (4 * std::numbers::pi * 110.0)));
   CHECK(L.return_N == doctest::Approx(0.0));
+  // Unloaded to 1 % of the force range (2.2 N) on the last side, (0.5, 20) to (0, 0): at 0.055 mm.
+  CHECK(L.residual_mm == doctest::Approx(0.5 * 2.2 / 20).epsilon(1e-6));
   REQUIRE(L.plateaus.size() == 1);
   CHECK(L.plateaus[0].at_mm == 2.0);
   CHECK(L.plateaus[0].loading_N == doctest::Approx(55.0));                        // 40 + 15 * 1
@@ -204,4 +206,18 @@ TEST_CASE("loop figures: bad records are refused with the sample named") {
   CHECK_THROWS_WITH(hystlab::models::find_loops(x, g), "loops: displacement and force differ in length");
   const std::vector<double> flat(10, 1.0);
   CHECK(hystlab::models::find_loops(flat, flat).empty());
+}
+
+TEST_CASE("residual displacement of a loop with a permanent set, and of a cycle from a maximum") {
+  // As the hand-drawn loop, but the unloading reaches no force at 0.3 mm and is pushed below it
+  // back to 0 (displacement control): 2.2 N (1 % of 220 N) is crossed on (0.8, 20)-(0.3, 0).
+  const std::vector<Pt> set{{0, 0}, {1, 40}, {3, 70}, {4, 220}, {kAsX, 45}, {0.8, 20}, {0.3, 0}, {0, -5}};
+  std::vector<double> x, f;
+  trace(set, 400, x, f);
+  const auto loops = hystlab::models::find_loops(x, f);
+  REQUIRE(loops.size() == 1);
+  CHECK(loops[0].residual_mm == doctest::Approx(0.3 + 0.5 * 2.2 / 20).epsilon(1e-6));
+  // A cycle inside a loading (from a maximum, down and back up) unloads to no start: NaN.
+  const auto inner = hystlab::models::loop_figures(std::vector<double>{2, 1, 2}, std::vector<double>{50, 30, 50}, 0, 1, 2);
+  CHECK(std::isnan(inner.residual_mm));
 }

@@ -58,6 +58,14 @@ class FakeDaemon final : public control::DaemonInterface {
     commands.emplace_back(campaign, c);
     return {control::CommandOutcome::Result::done, false, false, "running", "", 0.0};
   }
+  // A record change: kept, written as the daemon writes it (a "record" event), or refused by field.
+  void set_record(std::int64_t campaign, const nlohmann::json& changes) override {
+    if (changes.contains("colour")) throw control::PlanError("colour", "colour is not part of a campaign's record (specimen, notes)");
+    std::lock_guard lk(mu);
+    records.emplace_back(campaign, changes);
+    db::Store(db_).add_event(campaign, "record", nlohmann::json{{"specimen", changes.value("specimen", "")}, {"notes", changes.value("notes", "")}}.dump(),
+                             "2026-01-01T00:00:00.000Z");
+  }
   control::WriterCounters writer() const override { return {99, 0, 0, 1}; }
   double uptime_s() const noexcept override { return 12.5; }
   std::string db_path() const override { return db_; }
@@ -67,6 +75,7 @@ class FakeDaemon final : public control::DaemonInterface {
   std::atomic<bool> estopped{false};
   std::mutex mu;
   std::vector<std::pair<std::int64_t, control::CampaignCommand>> commands;
+  std::vector<std::pair<std::int64_t, nlohmann::json>> records;
 };
 }  // namespace
 
@@ -125,6 +134,30 @@ TEST_CASE("the web layer runs on the daemon's interface alone: snapshots, comman
     REQUIRE(fake.commands.size() == 1);
     CHECK(fake.commands[0].first == id);
     CHECK(fake.commands[0].second == control::CampaignCommand::abort);
+  }
+  SUBCASE("a campaign's specimen and notes change through the interface; a field it refuses is named as the body's") {
+    auto r = c.Post("/api/campaigns", json{{"plan", {{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 2}, {"specimen", "S-1"}}}}.dump(), "application/json");
+    REQUIRE(r);
+    REQUIRE(r->status == 201);
+    const std::string id = std::to_string(json::parse(r->body)["id"].get<std::int64_t>());
+    CHECK(json::parse(r->body)["specimen"] == "S-1");  // from the plan, as submitted
+    auto ok = c.Post("/api/campaigns/" + id + "/record", json{{"specimen", "S-2"}, {"notes", "reseated"}}.dump(), "application/json");
+    REQUIRE(ok);
+    CHECK(ok->status == 200);
+    const json after = json::parse(ok->body);
+    CHECK(after["specimen"] == "S-2");
+    CHECK(after["notes"] == "reseated");
+    CHECK(after["record_changed_at"] == "2026-01-01T00:00:00.000Z");
+    auto bad = c.Post("/api/campaigns/" + id + "/record", json{{"colour", "red"}}.dump(), "application/json");
+    REQUIRE(bad);
+    CHECK(bad->status == 400);
+    CHECK(json::parse(bad->body)["field"] == "colour");
+    auto missing = c.Post("/api/campaigns/999/record", json{{"notes", "x"}}.dump(), "application/json");
+    REQUIRE(missing);
+    CHECK(missing->status == 404);
+    std::lock_guard lk(fake.mu);
+    REQUIRE(fake.records.size() == 1);
+    CHECK(fake.records[0].second["notes"] == "reseated");
   }
   SUBCASE("a plan the interface refuses is a 400 naming the plan's field") {
     auto r = c.Post("/api/campaigns", json{{"plan", {{"range_mm", {0, 4}}}}}.dump(), "application/json");

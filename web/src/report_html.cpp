@@ -38,9 +38,10 @@ void header(std::ostringstream& o, const json& doc) {
   o << "<p><span class=\"state\">" << esc(s(c, "state")) << "</span> " << esc(s(c, "reason")) << "</p><table>";
   kv(o, "created", esc(s(c, "created_at")) + " (UTC)");
   kv(o, "last change", esc(s(c, "updated_at")) + " (UTC)");
-  const json& plan = c.value("plan", json::object());
-  if (!s(plan, "specimen").empty()) kv(o, "specimen", esc(s(plan, "specimen")));
-  if (!s(plan, "notes").empty()) kv(o, "notes", esc(s(plan, "notes")));
+  // The record as it stands (at submission, or changed since: db/campaign_record.hpp).
+  if (!s(c, "specimen").empty()) kv(o, "specimen", esc(s(c, "specimen")));
+  if (!s(c, "notes").empty()) kv(o, "notes", "<span style=\"white-space: pre-wrap\">" + esc(s(c, "notes")) + "</span>");
+  if (!s(c, "record_changed_at").empty()) kv(o, "record changed", esc(s(c, "record_changed_at")) + " (UTC)");
   kv(o, "report", "generated " + esc(s(doc, "generated_at")) + " (UTC) by " + esc(s(doc, "software")) + " from the stored records only");
   o << "</table>";
 }
@@ -154,11 +155,11 @@ void shakedown_figure(std::ostringstream& o, const json& c) {
 
 // Per closed cycle: the figures a superelastic test standard (ASTM F2516) reports, in force and
 // displacement units for springs: the plateau forces (the knees of each branch), the force at
-// return, the dissipated energy.
+// return, the residual displacement (unloaded to 1 % of the cycle's force range), the dissipated energy.
 void cycles_table(std::ostringstream& o, const json& loops) {
   if (!loops.is_array() || loops.empty()) return;
   o << "<h3>Loop figures, per closed cycle</h3><table><tr><th>cycle</th><th>phase</th><th class=n>range</th><th class=n>peak force</th>"
-       "<th class=n>loading plateau</th><th class=n>unloading plateau</th><th class=n>force at return</th><th class=n>dissipated energy</th><th class=n>damping ratio</th></tr>";
+       "<th class=n>loading plateau</th><th class=n>unloading plateau</th><th class=n>force at return</th><th class=n>residual displacement</th><th class=n>dissipated energy</th><th class=n>damping ratio</th></tr>";
   auto plateau = [](const json& k) {
     if (!k.is_object() || !k.value("plateau", false)) return std::string("<span class=muted>none</span>");
     return num(d(k, "lower_N")) + "–" + num(d(k, "upper_N")) + " N";
@@ -167,7 +168,7 @@ void cycles_table(std::ostringstream& o, const json& loops) {
     o << "<tr><td>" << l.value("k", 0) << " (run #" << l.value("run", 0) << ")</td><td>" << esc(s(l, "phase")) << "</td><td class=n>" << num(d(l, "min_mm")) << "–"
       << unit(d(l, "max_mm"), "mm") << "</td><td class=n>" << unit(d(l, "peak_force_N"), "N") << "</td><td class=n>" << plateau(l.value("loading_knees", json()))
       << "</td><td class=n>" << plateau(l.value("unloading_knees", json())) << "</td><td class=n>" << unit(d(l, "return_N"), "N") << "</td><td class=n>"
-      << unit(d(l, "energy_Nmm"), "N·mm") << "</td><td class=n>" << num(d(l, "damping_ratio")) << "</td></tr>";
+      << unit(d(l, "residual_mm"), "mm") << "</td><td class=n>" << unit(d(l, "energy_Nmm"), "N·mm") << "</td><td class=n>" << num(d(l, "damping_ratio")) << "</td></tr>";
   o << "</table>";
 }
 

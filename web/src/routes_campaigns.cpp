@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <set>
 
+#include "hystlab/db/campaign_record.hpp"
 #include "hystlab/models/grid.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
@@ -32,6 +33,14 @@ json tables_of(db::Store& store, std::int64_t campaign, const json& runs) {
     for (const json& r : runs)
       for (const json& w : result_warnings(r["quality"])) warnings.push_back(w);
     j["warnings"] = warnings;
+    // A least-squares table's prior and regularisation, as fields (not only inside a sentence).
+    if (t.method == "lsq")
+      if (const auto text = store.table_document(t.id)) {
+        const json doc = json::parse(*text, nullptr, false);
+        const json details = doc.is_object() ? doc.value("provenance", json::object()).value("details", json::object()) : json::object();
+        if (details.is_object() && details.contains("prior")) j["prior"] = details["prior"], j["lambda"] = details.value("lambda", json());
+        if (details.is_object() && details.contains("reason")) j["prior_reason"] = details["reason"];
+      }
     out.push_back(j);
   }
   return out;
@@ -96,8 +105,11 @@ json campaign_json(const control::DaemonInterface& d, db::Store& store, const db
   j["commands"] = commands;
   j["active"] = db::is_active(row.state);
   j["final"] = db::is_final(row.state);
-  const json plan = json::parse(row.plan, nullptr, false);  // the specimen the lab named at submission
-  j["specimen"] = plan.is_object() && plan.contains("specimen") && plan["specimen"].is_string() ? plan["specimen"] : json(nullptr);
+  // What the lab records with it: at submission, or changed since (POST .../record).
+  const db::CampaignRecord record = db::campaign_record(store, row);
+  j["specimen"] = record.specimen.empty() ? json(nullptr) : json(record.specimen);
+  j["notes"] = record.notes.empty() ? json(nullptr) : json(record.notes);
+  j["record_changed_at"] = record.changed_at.empty() ? json(nullptr) : json(record.changed_at);
   // Why it is in this state (why it ended, was held, failed), beside the state wherever it is shown.
   const std::string why = store.state_reason(row.id, row.state);
   j["reason"] = why.empty() ? json(nullptr) : json(why);
@@ -148,6 +160,19 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/campaigns/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
     send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, path_id(req)), true));
+  }));
+  // The specimen and notes, changed after submission (any state): {"specimen": ..., "notes": ...}.
+  post_route(s, c, R"(/api/campaigns/(\d+)/record)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
+    const auto row = campaign_or_404(reader(c.db_path), path_id(req));
+    try {
+      c.daemon.set_record(row.id, body_object(req));
+    } catch (const control::PlanError& e) {  // not a plan's field: named as the body's
+      throw ApiError(400, "invalid record", e.what(), e.field);
+    } catch (const std::out_of_range& e) {
+      throw ApiError(404, "not found", e.what());
+    }
+    auto& store = reader(c.db_path);
+    send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, row.id), false));
   }));
   post_route(s, c, R"(/api/campaigns/(\d+)/([a-z_]+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     const std::string verb = req.matches[2].str();

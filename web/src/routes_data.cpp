@@ -1,5 +1,5 @@
 // Runs and their samples (decimated with min/max per bucket, or full resolution as a streamed
-// CSV), tables (list, get, export) and model evaluation.
+// CSV, db/run_csv.hpp), tables (list, get, export) and model evaluation.
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -10,15 +10,12 @@
 #include "hystlab/fmu/element_export.hpp"
 #include "hystlab/models/table_export.hpp"
 #include "hystlab/models/table_score.hpp"
-#include "hystlab/models/text_forms.hpp"
-#include "hystlab/db/signals.hpp"
+#include "hystlab/db/run_csv.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
 namespace {
-constexpr std::int64_t kCsvChunk = 8192;
-
 db::RunInfo run_or_404(db::Store& store, std::int64_t id) {
   auto r = store.run(id);
   if (!r) throw ApiError(404, "not found", "no run " + std::to_string(id));
@@ -45,54 +42,22 @@ std::unique_ptr<models::HysteresisModel> model_of(const json& body, db::Store& s
   return std::make_unique<models::SimplifiedSmaModel>(models::params_from_json(body["params"].dump()));
 }
 
-// A number in the shortest form that reads back to the same double (as the CLI's exports and
-// HDF5 hold it: an analyst's arrays are the stored values), then the separator.
-void append_exact(std::string& out, double v, char sep) {
-  models::append_exact(out, v);
-  out.push_back(sep);
-}
-
-// One chunk of a run's rows as CSV lines; rows: how many there were.
-std::string csv_chunk(db::Store& store, std::int64_t run, bool shaker, std::int64_t seq0, std::int64_t& rows) {
-  std::string chunk;
-  if (shaker) {
-    store.for_each_shaker_sample(run, seq0, seq0 + kCsvChunk - 1, [&](const db::ShakerRow& r) {
-      chunk += std::to_string(r.seq);
-      chunk.push_back(',');
-      append_exact(chunk, r.t, ',');
-      for (const double v : r.v) append_exact(chunk, v, ',');
-      chunk += std::to_string(r.status);
-      chunk.push_back('\n');
-      ++rows;
-    });
-    return chunk;
-  }
-  store.for_each_sample(run, seq0, seq0 + kCsvChunk - 1, [&](const db::SampleRow& r) {
-    chunk += std::to_string(r.seq);
-    chunk.push_back(',');
-    for (const double v : {r.t, r.cmd, r.disp, r.force}) append_exact(chunk, v, ',');
-    chunk += std::to_string(r.status);
-    chunk.push_back('\n');
-    ++rows;
-  });
-  return chunk;
-}
-
-// The columns are the rig kind's signals (db/signals.hpp): a shaker's are its own, not the load frame's.
+// Every sample in the one CSV layout of a run (db/run_csv.hpp: the CLI's `runs export` writes the
+// same bytes), a window of samples a chunk. A run without samples: its rig kind's header only.
 void stream_csv(httplib::Response& res, const std::string& db_path, std::int64_t run, bool shaker) {
   res.set_header("Content-Disposition", "attachment; filename=\"run-" + std::to_string(run) + ".csv\"");
   auto next = std::make_shared<std::int64_t>(-1);  // -1: the header is still to be sent
   res.set_chunked_content_provider("text/csv", [db_path, run, next, shaker](std::size_t, httplib::DataSink& sink) {
     if (*next < 0) {
-      const std::string head = shaker ? db::csv_header(db::kShakerSignals) : db::csv_header(db::kFrameSignals);
+      const std::string head = db::run_csv_header(shaker);
       *next = 0;
       return sink.write(head.data(), head.size());
     }
-    std::int64_t rows = 0;
     db::Store& store = reader(db_path);
-    const std::string chunk = csv_chunk(store, run, shaker, *next, rows);
-    *next += kCsvChunk;
-    if (rows == 0 && *next > (shaker ? store.max_shaker_seq(run) : store.max_seq(run))) {
+    std::string chunk;
+    const std::int64_t rows = db::append_csv_rows(store, run, shaker, *next, *next + db::kRunCsvWindow - 1, chunk);
+    *next += db::kRunCsvWindow;
+    if (rows == 0 && *next > db::last_seq(store, run, shaker)) {
       sink.done();
       return true;
     }
@@ -139,7 +104,9 @@ void add_data_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/runs/(\d+)/samples\.csv)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
     auto& store = reader(c.db_path);
     const db::RunInfo r = run_or_404(store, path_id(req));
-    stream_csv(res, c.db_path, r.id, shaker_run(store, r));
+    // Where its samples are says the rig kind; a run without any, its campaign's kind.
+    const db::RunSamples where = db::run_samples(store, r.id);
+    stream_csv(res, c.db_path, r.id, where == db::RunSamples::none ? shaker_run(store, r) : where == db::RunSamples::shaker);
   }));
   s.Get("/api/tables", guarded([&c](const httplib::Request&, httplib::Response& res) {
     json out = json::array();

@@ -104,7 +104,7 @@ json preview_json(ApiContext& c, const PlanRequest& req) {
            {"samples", std::llround(v.samples)}, {"sample_rate_hz", v.sample_rate_hz}, {"time_scale", v.time_scale},
            // what the rig can give at its time scale: the wall time, and what is stored in rig time
            {"wall_s", v.duration_s / v.time_scale}, {"stored_samples", std::llround(v.samples / v.time_scale)},
-           {"stored_rate_hz", v.sample_rate_hz / v.time_scale}};
+           {"stored_rate_hz", v.sample_rate_hz / v.time_scale}, {"limits_applied", v.limits_applied}};
   if (model) out["peak_force_N"] = v.peak_force_N, out["force_source"] = source, out["force_limit_N"] = v.force_limit_N;
   else out["peak_accel_m_s2"] = v.peak_accel_m_s2;
   return out;

@@ -73,6 +73,9 @@ std::string metrics_text(ApiContext& c) {
   for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_missed_deadlines_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).missed_deadlines));
   metric(o, "hystlab_late_wakeups_total", "counter", "Acquisition periods that started more than a period late.");
   for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_late_wakeups_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).late_wakeups));
+  metric(o, "hystlab_submission_latency_seconds", "gauge", "The newest submission's time from the call to its rig's thread taking the job.");
+  for (std::size_t k = 0; k < d.rig_count(); ++k)
+    if (const double s = d.rig_counters(k).submit_latency_s; s >= 0) line("hystlab_submission_latency_seconds", "rig=\"" + label(d.rig_info(k).name) + "\"", s);
   std::vector<std::pair<std::string, control::LinkHealth>> rigs;  // one read per rig: families stay consistent
   for (std::size_t k = 0; k < d.rig_count(); ++k) rigs.emplace_back("rig=\"" + label(d.rig_info(k).name) + "\"", d.rig_health(k));
   auto family = [&](const char* name, const char* type, const char* help, auto value) {

@@ -3,7 +3,9 @@
 // plots (plots.js), a shaker's sine sweep (shaker.js); this file holds the campaign being shown
 // and the live stream.
 import { api, post, token } from './api.js';
-import { XYPlot, TimePlot, TriangleHeatmap } from './plots.js';
+import { XYPlot, TimePlot, TriangleHeatmap, LOOP_SHARE, relayout } from './plots.js';
+import { parseRoute, setRoute, routeHref } from './route.js';
+import { RecordView } from './record.js';
 import { SweepView, describeSweepEvent } from './shaker.js';
 import { RigPanel } from './rigs.js';
 import { PlanForm } from './form.js';
@@ -24,7 +26,7 @@ const S = {
 };
 
 const loop = new XYPlot($('loop-plot'), 'displacement (mm)', 'force (N)',
-  [{ label: 'measured', color: '#1565c0', width: 1.2 }, { label: 'identified model', color: '#ef6c00', width: 2 }]);
+  [{ label: 'measured', color: '#1565c0', width: 1.2 }, { label: 'identified model', color: '#ef6c00', width: 2 }], { share: LOOP_SHARE, minHeight: 200 });
 const heat = new TriangleHeatmap($('heatmap-plot'));
 const timeplot = new TimePlot($('time-plot'), ['displacement (mm)', 'force (N)']);
 const sweep = new SweepView({ trans: $('trans-plot'), time: $('shaker-time-plot'), table: $('resonance'), status: $('sweep-status') });
@@ -39,7 +41,7 @@ const planForm = new PlanForm($('plan-form'), { rigPanel, onSubmitted: c => seri
 // For tests and the curious: what the page shows, as numbers.
 window.hystlab = {
   state: () => S.detail && S.detail.state, selected: () => S.selected,
-  loopPoints: () => loop.points(0), modelPoints: () => loop.points(1),
+  loopPoints: () => loop.points(0), shownRun: () => S.runId, loopTicks: () => loop.ticks(), modelPoints: () => loop.points(1),
   loopPath: () => loop.path(0), modelPath: () => loop.path(1), loopInfo: () => S.loopInfo,
   loadLoop: points => new Promise((resolve, reject) => serial(() => loadLoop(points).then(resolve, reject))()),
   heatmapIdentified: () => heat.identified(), heatmapRequired: () => heat.required(), heatmapLimits: () => heat.limits(),
@@ -51,7 +53,7 @@ window.hystlab = {
   jumps: () => [...document.querySelectorAll('#resonance .jumps li')].map(li => li.textContent),
   timeAxes: () => (isSine() ? sweep.time.axes() : timeplot.axes()),
   rigs: () => rigPanel.rigs(), warnings: () => S.warnings.slice(),
-  shakedownPoints: () => shakedown.points(), loopRows: () => $('loops').querySelectorAll('tbody tr').length,
+  shakedownPoints: () => shakedown.points(), shakedownTicks: () => shakedown.ticks(), loopRows: () => $('loops').querySelectorAll('tbody tr').length,
   heldOut: () => [...document.querySelectorAll('#accuracy .heldout')].map(e => e.textContent),
   recommended: () => { const r = document.querySelector('#accuracy .recommended'); return r ? Number(r.dataset.table) : null; },
 };
@@ -61,10 +63,12 @@ async function refreshList() {
   S.campaigns = await api('/api/campaigns');
   $('campaigns').replaceChildren(...S.campaigns.slice().reverse().map(c => {
     const li = el('li', { 'data-id': c.id, class: c.id === S.selected ? 'selected' : '',
-                          text: `#${c.id} ${c.kind} — ${c.state}` + (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : '') +
+                          // why it ended (or waits) beside the state, unless it simply finished
+                          text: `#${c.id} ${c.kind} — ${c.state}` + (c.reason && c.state !== 'completed' && !c.active && c.state !== 'queued' ? ` (${c.reason})` : '') +
+                                (c.tables ? ` · ${c.tables} table${c.tables > 1 ? 's' : ''}` : '') +
                                 (c.specimen ? ` · ${c.specimen}` : ''),
                           title: c.reason ? `${c.state}: ${c.reason}` : '' });
-    li.addEventListener('click', serial(() => { S.follow = false; return select(c.id); }));
+    li.addEventListener('click', serial(() => { S.follow = false; return select(c.id, null, true); }));
     return li;
   }));
   if (S.follow) {
@@ -74,8 +78,11 @@ async function refreshList() {
   }
 }
 
-async function select(id) {
+// Shows campaign id (and run `run` of it in the plots; null: its own run), with its address.
+async function select(id, run = null, remember = false) {
   S.selected = id;
+  S.wantRun = run;
+  setRoute(id, run, remember);
   for (const li of $('campaigns').children) li.className = Number(li.dataset.id) === id ? 'selected' : '';
   S.loopInfo = null;
   loop.set(0, [], []); loop.set(1, [], []); timeplot.clear();
@@ -91,6 +98,7 @@ async function loadNodes(id) {
   if (id !== S.selected) return;
   heat.setGrid(nodes.grid);
   for (const n of nodes.nodes) heat.add(n.alpha, n.beta, n.F);
+  heat.fitScale();
   heat.redraw();
 }
 
@@ -106,10 +114,15 @@ async function refreshDetail() {
   }
   // The stored count is the truth: a node missed on the stream (or a failed load) is fetched again.
   if (d.kind === 'fot' && d.progress && (heat.grid ? d.progress.nodes !== heat.identified() : true)) await loadNodes(d.id);
+  else if (d.final) heat.fitScale();
   // The campaign's own run (the newest, after a resume), not the validation run beside it.
+  // A run named in the address (#campaign/ID/run/R), when it is one of this campaign's.
   const own = d.runs.filter(r => r.role !== 'validation');
-  S.runId = own.length ? own[own.length - 1].id : null;
+  const wanted = d.runs.find(r => r.id === S.wantRun);
+  S.runId = wanted ? wanted.id : own.length ? own[own.length - 1].id : null;
   $('title').textContent = `Campaign #${d.id}: ${d.kind} on ${d.rig}` + (d.specimen ? ` · ${d.specimen}` : '');
+  $('title').href = routeHref(d.id, wanted ? wanted.id : null);
+  record.show(d);
   $('state').textContent = d.state;
   $('state').className = 'state ' + d.state;
   // Why it is in that state, beside it (an aborted or failed campaign's reason, not at the bottom of the events).
@@ -130,13 +143,21 @@ async function refreshDetail() {
   // frequency and amplitude into one unreadable knot.
   $('loop-fig').hidden = shaker && d.final;
   $('shaker-time-fig').classList.toggle('wide', !!d.final);  // alone on its row then
+  // The stored run's overview keeps displacements only: acceleration is a live view (and in samples.csv).
+  const accel = $('time-mode').querySelector('option[value=accel]');
+  accel.disabled = !!d.final;
+  accel.title = d.final ? "live only: a finished run's acceleration is in its samples .csv" : '';
+  if (d.final && $('time-mode').value === 'accel') { $('time-mode').value = 'disp'; sweep.time.setMode('disp'); }
   loop.relabel(shaker ? 'base displacement (mm)' : 'displacement (mm)', shaker ? 'mass displacement (mm)' : 'force (N)');
+  loop.offer(1, !shaker);  // a shaker has no identified model to draw
   showLoopCaption();
   showAccuracy(d);
   S.events = await api(`/api/campaigns/${d.id}/events`);
   if (S.selected !== d.id) return;
   if (shaker) { sweep.setEvents(S.events); useStreamRate(sineStreamRate(d)); await sweep.refresh(d); } else useStreamRate(FRAME_RATE);
-  S.warnings = showQuality(d, $('quality'), $('warnings'), shaker ? sweepWarnings(d) : []);
+  const warned = $('warnings').hidden ? 0 : $('warnings').offsetHeight;
+  S.warnings = showQuality(d, $('quality'), $('warnings'), shaker ? sweepWarnings(d) : [], { run: S.runId, href: r => routeHref(d.id, r) });
+  if (($('warnings').hidden ? 0 : $('warnings').offsetHeight) !== warned) relayout();  // the plots share what the box leaves
   showDownloads(d);
   await showLoops(d);
   showProgress(d);
@@ -158,8 +179,10 @@ function describe(e) {
   if (e.kind === 'recommendation' || e.kind === 'training') return d.why;
   if (e.kind === 'shakedown') return `cycle ${d.cycle}: E_d ${num(d.energy_Nmm)} N·mm` + (d.energy_change_pct != null ? ` (${num(d.energy_change_pct, 2)} %)` : '') +
     `, peak ${round2(d.peak_force_N)} N` + (d.peak_change_pct != null ? ` (${num(d.peak_change_pct, 2)} %)` : '') + (d.stable ? ': stable' : '');
-  if (e.kind === 'limits') return Object.entries(d).map(([k, v]) => `${k.replace(/_/g, ' ')} ${Array.isArray(v) ? v.map(x => num(x)).join('…') : num(v)}`).join(', ');
-  return JSON.stringify(d);
+  if (e.kind === 'record') return `the record changed: specimen ${d.specimen ? `"${d.specimen}"` : 'none'}, notes ${d.notes ? `"${d.notes}"` : 'none'}`;
+  if (e.kind === 'limits' || e.kind === 'envelope') return Object.entries(d).map(([k, v]) => `${k.replace(/_/g, ' ')} ${Array.isArray(v) ? v.map(x => num(x)).join('…') : num(v)}`).join(', ');
+  // A kind this page does not know: its fields in words, never raw JSON.
+  return Object.entries(d).map(([k, v]) => `${k.replace(/_/g, ' ')} ${typeof v === 'number' ? num(v) : typeof v === 'object' ? JSON.stringify(v) : v}`).join(', ');
 }
 
 // Seconds the campaign has spent running, from its state events: paused (or held) time does
@@ -176,7 +199,12 @@ function activeSeconds(events, now) {
   return total / 1000;
 }
 
+// The header's status line (reason, progress, ETA) may be cut at its end: its tooltip has it all.
 function showProgress(d) {
+  progressText(d);
+  $('status-line').title = $('status-line').textContent.trim();
+}
+function progressText(d) {
   if (d.kind === 'sine') { const s = sweep.showStatus(d); $('progress').textContent = s.progress; $('eta').textContent = s.eta; return; }
   if (!d.progress) { $('progress').textContent = ''; $('eta').textContent = ''; return; }
   const k = d.progress.nodes, n = d.progress.required;
@@ -213,7 +241,9 @@ function showDownloads(d) {
     links.push(link(`/api/campaigns/${d.id}/sweep.csv`, 'sweep points .csv', `sweep-${d.id}.csv`));
     links.push(link(`/api/campaigns/${d.id}/sweep`, 'sweep points and resonances .json', `sweep-${d.id}.json`));
   }
+  links.push(el('a', { href: `/api/campaigns/${d.id}/report.html`, target: '_blank', class: 'report', text: 'report (to print or file)' }));
   for (const r of d.runs) {
+    if (!(r.samples > 0)) continue;  // nothing stored: nothing to download
     links.push(link(`/api/runs/${r.id}/samples.csv`, `run #${r.id} samples .csv`));
     links.push(link(`/api/runs/${r.id}/samples.h5`, `run #${r.id} .h5 (with the campaign)`));
   }
@@ -273,7 +303,12 @@ async function loadLoop(points = LOOP_POINTS) {
 function showLoopCaption() {
   const shaker = S.detail && S.detail.kind === 'sine', i = S.loopInfo;
   let text = shaker ? 'Mass against base displacement: the newest cycles' : 'Force–displacement';
-  if (i) text += ` — ${count(i.samples)} samples, ${count(i.reversals)} reversals (drawn with ${count(i.points)} points)` +
+  // Live, the samples the stream brought (it updates as they come); at the end, the stored run's.
+  const shown = S.runId != null && S.detail.runs.find(r => r.id === S.runId);
+  if (shown) text += `, run #${shown.id}` + (shown.role === 'validation' ? ' (validation)' : '');
+  const live = !shaker && S.detail && !S.detail.final && shown && shown.state === 'running';
+  if (live) text += ` — live: ${count(loop.points(0))} samples drawn (${S.streamRate}/s of the rig's)`;
+  else if (i) text += ` — ${count(i.samples)} samples, ${count(i.reversals)} reversals (drawn with ${count(i.points)} points)` +
     (i.table ? `; orange: table #${i.table}` : '');
   $('loop-caption').textContent = text;
 }
@@ -379,7 +414,7 @@ let redrawPending = false;
 function scheduleRedraw() {
   if (redrawPending) return;
   redrawPending = true;
-  requestAnimationFrame(() => { redrawPending = false; loop.redraw(); if (isSine()) sweep.time.redraw(); else timeplot.redraw(); });
+  requestAnimationFrame(() => { redrawPending = false; loop.redraw(); if (isSine()) sweep.time.redraw(); else { timeplot.redraw(); showLoopCaption(); } });
 }
 
 async function onCampaign(ev) {
@@ -424,6 +459,25 @@ for (const verb of ['pause', 'resume', 'abort']) {
   });
 }
 
+// Specimen and notes under the plots (serial: defined above with the stream's handlers).
+const record = new RecordView($('record'), { onSaved: serial(async () => { await refreshList(); await refreshDetail(); }) });
+
+// The address names a campaign (and a run): shown, and the page does not follow the newest.
+function followRoute() {
+  const r = parseRoute();
+  if (!r) return false;
+  S.follow = false;
+  if (r.campaign !== S.selected || r.run !== S.wantRun)
+    serial(() => select(r.campaign, r.run).catch(e => {
+      if (e.status !== 404) throw e;
+      $('title').textContent = `There is no campaign #${r.campaign} in this daemon's database`;
+      $('state').textContent = ''; $('state').className = 'state';
+    }))();
+  return true;
+}
+window.addEventListener('popstate', followRoute);
+window.addEventListener('hashchange', followRoute);
+followRoute();
 rigPanel.start();
 connect();
 // Now and then, the selected campaign from the API, while it is live: a record the stream

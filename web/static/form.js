@@ -38,8 +38,12 @@ const FIELDS = [
   { name: 'dhi', group: 'limits', label: 'upper displacement limit', unit: 'mm', value: '', optional: true, placeholder: 'δmax + 0.5', min: -1e4, max: 1e4, plan: 'limits.displacement_mm' },
   { name: 'force', group: 'limits', label: 'force limit', unit: 'N', value: '400', optional: true, placeholder: "rig's", min: 1e-6, max: 1e7, plan: 'limits.force_N' },
   { name: 'ratelim', group: 'limits', label: 'rate limit', unit: 'mm/s', value: '', optional: true, placeholder: "rig's", min: 1e-6, max: 1e4, plan: 'limits.rate_mm_s' },
+  // What the lab records with the campaign (shown in the lists, the report and the exports; it
+  // can be changed later under the plots).
+  { name: 'specimen', group: 'record', label: 'specimen', value: '', optional: true, text: true, maxlength: 200, placeholder: 'e.g. NiTi spring S-07', plan: 'specimen' },
+  { name: 'notes', group: 'record', label: 'notes', value: '', optional: true, text: true, textarea: true, maxlength: 4000, placeholder: 'operator, set-up, anything seen', plan: 'notes' },
 ];
-const GROUP_TITLES = { fot: null, sine: null, common: null, limits: 'Limits (blank: the rig’s own)' };
+const GROUP_TITLES = { fot: null, sine: null, common: null, limits: 'Limits (blank: the rig’s own)', record: 'Record (optional)' };
 // The server's field names, as the form says them (for its messages).
 const WORDS = [['sweep.from_hz', 'sweep from'], ['sweep.to_hz', 'sweep to'], ['sweep.steps', 'steps'], ['frequencies_hz', 'frequencies'],
   ['amplitudes_mm', 'amplitudes'], ['settle.change', 'settle change'], ['settle_cycles', 'settle cycles'], ['control.tolerance', 'control tolerance'],
@@ -79,10 +83,11 @@ export class PlanForm {
       for (const f of FIELDS.filter(x => x.group === g)) {
         const id = 'f-' + f.name;
         const input = f.options ? el('select', { id, name: f.name, 'aria-describedby': id + '-msg' }, ...f.options.map(([v, text]) => el('option', { value: v, text })))
+          : f.textarea ? el('textarea', { id, name: f.name, rows: 2, maxlength: f.maxlength, placeholder: f.placeholder, 'aria-describedby': id + '-msg' })
           : el('input', { id, name: f.name, type: f.type || 'text', inputmode: f.type ? null : 'decimal',
-                          value: f.value, placeholder: f.placeholder || null, 'aria-describedby': id + '-msg', autocomplete: 'off' });
+                          value: f.value, placeholder: f.placeholder || null, 'aria-describedby': id + '-msg', autocomplete: 'off', maxlength: f.maxlength || null });
         if (f.options) input.value = f.value;
-        box.append(el('div', { class: 'field' },
+        box.append(el('div', { class: 'field' + (f.text ? ' text' : '') },
           el('label', { for: id, text: f.label + (f.unit ? ` (${f.unit})` : '') }), input,
           el('span', { class: 'msg', id: id + '-msg', 'aria-live': 'polite' })));
       }
@@ -143,10 +148,14 @@ export class PlanForm {
     return [];
   }
   inputOf(name) { return this.form.querySelector(`#f-${name}`); }
+  // A pasted plan replaces the form's fields: its errors belong to the text box, not to them.
+  pasted() { return this.form.json.value.trim() !== ''; }
   mark(name, message) {
     const input = this.inputOf(name);
     if (!input) return;
     input.setAttribute('aria-invalid', 'true');
+    const box = input.closest('details');
+    if (box) box.open = true;  // the pasted plan's box: its message must be seen
     const msg = this.form.querySelector(`#f-${name}-msg`);
     if (message) msg.textContent = message;
   }
@@ -158,7 +167,7 @@ export class PlanForm {
     for (const n of pair) { this.inputOf(n).removeAttribute('aria-invalid'); this.form.querySelector(`#f-${n}-msg`).textContent = ''; }
   }
   clearAll() {
-    for (const f of FIELDS) { this.inputOf(f.name).removeAttribute('aria-invalid'); this.form.querySelector(`#f-${f.name}-msg`).textContent = ''; }
+    for (const f of [...FIELDS, { name: 'json' }]) { this.inputOf(f.name).removeAttribute('aria-invalid'); this.form.querySelector(`#f-${f.name}-msg`).textContent = ''; }
     if (this.error) this.error.textContent = '';
   }
   // A 400 from the server: its `field` (or the "plan: FIELD ..." of its detail) marks the input.
@@ -167,6 +176,7 @@ export class PlanForm {
     const field = b.field || (/^plan: ([a-z_.]+(?:\[\d+\])?) /.exec(b.detail || '') || [])[1];
     const names = field ? this.inputsFor(field) : [];
     const message = humanize(b.detail || err.message);
+    if (this.pasted()) { this.mark('json', `in the pasted plan: ${message}`); return; }
     if (!names.length) { this.error.textContent = message; return; }
     names.forEach((n, k) => this.mark(n, k === 0 ? message : ''));
   }
@@ -176,16 +186,17 @@ export class PlanForm {
   read() {
     const form = this.form;
     if (form.json.value.trim()) {
-      try { return { plan: JSON.parse(form.json.value) }; } catch (e) { return { errors: [['', `the pasted plan is not valid JSON (${e.message})`]] }; }
+      try { return { plan: JSON.parse(form.json.value) }; } catch (e) { return { errors: [['json', `the pasted plan is not valid JSON (${e.message})`]] }; }
     }
     const sine = form.kind.value === 'sine';
-    const groups = sine ? ['sine', 'common'] : ['fot', 'common', 'limits'];
+    const groups = sine ? ['sine', 'common', 'record'] : ['fot', 'common', 'limits', 'record'];
     const errors = [], v = {};
     const list = sine && this.inputOf('freqs').value.trim() !== '';  // a list of frequencies: the steps' fields are not used
     for (const f of FIELDS.filter(x => groups.includes(x.group) && !(list && x.sweep))) {
       const raw = this.inputOf(f.name).value.trim();
       const what = f.label;
       if (f.options) { v[f.name] = raw; continue; }
+      if (f.text) { if (raw) v[f.name] = f.textarea ? this.inputOf(f.name).value : raw; continue; }
       if (raw === '') { if (!f.optional) errors.push([f.name, `${what} is required`]); continue; }
       const parts = f.list ? raw.split(/[,;\s]+/).filter(Boolean) : [raw];
       const vals = parts.map(p => Number(p.replace(',', '.')));
@@ -203,8 +214,10 @@ export class PlanForm {
       if ((v.dlo == null) !== (v.dhi == null)) errors.push([v.dlo == null ? 'dlo' : 'dhi', 'give both displacement limits, or neither']);
     }
     if (sine) errors.push(...sineErrors(v));
+    if (v.specimen && v.specimen.includes('\n')) errors.push(['specimen', 'specimen must be one line']);
     if (errors.length) return { errors };
-    if (sine) return { plan: sinePlan(v) };
+    const record = plan => { if (v.specimen) plan.specimen = v.specimen; if (v.notes) plan.notes = v.notes; return plan; };
+    if (sine) return { plan: record(sinePlan(v)) };
     const limits = {};
     if (v.dlo != null) limits.displacement_mm = [v.dlo, v.dhi];
     if (v.force != null) limits.force_N = v.force;
@@ -221,7 +234,7 @@ export class PlanForm {
     if (v.plateaus && v.plateaus.length) plan.plateaus_mm = v.plateaus;
     if (v.repeats !== 1) plan.repeats = v.repeats;
     if (Object.keys(limits).length) plan.limits = limits;
-    return { plan };
+    return { plan: record(plan) };
   }
   body(plan) { const b = { plan }; if (this.form.rig.value) b.rig = this.form.rig.value; return b; }
   showErrors(errors) {
@@ -305,5 +318,7 @@ export function previewText(p) {
   else if (p.samples != null) parts.push(`${count(p.samples)} samples`);
   if (p.peak_speed_mm_s != null) parts.push(`peak speed ${num(p.peak_speed_mm_s, 2)} mm/s`);
   if (p.peak_force_N != null) parts.push(`peak force ≈ ${round2(p.peak_force_N)} N${p.force_source ? ` (from ${p.force_source})` : ''}`);
+  // A limit looser than the rig's is not refused: the rig's applies, and the operator is told.
+  for (const a of p.limits_applied || []) parts.push(a);
   return parts.join(' · ');
 }

@@ -4,6 +4,7 @@
 // and peak force), and the figures of every closed cycle (GET /api/campaigns/ID/loops).
 /* global uPlot */
 import { el, num, round2, count } from './fmt.js';
+import { tickLabels, axisSize } from './plots.js';
 
 const accuracyLine = a => `RMS ${round2(a.rms_N)} N (${num(100 * a.rms_norm, 2)} % of range) · max ${round2(a.max_N)} N`;
 
@@ -19,6 +20,9 @@ export function tableLines(d) {
     out.push(el('div', { class: 'table-line' + (a.recommended ? ' recommended' : ''), 'data-table': t.id },
       el('strong', { text: `table #${t.id} (${t.method}, n = ${t.n})` }),
       a.recommended ? el('span', { class: 'badge', text: 'recommended' }) : null,
+      // A least-squares table's prior as a field of its own, the reason in its tooltip.
+      t.prior ? el('div', { class: 'prior', title: t.prior_reason || '', text: `prior: ${t.prior}` + (t.lambda != null ? ` · λ ${num(t.lambda)}` : '') +
+        ' (chosen on held-out blocks of the record)' }) : null,
       el('div', { class: 'muted', text: `own samples: ${accuracyLine(a.overall)}` }),
       held ? el('div', { class: 'heldout', text: `held-out (validation run): ${accuracyLine(held)}` +
         (a.held_out.loop_energy_rel_error != null ? ` · loop energy ${num(100 * a.held_out.loop_energy_rel_error, 2)} %` : '') }) : null));
@@ -36,8 +40,10 @@ export class ShakedownPlot {
     this.u = new uPlot({
       width: Math.max(200, box.clientWidth), height: 240, legend: { live: false },
       scales: { x: { time: false }, e: {}, p: {} },
-      axes: [{ label: 'training cycle' }, { scale: 'e', label: 'dissipated energy (N·mm)', stroke: '#2e7d32' },
-             { scale: 'p', side: 1, label: 'peak force (N)', stroke: '#c62828', grid: { show: false } }],
+      // Whole cycles only on x (no "1.5"); each y axis as wide as its labels, so titles never overlap them.
+      axes: [{ label: 'training cycle', incrs: [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000], values: (u, s) => s.map(v => String(Math.round(v))) },
+             { scale: 'e', label: 'dissipated energy (N·mm)', stroke: '#2e7d32', values: tickLabels, size: axisSize },
+             { scale: 'p', side: 1, label: 'peak force (N)', stroke: '#c62828', grid: { show: false }, values: tickLabels, size: axisSize }],
       series: [{}, { label: 'energy', scale: 'e', stroke: '#2e7d32', width: 2, points: { show: true, size: 6 } },
                { label: 'peak force', scale: 'p', stroke: '#c62828', width: 1.5, points: { show: true, size: 5 } }],
     }, [this.x, this.e, this.p], box);
@@ -48,6 +54,7 @@ export class ShakedownPlot {
     this.u.setData([this.x, this.e, this.p]);
   }
   points() { return this.x.length; }
+  ticks() { return (this.u.axes[0]._values || []).map(String); }  // what the cycle axis says (for the tests)
 }
 
 export function shakedownCaption(d) {
@@ -63,14 +70,14 @@ const point = p => (p ? `${num(p.displacement_mm)} mm, ${round2(p.force_N)} N` :
 
 // The figures of every closed cycle, one row each, grouped by where it was taken.
 export function loopRows(loops) {
-  const head = el('tr', {}, ...['phase', '#', 'δ range (mm)', 'peak (N)', 'E_d (N·mm)', 'k_sec (N/mm)', 'ζ', 'return (N)', 'Ms', 'Mf', 'As', 'Af', 'plateaus (load / unload N)']
+  const head = el('tr', {}, ...['phase', '#', 'δ range (mm)', 'peak (N)', 'E_d (N·mm)', 'k_sec (N/mm)', 'ζ', 'return (N)', 'residual (mm)', 'Ms', 'Mf', 'As', 'Af', 'plateaus (load / unload N)']
     .map(h => el('th', { text: h })));
   const rows = loops.map(l => {
     const t = l.transformation || {};
     const plateaus = (l.plateaus || []).map(p => `${num(p.at_mm)} mm: ${round2(p.loading_N)} / ${round2(p.unloading_N)}`).join('; ');
     return el('tr', { class: l.phase },
       ...[l.phase, String(l.k + 1), `${num(l.min_mm)}–${num(l.max_mm)}`, round2(l.peak_force_N), num(l.energy_Nmm), num(l.secant_stiffness_N_mm),
-        num(l.damping_ratio, 2), round2(l.return_N), point(t.Ms), point(t.Mf), point(t.As), point(t.Af), plateaus || '–'].map(v => el('td', { text: v })));
+        num(l.damping_ratio, 2), round2(l.return_N), num(l.residual_mm), point(t.Ms), point(t.Mf), point(t.As), point(t.Af), plateaus || '–'].map(v => el('td', { text: v })));
   });
   return [el('thead', {}, head), el('tbody', {}, ...rows)];
 }

@@ -14,14 +14,35 @@ function extent(arrays, fallback) {
   return [lo - pad, hi + pad];
 }
 
-// Calls fn(width) when the element's width changes (not its height: that is ours to set).
+// Calls fn(width) when the element's width changes (not its height: that is ours to set), and
+// when the window's height does (the plots' heights follow the screen's: screenShare).
+const sized = [];  // every plot's resize, for relayout()
 export function onWidth(el, fn) {
   let last = 0;
   new ResizeObserver(entries => {
     const w = Math.floor(entries[0].contentRect.width);
     if (w > 0 && Math.abs(w - last) >= 2) { last = w; fn(w); }
   }).observe(el);
+  let lastH = window.innerHeight;
+  window.addEventListener('resize', () => { if (window.innerHeight !== lastH && last > 0) { lastH = window.innerHeight; fn(last); } });
+  sized.push(() => { if (last > 0) fn(last); });
 }
+// What is above the plots changed (the warning box came or went): every plot sized again.
+export function relayout() { for (const f of sized) f(); }
+
+// Where the loop and the heatmap stand side by side (style.css: .plots from 1200 px), the work
+// view is the loop, the heatmap and the time plot together on one screen: each plot's height is
+// its share of what the sticky header leaves, less its caption, legend and the gaps (~190 px in
+// all, measured at 1280x800). Narrower, the plots are stacked and keep their own aspect.
+const SIDE_BY_SIDE = '(min-width: 1200px)';
+const CHROME_PX = 190;
+export function screenShare(share) {
+  if (!window.matchMedia(SIDE_BY_SIDE).matches) return Infinity;
+  const top = document.getElementById('top'), warn = document.getElementById('warnings');
+  const above = (top ? top.offsetHeight : 0) + (warn && !warn.hidden ? warn.offsetHeight + 10 : 0);  // the warning box, when shown, is above them
+  return Math.max(0, (window.innerHeight - above - CHROME_PX) * share);
+}
+export const LOOP_SHARE = 0.62, TIME_SHARE = 0.38;
 
 // The x-y path in sample order, through every point. uPlot's own path builders thin points
 // per pixel column assuming x only increases; a hysteresis loop goes back and forth in x, so
@@ -39,17 +60,31 @@ function inOrder(u, si) {
   return { stroke: p, fill: null, clip: null, band: null, gaps: null, flags: 0 };
 }
 
+// Ticks as numbers with the decimals their spacing needs.
+export function tickLabels(u, splits) {
+  const step = splits.length > 1 ? Math.abs(splits[1] - splits[0]) : 1;
+  let decimals = 0;  // the fewest that write the step exactly (0.25: 2, 0.5: 1, 50: 0)
+  while (decimals < 8 && step > 0 && Math.abs(Math.round(step * 10 ** decimals) - step * 10 ** decimals) > 1e-6 * step * 10 ** decimals) decimals++;
+  return splits.map(v => (v == null ? '' : Number(v.toFixed(decimals)).toLocaleString('en', { minimumFractionDigits: decimals, maximumFractionDigits: decimals })));
+}
+// The y axis's width: its longest tick label, the gap and its title (px).
+export function axisSize(u, values) {
+  const longest = (values || []).reduce((m, v) => Math.max(m, String(v).length), 0);
+  return Math.max(50, Math.ceil(longest * 7.5) + 30);
+}
+
 // An x-y plot (uPlot's mode 2): series of [xs, ys] drawn as paths in the order given.
 export class XYPlot {
-  constructor(el, xLabel, yLabel, series, { aspect = 0.62, maxHeight = 640, minHeight = 240 } = {}) {
-    this.el = el; this.series = series; this.aspect = aspect; this.maxHeight = maxHeight; this.minHeight = minHeight;
+  constructor(el, xLabel, yLabel, series, { aspect = 0.62, maxHeight = 640, minHeight = 240, share = null } = {}) {
+    this.el = el; this.series = series; this.aspect = aspect; this.maxHeight = maxHeight; this.minHeight = minHeight; this.share = share;
     this.data = series.map(() => [[], []]);
     this.build(xLabel, yLabel);
     onWidth(el, w => this.u.setSize(this.size(w)));
   }
   size(w = this.el.clientWidth) {
     const width = Math.max(200, w);
-    return { width, height: Math.round(Math.min(this.maxHeight, Math.max(this.minHeight, width * this.aspect))) };
+    const fit = this.share ? screenShare(this.share) : Infinity;
+    return { width, height: Math.round(Math.min(this.maxHeight, Math.max(this.minHeight, Math.min(width * this.aspect, fit)))) };
   }
   build(xLabel, yLabel) {
     this.labels = [xLabel, yLabel];
@@ -58,7 +93,9 @@ export class XYPlot {
       // No drag-zoom: the scales are ours (redraw), a zoom would be undone by the next sample.
       cursor: { drag: { x: false, y: false, setScale: false }, points: { show: false } },
       scales: { x: { time: false, auto: false }, y: { auto: false } },
-      axes: [{ label: xLabel }, { label: yLabel }],
+      // Tick labels with as many decimals as their spacing needs (never "0.01, 0.01, 0.00" on a
+      // 0.005 mm sine), and a y axis as wide as its longest label (the title never over them).
+      axes: [{ label: xLabel, values: tickLabels }, { label: yLabel, values: tickLabels, size: axisSize }],
       series: [{}, ...this.series.map(s => ({
         label: s.label, stroke: s.color, width: s.width || 1.5, paths: s.points ? undefined : inOrder,
         points: { show: !!s.points, size: 5, fill: s.color },
@@ -77,6 +114,12 @@ export class XYPlot {
     this.build(xLabel, yLabel);
   }
   set(k, xs, ys) { this.data[k] = [xs, ys]; }
+  ticks() { return this.u.axes.map(a => (a._values || []).map(String)); }  // what the axes say (for the tests)
+  // Series k offered (its legend entry shown) or not.
+  offer(k, on) {  // (by its label: an x-y plot's legend has no row for x)
+    const item = [...this.u.root.querySelectorAll('.u-legend .u-series')].find(e => e.textContent.trim() === this.series[k].label);
+    if (item) item.style.display = on ? '' : 'none';
+  }
   append(k, xs, ys) { const d = this.data[k]; for (let i = 0; i < xs.length; i++) { d[0].push(xs[i]); d[1].push(ys[i]); } }
   // Keep the newest `keep` points of series k (a live loop must not grow without end).
   trim(k, keep) { const d = this.data[k]; if (d[0].length > keep) { const n = d[0].length - keep; d[0].splice(0, n); d[1].splice(0, n); } }
@@ -99,15 +142,16 @@ export class TimePlot {
     this.el = el;
     this.t = []; this.a = []; this.b = [];
     this.build(labels);
-    onWidth(el, w => this.u.setSize({ width: Math.max(200, w), height: 260 }));
+    onWidth(el, w => this.u.setSize(this.size(w)));
   }
+  size(w = this.el.clientWidth) { return { width: Math.max(200, w), height: Math.round(Math.max(150, Math.min(260, screenShare(TIME_SHARE)))) }; }
   build(labels) {
     this.labels = labels;
     this.u = new uPlot({
-      width: Math.max(200, this.el.clientWidth), height: 260, legend: { live: false },
+      ...this.size(), legend: { live: false },
       scales: { x: { time: false }, a: {}, b: {} },
-      axes: [{ label: 'rig time (s)' }, { scale: 'a', label: labels[0], stroke: '#1565c0' },
-             { scale: 'b', side: 1, label: labels[1], stroke: '#c62828', grid: { show: false } }],
+      axes: [{ label: 'rig time (s)', values: tickLabels }, { scale: 'a', label: labels[0], stroke: '#1565c0', values: tickLabels, size: axisSize },
+             { scale: 'b', side: 1, label: labels[1], stroke: '#c62828', grid: { show: false }, values: tickLabels, size: axisSize }],
       series: [{}, { label: labels[0], scale: 'a', stroke: '#1565c0' }, { label: labels[1], scale: 'b', stroke: '#c62828' }],
     }, [this.t, this.a, this.b], this.el);
   }
@@ -175,7 +219,10 @@ export class TriangleHeatmap {
     onWidth(el, w => this.u.setSize(this.size(w)));
     this.drawScale();
   }
-  size(w = this.el.clientWidth) { const width = Math.max(200, w); return { width, height: Math.round(Math.min(560, Math.max(240, width * 0.75))) }; }
+  size(w = this.el.clientWidth) {
+    const width = Math.max(200, w);
+    return { width, height: Math.round(Math.min(560, Math.max(200, Math.min(width * 0.75, screenShare(LOOP_SHARE) - 40)))) };  // 40: its scale and read-out
+  }
   range() {
     if (!this.grid) return [0, 1];
     return [this.lower(0), this.upper(this.grid.n)];
@@ -219,6 +266,19 @@ export class TriangleHeatmap {
     else if (F < this.lim[0]) this.lim[0] = -niceUp(-F * 1.25);
     else return;
     this.drawScale();
+  }
+  // Once every node is known (a stored campaign, an ended one): the scale fitted to the cells
+  // (0 is in it: the diagonal's F), without the head room kept while nodes arrive.
+  fitScale() {
+    let lo = 0, hi = -Infinity;
+    for (const F of this.values.values()) if (Number.isFinite(F)) { lo = Math.min(lo, F); hi = Math.max(hi, F); }
+    if (!(hi > 0)) return;
+    const up2 = v => { const p = 10 ** (Math.floor(Math.log10(v)) - 1); return Math.ceil(v / p - 1e-9) * p; };  // 157 -> 160
+    const lim = [lo < 0 ? -up2(-lo) : 0, up2(hi)];
+    if (this.lim && lim[0] === this.lim[0] && lim[1] === this.lim[1]) return;
+    this.lim = lim;
+    this.drawScale();
+    this.u.redraw();
   }
   identified() { return this.values.size; }
   required() { return this.grid ? this.grid.n * (this.grid.n + 1) / 2 : 0; }

@@ -17,9 +17,14 @@ function rateText(q) {
 }
 const figure = (n, one, many) => el('span', { class: n ? 'bad' : '', text: plural(n || 0, one, many) });
 
-function runLine(r) {
+// A run's line: its figures, and which run the plots show (a link shows another).
+function runLine(r, show) {
   const q = r.quality;
-  const li = el('li', {}, `run #${r.id}: `);
+  const li = el('li', { 'data-run': r.id }, `run #${r.id}` + (r.role === 'validation' ? ' (validation)' : '') + ': ');
+  if (show && (r.samples || 0) > 0)
+    li.append(show.run === r.id ? el('span', { class: 'shown-run', text: '(in the plots) ' }) : el('a', { href: show.href(r.id), class: 'show-run', text: 'show' }), ' ');
+  // A run that stored nothing (a campaign stopped before it started): no rate, no figures to judge.
+  if (!(r.samples > 0) && !(q && q.samples > 0)) { li.append(r.state === 'running' ? 'no samples yet' : 'no samples stored (it stopped before sampling)'); return li; }
   // A run's figures are stored at its end; before that, only its samples.
   if (!q) { li.append(`${plural(r.samples || 0, 'sample')}` + (r.state === 'running' ? ' so far (its quality figures come at its end)' : ' (this daemon gives no quality figures)')); return li; }
   const parts = [plural(q.samples ?? r.samples ?? 0, 'sample'), rateText(q),
@@ -33,15 +38,21 @@ function runLine(r) {
 
 // Fills the quality list and the warning box; returns the warnings shown. `extra`: the
 // campaign's own warnings in words (a sweep's control warnings, say), after the runs' and tables'.
-export function showQuality(d, listEl, boxEl, extra = []) {
+// show: {run, href(run)}: the run in the plots and the address of another.
+export function showQuality(d, listEl, boxEl, extra = [], show = null) {
   const runs = (d && d.runs) || [], tables = (d && d.tables) || [];
-  listEl.replaceChildren(...runs.map(runLine));
+  listEl.replaceChildren(...runs.map(r => runLine(r, show)));
   const warnings = [];
   for (const r of runs) for (const w of (r.quality && r.quality.warnings) || []) warnings.push(`run #${r.id}: ${w}`);
   for (const t of tables) for (const w of t.warnings || []) warnings.push(`table #${t.id}: ${w}`);
   warnings.push(...extra);
+  // The first few in view, the rest one click away: a starved run's dozen warnings would push
+  // the plots off the screen.
+  const SHOWN = 2, item = w => el('li', { text: w });
+  const rest = warnings.length > SHOWN + 1 ? warnings.slice(SHOWN) : [];
   boxEl.replaceChildren(...(warnings.length ? [el('strong', { text: `Check before trusting this campaign (${plural(warnings.length, 'warning')}):` }),
-    el('ul', {}, ...warnings.map(w => el('li', { text: w })))] : []));
+    el('ul', {}, ...warnings.slice(0, warnings.length - rest.length).map(item)),
+    rest.length ? el('details', {}, el('summary', { text: `${plural(rest.length, 'more warning')}` }), el('ul', {}, ...rest.map(item))) : null].filter(Boolean) : []));
   boxEl.hidden = warnings.length === 0;
   return warnings;
 }

@@ -90,6 +90,14 @@ export class RigPanel {
       c.state.textContent = r.state || '?';
       c.state.className = 'rstate ' + (r.state || '');
       c.live.textContent = liveText(r);
+      // A shaker's mass at rest away from 0 after a sweep: not a sensor offset, but where the
+      // hysteretic springs' last cycles left it (at the weight's force their loop spans a band
+      // of displacements; which one depends on the history). Said, with a mark, in the tooltip.
+      const rest = r.kind === 'shaker' && r.state === 'idle' && r.sample ? r.sample.mass_displacement_mm : NaN;
+      const offset = Number.isFinite(rest) && Math.abs(rest) >= 0.01;
+      if (offset) c.live.textContent += ' ⓘ';
+      c.live.title = offset ? `The mass rests at ${fixed(rest, 3)} mm: where the springs' last cycles left it. A hysteretic spring carries the same weight over a ` +
+        'band of compressions, and which one it rests at depends on its history; it is not a sensor offset.' : '';
       const st = r.status || {};
       c.bits.replaceChildren(...(st.known === false ? [el('span', { class: 'bit', text: 'status unknown' })] :
         BITS.map(b => el('span', { class: 'bit' + (st[b] ? (BAD_BITS.has(b) ? ' bad' : ' on') : ''), text: b.replace('_', ' '),

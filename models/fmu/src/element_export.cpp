@@ -1,5 +1,6 @@
 #include "hystlab/fmu/element_export.hpp"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -9,7 +10,7 @@
 
 namespace hystlab::fmu {
 
-bool is_export_format(std::string_view f) { return f == "json" || f == "csv" || f == "m" || f == "h" || f == "fmu"; }
+bool is_export_format(std::string_view f) { return std::find(kExportFormatList.begin(), kExportFormatList.end(), f) != kExportFormatList.end(); }
 
 ExportedFile export_element(std::string_view document, std::string_view format, const std::string& name, const std::string& created,
                             std::optional<models::ElementKind> kind) {

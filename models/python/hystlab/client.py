@@ -163,7 +163,8 @@ class Client:
     def samples(self, run_id):
         """Every sample of a run at full resolution (GET /api/runs/ID/samples.csv) as a dict of
         numpy arrays by column: seq, t_s, command_mm, displacement_mm, force_N, status for a load
-        frame; a shaker's run has its own columns. The daemon writes 9 significant digits.
+        frame; a shaker's run has its own columns (docs/FORMATS.md, "Runs as CSV"). The numbers
+        are the stored doubles exactly.
         Columns are float64, seq and status int64."""
         with self._open("GET", "/api/runs/%d/samples.csv" % run_id) as r:
             reader = csv.reader(io.TextIOWrapper(r, encoding="utf-8", newline=""))

@@ -64,9 +64,13 @@ void write_file(const fs::path& path, const std::string& text);  // atomically: 
 [[nodiscard]] std::uint64_t fingerprint(const models::EverettTable& t);
 [[nodiscard]] std::uint64_t fingerprint(const models::SmaParameters& p);
 
-[[nodiscard]] Table table_from_text(std::string_view text);
+// source: how an error names the document (models/document_source.hpp): "table file 'T.json'".
+[[nodiscard]] Table table_from_text(std::string_view text, const std::string& source = "table text");
 [[nodiscard]] std::string table_text(const Table& t);  // as the CLI writes it: 2-space JSON and a newline
-[[nodiscard]] Params params_from_text(std::string_view text);
+[[nodiscard]] Params params_from_text(std::string_view text, const std::string& source = "parameter text");
+// A document read from path, named as the CLI names it.
+[[nodiscard]] Table table_from_file(const fs::path& path);
+[[nodiscard]] Params params_from_file(const fs::path& path);
 [[nodiscard]] std::string params_text(const Params& p);
 [[nodiscard]] py::dict transitions_to_dict(const models::SmaTransitions& t);
 [[nodiscard]] Table make_table(models::EverettTable table, models::TableProvenance provenance);

@@ -10,6 +10,7 @@
 #include <variant>
 
 #include "bindings.hpp"
+#include "hystlab/models/document_source.hpp"
 #include "hystlab/models/preisach_model.hpp"
 
 namespace hystlab::python {
@@ -178,10 +179,12 @@ void Model::set_state(const py::bytes& b) {
   std::visit([&s](auto& m) { m.restore_state(s); }, impl_);
 }
 
-Model model_from_document(const std::string& text, double merge_tolerance, std::size_t max_turning_points) {
+// path: the file it was read from ("" for a pickled model's text), for the errors' names.
+Model model_from_document(const std::string& text, double merge_tolerance, std::size_t max_turning_points, const std::string& path = "") {
   const auto j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_object() && j.contains("format")) return Model(table_from_text(text), merge_tolerance, max_turning_points);
-  return Model(params_from_text(text));
+  if (j.is_object() && j.contains("format"))
+    return Model(table_from_text(text, path.empty() ? "table text" : models::file_source("table file", path)), merge_tolerance, max_turning_points);
+  return Model(params_from_text(text, path.empty() ? "parameter text" : models::file_source("parameter file", path)));
 }
 
 py::tuple pickle_state(const Model& m) {
@@ -204,11 +207,11 @@ void bind_model(py::module_& m) {
            py::arg("max_turning_points") = 512)
       .def(py::init<const Params&>(), py::arg("params"))
       .def(py::init([](const fs::path& path, double merge_tolerance, std::size_t max_turning_points) {
-             return model_from_document(read_file(path), merge_tolerance, max_turning_points);
+             return model_from_document(read_file(path), merge_tolerance, max_turning_points, path.string());
            }), py::arg("path"), py::kw_only(), py::arg("merge_tolerance") = 0.0, py::arg("max_turning_points") = 512,
            "Model(\"T.json\") is Model.load(\"T.json\").")
       .def_static("load", [](const fs::path& path, double merge_tolerance, std::size_t max_turning_points) {
-                    return model_from_document(read_file(path), merge_tolerance, max_turning_points);
+                    return model_from_document(read_file(path), merge_tolerance, max_turning_points, path.string());
                   }, py::arg("path"), py::kw_only(), py::arg("merge_tolerance") = 0.0, py::arg("max_turning_points") = 512,
                   "A table document or parameters, told apart by the table's \"format\" field.")
       .def("evaluate", &Model::evaluate, py::arg("x"), py::arg("clamp") = true, py::arg("out") = py::none(),

@@ -122,7 +122,7 @@ void bind_table(py::module_& m) {
       .def(py::init(&table_from_arrays), py::arg("nodes"), py::arg("values"), py::arg("force_offset") = 0.0,
            py::arg("provenance") = py::none(),
            "A table from its grid nodes and F values (packed lower triangle, or the square matrix's lower triangle).")
-      .def_static("load", [](const fs::path& path) { return table_from_text(read_file(path)); }, py::arg("path"))
+      .def_static("load", [](const fs::path& path) { return table_from_file(path); }, py::arg("path"))
       .def_static("from_json", [](std::string_view text) { return table_from_text(text); }, py::arg("text"))
       .def("save", [](const Table& t, const fs::path& path) { write_file(path, table_text(t)); }, py::arg("path"))
       .def("to_json", &table_text, "The document as `hystlab identify` writes it.")
@@ -171,7 +171,7 @@ void bind_params(py::module_& m) {
            py::kw_only(), py::arg("KA") = 40.0, py::arg("KM") = 150.0, py::arg("dtr_max") = 2.95, py::arg("C") = 5.7,
            py::arg("Mf0") = 12.7, py::arg("Ms0") = 17.9, py::arg("As0") = 17.9, py::arg("Af0") = 21.5, py::arg("T") = 25.0,
            py::arg("source") = "")
-      .def_static("load", [](const fs::path& path) { return params_from_text(read_file(path)); }, py::arg("path"))
+      .def_static("load", [](const fs::path& path) { return params_from_file(path); }, py::arg("path"))
       .def_static("from_json", [](std::string_view text) { return params_from_text(text); }, py::arg("text"))
       .def("save", [](const Params& p, const fs::path& path) { write_file(path, params_text(p)); }, py::arg("path"))
       .def("to_json", &params_text)

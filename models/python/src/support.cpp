@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "bindings.hpp"
+#include "hystlab/models/document_source.hpp"
 #include "hystlab/models/fingerprint.hpp"
 #include "hystlab/models/text_forms.hpp"
 
@@ -102,14 +103,16 @@ Table make_table(models::EverettTable table, models::TableProvenance provenance)
   return Table{std::make_shared<models::TableDocument>(models::TableDocument{std::move(table), std::move(provenance)})};
 }
 
-Table table_from_text(std::string_view text) {
-  return Table{std::make_shared<models::TableDocument>(models::table_from_json(text))};
+Table table_from_text(std::string_view text, const std::string& source) {
+  return Table{std::make_shared<models::TableDocument>(models::table_from_source(text, source))};
 }
+Table table_from_file(const fs::path& path) { return table_from_text(read_file(path), models::file_source("table file", path.string())); }
+Params params_from_file(const fs::path& path) { return params_from_text(read_file(path), models::file_source("parameter file", path.string())); }
 
 std::string table_text(const Table& t) { return models::table_to_json(t.table(), t.doc->provenance).dump(2) + "\n"; }
 
-Params params_from_text(std::string_view text) {
-  Params out{models::params_from_json(text), {}};
+Params params_from_text(std::string_view text, const std::string& source) {
+  Params out{models::params_from_source(text, source), {}};
   // params_from_json validated the document; the source is kept for the next save.
   const auto j = nlohmann::json::parse(text.begin(), text.end());
   if (const auto s = j.find("source"); s != j.end() && s->is_string()) out.source = s->get<std::string>();

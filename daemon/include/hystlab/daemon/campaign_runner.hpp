@@ -82,6 +82,7 @@ struct RunSeries {
 // what its earlier runs measured (their nodes, and their samples for the final fits).
 struct CampaignJob {
   std::int64_t id = 0;
+  double submitted_mono = 0;  // monotonic seconds at submit() (0: dispatched from the database)
   Plan plan;
   std::shared_ptr<const IsolatorModel> isolator;  // a shaker's, when the daemon has a model of it (sine)
   std::vector<models::FotNode> prior_nodes;

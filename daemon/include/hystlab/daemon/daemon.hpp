@@ -119,10 +119,14 @@ class Daemon {
   std::int64_t submit(const std::string& rig_name, const nlohmann::json& plan);
   // What submit checks, without queuing: the plan parsed, for the rig (its index) it would run on.
   [[nodiscard]] std::pair<Plan, std::size_t> check_plan(const std::string& rig_name, const nlohmann::json& plan) const;
+  // The limits a checked plan runs under on rig k: the tighter of the plan's and the rig's.
+  [[nodiscard]] Limits applied_limits(const Plan& plan, std::size_t k) const;
   // A running campaign's command goes straight to its rig's thread (never through the database,
   // which may be busy); a queued or held one's through the main loop. An e-stop latches the
   // campaign's rig first (as rig_command), whatever the campaign's state.
   CommandOutcome command(std::int64_t campaign_id, CampaignCommand c);
+  // The campaign's specimen and notes changed (control::DaemonInterface::set_record).
+  void set_record(std::int64_t campaign_id, const nlohmann::json& changes);
   // reset or estop a rig: straight to its thread, read there every period in every state; waits
   // (at most wait_s) for the rig to confirm it, and says what happened.
   CommandOutcome rig_command(std::size_t rig, RigCommand c, double wait_s = 2.0);

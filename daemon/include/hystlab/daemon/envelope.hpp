@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "hystlab/daemon/plan.hpp"
 
@@ -61,5 +62,10 @@ struct RigConfigError : std::invalid_argument {
 // safety checks use: the tighter of the plan's and the envelope's, with the derived safe
 // position and rate filled in (stored with the campaign, shown by the API).
 [[nodiscard]] Limits check_plan_against(const Plan& plan, const RigEnvelope& e, const SupervisionSettings& s, bool shaker);
+
+// The limits the plan gave that the rig's envelope tightens, each in a sentence ("force limit:
+// the rig's 2000 N applies (the plan asked 5000 N)"): a plan is not refused for a limit looser
+// than the rig's, but the operator is told which one holds.
+[[nodiscard]] std::vector<std::string> limits_tightened(const Plan& plan, const Limits& applied);
 
 }  // namespace hystlab::daemon

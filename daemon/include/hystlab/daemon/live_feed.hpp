@@ -85,6 +85,8 @@ struct RigLive {
   std::atomic<std::int64_t> campaign{0}, run{0};
   std::atomic<double> sample_rate_hz{0};
   std::atomic<std::uint8_t> phase{0};  // daemon::CampaignPhase, set by the loop every period
+  // Seconds from the newest submission's call to its rig's thread taking the job (-1: none yet).
+  std::atomic<double> submit_latency_s{-1};
 };
 
 }  // namespace hystlab::daemon

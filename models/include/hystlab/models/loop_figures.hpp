@@ -36,6 +36,11 @@ struct LoopFigures {
   double force_at_min_N = 0, force_at_max_N = 0;
   double peak_force_N = 0;  // the largest force in the cycle
   double return_N = 0;      // the force back at the start's displacement (at δmin for a cycle from a minimum)
+  // A cycle from a minimum: how far from the start the unloading branch is when its force is back
+  // down to the start's (within 1 % of the cycle's force range); 0 when it gets there only at the
+  // start. ASTM F2516's residual elongation after unloading, in displacement for a spring. NaN for
+  // a cycle from a maximum (it does not unload to a start).
+  double residual_mm = 0;
   double energy_Nmm = 0;                  // ∮ f dδ, the energy dissipated in the cycle
   double secant_stiffness_N_mm = 0;       // (f(max) - f(min)) / (max - min)
   double strain_energy_Nmm = 0;           // E_s = ½ k a², a = (max - min) / 2 (the loop about its centre)

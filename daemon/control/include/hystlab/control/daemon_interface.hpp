@@ -53,6 +53,10 @@ class DaemonInterface {
   // A campaign's command. conflict when it does not apply to the campaign's state (the reason
   // says why); an e-stop latches the campaign's rig as rig_command does, then ends the campaign.
   virtual CommandOutcome command(std::int64_t campaign, CampaignCommand c) = 0;
+  // Changes what the lab records with a campaign, in any state: changes holds "specimen" and/or
+  // "notes" (text); the others stay. Kept as a "record" event (every change, with its time).
+  // Throws PlanError naming the field, std::out_of_range for an unknown campaign.
+  virtual void set_record(std::int64_t campaign, const nlohmann::json& changes) = 0;
 
   [[nodiscard]] virtual WriterCounters writer() const = 0;
   [[nodiscard]] virtual double uptime_s() const noexcept = 0;

@@ -99,6 +99,7 @@ struct AcquisitionCounters {
   std::int64_t campaign = 0, run = 0;  // 0: none running
   double sample_rate_hz = 0;           // the running campaign's
   std::string phase = "none";          // what its loop is doing: arming, ramping, dwelling, paused, safing, ...
+  double submit_latency_s = -1;        // the newest submission's, call to the rig's thread taking it (-1: none)
 };
 
 struct WriterCounters {
@@ -119,6 +120,8 @@ struct PlanPreview {
   // duration_s / time_scale of wall time, and the host, sampling at sample_rate_hz of wall time,
   // stores sample_rate_hz / time_scale of rig time.
   double time_scale = 1;
+  // The plan's limits that the rig's envelope tightens, in sentences (what applies instead).
+  std::vector<std::string> limits_applied;
 };
 
 // A FOT plan's grid: its nodes are on n = subdivisions steps of [lo_mm, hi_mm], or nodes_mm (a

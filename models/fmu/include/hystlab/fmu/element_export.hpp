@@ -2,6 +2,7 @@
 // Every export format of a calibrated element (a table or simplified-model parameters), named
 // once for the CLI (`hystlab export`, `hystlab tables export`) and the HTTP API
 // (GET /api/tables/ID/export): json, csv, m, h and fmu. Pure: returns the bytes.
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -16,6 +17,8 @@ struct ExportedFile {
   bool binary = false;     // not for a terminal
 };
 
+// Every format, once: is_export_format accepts these and no other; the CLI's help lists them.
+inline constexpr std::array<std::string_view, 5> kExportFormatList{"json", "csv", "m", "h", "fmu"};
 inline constexpr std::string_view kExportFormats = "json, csv, m, h or fmu";
 [[nodiscard]] bool is_export_format(std::string_view format);
 
