@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
 namespace fs = std::filesystem;
@@ -29,11 +30,6 @@ inline std::string slurp(const fs::path& p) {
 
 class Workdir {
  public:
-  Workdir() {
-    char tmpl[] = "/tmp/hystlab-cli-XXXXXX";
-    dir_ = mkdtemp(tmpl);
-  }
-  ~Workdir() { fs::remove_all(dir_); }
   fs::path operator/(const std::string& name) const { return dir_ / name; }
   void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
   Result run(const std::string& args) const { return run_raw("env -u HYSTLAB_DAEMON -u HYSTLAB_TOKEN '" HYSTLAB_CLI "' " + args); }
@@ -49,7 +45,8 @@ class Workdir {
   }
 
  private:
-  fs::path dir_;
+  hystlab::test_support::TempDir tmp_{"cli"};
+  fs::path dir_ = tmp_.path();
 };
 
 

@@ -16,6 +16,7 @@
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
 namespace fs = std::filesystem;
@@ -23,8 +24,6 @@ namespace {  // each test program's own copy
 
 struct Bench {  // a db file, a writer, and a campaign row
   Bench(std::size_t capacity = 1U << 17) {
-    char tmpl[] = "/tmp/hystlab-campaign-XXXXXX";
-    dir = mkdtemp(tmpl);
     path = (dir / "hystlab.db").string();
     store = std::make_unique<db::Store>(path);
     writer = std::make_unique<db::SampleWriter>(path, db::WriterOptions{capacity, 0.1, 50'000, true});
@@ -33,10 +32,10 @@ struct Bench {  // a db file, a writer, and a campaign row
   ~Bench() {
     writer.reset();
     store.reset();
-    fs::remove_all(dir);
   }
   std::int64_t submit(const nlohmann::json& plan) { return store->create_campaign(rig_id, daemon::parse_plan(plan).kind, plan.dump(), "t"); }
-  fs::path dir;
+  test_support::TempDir tmp{"campaign"};
+  fs::path dir = tmp.path();
   std::string path;
   std::unique_ptr<db::Store> store;
   std::unique_ptr<db::SampleWriter> writer;

@@ -18,13 +18,12 @@
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "rig_worker.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
 
 struct SafetyWorld {
   SafetyWorld(bool shaker, std::size_t ring_slots) {
-    char tmpl[] = "/tmp/hystlab-safety-XXXXXX";
-    dir = mkdtemp(tmpl);
     path = (dir / "hystlab.db").string();
     store = std::make_unique<db::Store>(path);
     writer = std::make_unique<db::SampleWriter>(path, db::WriterOptions{ring_slots, 0.05, 50'000, false});
@@ -44,7 +43,6 @@ struct SafetyWorld {
   ~SafetyWorld() {
     writer.reset();
     store.reset();
-    std::filesystem::remove_all(dir);
   }
   SafetyWorld(const SafetyWorld&) = delete;
   SafetyWorld& operator=(const SafetyWorld&) = delete;
@@ -119,7 +117,8 @@ struct SafetyWorld {
     }
   }
 
-  std::filesystem::path dir;
+  test_support::TempDir tmp{"safety"};
+  std::filesystem::path dir = tmp.path();
   std::string path;
   std::unique_ptr<db::Store> store;
   std::unique_ptr<db::SampleWriter> writer;

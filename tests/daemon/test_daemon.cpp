@@ -17,18 +17,15 @@
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/simplified_sma.hpp"
 #include "../support/daemon_process.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystlab;
 
 namespace {
 struct Dir {
-  Dir() {
-    char tmpl[] = "/tmp/hystlabd-XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~Dir() { fs::remove_all(path); }
-  fs::path path;
+  hystlab::test_support::TempDir dir{"daemon"};
+  fs::path path = dir.path();
   std::string db() const { return (path / "hystlab.db").string(); }
   void write(const std::string& name, const std::string& text) const { std::ofstream(path / name) << text; }
 };

@@ -15,6 +15,7 @@
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/sequencer.hpp"
 #include "hystlab/daemon/supervisor.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystlab;
@@ -26,8 +27,6 @@ using test::FaultEvent;
 namespace {
 struct Harness {
   explicit Harness(daemon::SupervisionSettings s = {}) : settings(s) {
-    char tmpl[] = "/tmp/hystlab-super-XXXXXX";
-    dir = mkdtemp(tmpl);
     path = (dir / "hystlab.db").string();
     store = std::make_unique<db::Store>(path);
     writer = std::make_unique<db::SampleWriter>(path, db::WriterOptions{1U << 16, 0.05, 50'000, false});
@@ -37,7 +36,6 @@ struct Harness {
   ~Harness() {
     writer.reset();
     store.reset();
-    fs::remove_all(dir);
   }
   daemon::CampaignJob job(const nlohmann::json& plan_json) {
     daemon::CampaignJob j;
@@ -73,7 +71,8 @@ struct Harness {
   daemon::FakeClock clock;
   daemon::SupervisionSettings settings;
   daemon::RigEnvelope envelope;
-  fs::path dir;
+  test_support::TempDir tmp{"super"};
+  fs::path dir = tmp.path();
   std::string path;
   std::unique_ptr<db::Store> store;
   std::unique_ptr<db::SampleWriter> writer;

@@ -15,6 +15,7 @@
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/db/schema.hpp"
 #include "hystlab/db/store.hpp"
+#include "../support/temp_dir.hpp"
 
 extern char** environ;
 namespace fs = std::filesystem;
@@ -22,14 +23,9 @@ using namespace hystlab::db;
 
 namespace {
 struct TempDb {
-  TempDb() {
-    char tmpl[] = "/tmp/hystlab-db-XXXXXX";
-    dir = mkdtemp(tmpl);
-    path = (dir / "hystlab.db").string();
-  }
-  ~TempDb() { fs::remove_all(dir); }
-  fs::path dir;
-  std::string path;
+  hystlab::test_support::TempDir tmp{"db"};
+  fs::path dir = tmp.path();
+  std::string path = (dir / "hystlab.db").string();
 };
 
 std::int64_t campaign_with_run(Store& s) {

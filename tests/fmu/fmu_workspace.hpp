@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "fmu_importer.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
 namespace fs = std::filesystem;
@@ -17,16 +18,14 @@ inline const std::string kCli = HYSTLAB_CLI;
 inline constexpr fmi2ValueReference kX = 0, kF = 1, kXScale = 2, kXOffset = 3, kForceScale = 4, kSign = 5, kSaturations = 6;
 
 struct Workspace {
-  fs::path dir;
+  hystlab::test_support::TempDir tmp{"fmu"};
+  fs::path dir = tmp.path();
   Workspace() {
-    char tmpl[] = "/tmp/hystlab-fmu-XXXXXX";
-    dir = mkdtemp(tmpl);
     run("identify --model simplified --range 0,4 --subdivisions 12 -o T.json");
     run("identify --model simplified --range 0,4 --subdivisions 12 --refine 2,1 -o T2.json");  // a grid of its own
     std::ofstream(dir / "P.json") << R"({"model": "simplified-sma", "KA_N_per_mm": 40, "KM_N_per_mm": 150, "dtr_max_mm": 2.95,
       "C_N_per_degC": 5.7, "Mf0_degC": 12.7, "Ms0_degC": 17.9, "As0_degC": 17.9, "Af0_degC": 21.5, "T_degC": 25})";
   }
-  ~Workspace() { fs::remove_all(dir); }
   std::string run(const std::string& args, int* status = nullptr) const {
     int st = 0;
     std::string out = shell("cd '" + dir.string() + "' && '" + kCli + "' " + args + " 2>&1", &st);

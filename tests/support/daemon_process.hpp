@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 #include <vector>
+#include "temp_dir.hpp"
 
 extern char** environ;
 
@@ -63,8 +64,6 @@ class DaemonProcess {
  public:
   // prepare: fills the database before the daemon opens it (a stored run to read back).
   explicit DaemonProcess(const std::string& config_json, const std::function<void(const std::string& db_path)>& prepare = {}) {
-    char tmpl[] = "/tmp/hystlab-bench-XXXXXX";
-    dir_ = mkdtemp(tmpl);
     if (prepare) prepare((dir_ / "bench.db").string());
     std::ofstream(dir_ / "hystlab.json") << config_json;
     const std::string log = (dir_ / "daemon.log").string();
@@ -98,10 +97,10 @@ class DaemonProcess {
       kill(pid_, SIGKILL);
       waitpid(pid_, &st, 0);
     }
-    std::filesystem::remove_all(dir_);
   }
 
-  std::filesystem::path dir_;
+  TempDir tmp_{"daemon"};  // removed after stop(): the daemon is gone by then
+  std::filesystem::path dir_ = tmp_.path();
   pid_t pid_ = -1;
   int port_ = 0;
 };

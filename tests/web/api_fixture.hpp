@@ -22,19 +22,16 @@
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/daemon/daemon_control.hpp"
 #include "hystlab/web/http_api.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-struct TempDir {
-  TempDir() {
-    char tmpl[] = "/tmp/hystlab-api-XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  fs::path path;
+struct TempDir {  // the API tests' folder (test_support::TempDir), its path a member as they use it
+  test_support::TempDir dir{"api"};
+  fs::path path = dir.path();
 };
 
 inline json fot_plan(int n, double rate_mm_s = 1.0) {
