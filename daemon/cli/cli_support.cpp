@@ -1,14 +1,14 @@
-#include <filesystem>
 #include "cli_support.hpp"
+#include <filesystem>
 #include "hystlab/models/document_source.hpp"
 #include "hystlab/models/text_forms.hpp"
 
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
-#include <cstring>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <iostream>
@@ -20,8 +20,7 @@
 
 namespace hystlab::cli {
 
-Options::Options(const std::vector<std::string>& args, const std::set<std::string>& with_value,
-                 const std::set<std::string>& flags) {
+Options::Options(const std::vector<std::string>& args, const std::set<std::string>& with_value, const std::set<std::string>& flags) {
   for (std::size_t k = 0; k < args.size(); ++k) {
     std::string a = args[k];
     if (a == "-o") a = "--output";
@@ -74,16 +73,13 @@ double parse_double(const std::string& s, const std::string& what) {
 }
 }  // namespace
 
-double Options::number(const std::string& name, double fallback) const {
-  return has(name) ? parse_double(get(name), "option --" + name) : fallback;
-}
+double Options::number(const std::string& name, double fallback) const { return has(name) ? parse_double(get(name), "option --" + name) : fallback; }
 
 int Options::integer(const std::string& name, int fallback, int lo, int hi) const {
   if (!has(name)) return fallback;
   const double v = number(name, 0.0);
   if (v != std::floor(v) || v < lo || v > hi)
-    throw CliError("option --" + name + ": must be a whole number from " + std::to_string(lo) + " to " +
-                   std::to_string(hi) + ", got '" + get(name) + "'");
+    throw CliError("option --" + name + ": must be a whole number from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got '" + get(name) + "'");
   return static_cast<int>(v);
 }
 
@@ -164,8 +160,10 @@ void write_file(const std::string& path, const std::string& text) {
 }
 
 void write_output(const std::string& path, const std::string& text) {
-  if (path.empty() || path == "-") std::cout << text << std::flush;
-  else write_file(path, text);
+  if (path.empty() || path == "-")
+    std::cout << text << std::flush;
+  else
+    write_file(path, text);
 }
 
 namespace {
@@ -207,8 +205,8 @@ Csv Csv::parse(const std::string& text, const std::string& name) {
     }
     auto fields = split_fields(line);
     if (fields.size() != csv.header_.size())
-      throw CliError(name + ": line " + std::to_string(lineno) + ": has " + std::to_string(fields.size()) +
-                     " fields, the header has " + std::to_string(csv.header_.size()));
+      throw CliError(name + ": line " + std::to_string(lineno) + ": has " + std::to_string(fields.size()) + " fields, the header has " +
+                     std::to_string(csv.header_.size()));
     csv.rows_.push_back(std::move(fields));
     csv.lines_.push_back(lineno);
   }
@@ -321,8 +319,7 @@ db::Store open_store(const Options& opt) {
 
 void require_database(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw CliError("--db: no database at '" + path + "' (hystlabd creates it; give the path it uses)");
+  if (!std::filesystem::is_regular_file(path, ec)) throw CliError("--db: no database at '" + path + "' (hystlabd creates it; give the path it uses)");
 }
 
 }  // namespace hystlab::cli

@@ -22,8 +22,7 @@ struct CliError : std::runtime_error {
 // Parses "--name value", "--name=value", flags and "-o value". Unknown options are errors.
 class Options {
  public:
-  Options(const std::vector<std::string>& args, const std::set<std::string>& with_value,
-          const std::set<std::string>& flags);
+  Options(const std::vector<std::string>& args, const std::set<std::string>& with_value, const std::set<std::string>& flags);
   [[nodiscard]] bool has(const std::string& name) const { return values_.count(name) > 0; }
   [[nodiscard]] std::string get(const std::string& name, const std::string& fallback = "") const;
   [[nodiscard]] std::string require(const std::string& name) const;

@@ -7,17 +7,17 @@
 #include <iostream>
 
 #include "cli_support.hpp"
-#include "hystlab/db/signals.hpp"
 #include "commands.hpp"
 #include "daemon_client.hpp"
 #include "event_text.hpp"
+#include "hystlab/daemon/plan.hpp"
 #include "hystlab/db/campaign_record.hpp"
+#include "hystlab/db/signals.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/fmu/element_export.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
-#include "hystlab/fmu/element_export.hpp"
 #include "hystlab/models/table_export.hpp"
-#include "hystlab/daemon/plan.hpp"
 
 namespace hystlab::cli {
 namespace {
@@ -133,10 +133,18 @@ std::string heldout_line(const std::string& json_text) {
 
 // hystlab tables list: one row a table, the columns aligned, and what its marks mean below it.
 void list_tables(db::Store& store) {
-  const std::vector<Column> columns{{"id", true},       {"campaign", true},        {"method"},
-                                    {"n", true},        {"range (mm)"},            {"RMS (N)", true},
-                                    {"% range", true},  {"max (N)", true},         {"held-out RMS (N)", true},
-                                    {"held-out max (N)", true}, {""},              {"created"}};
+  const std::vector<Column> columns{{"id", true},
+                                    {"campaign", true},
+                                    {"method"},
+                                    {"n", true},
+                                    {"range (mm)"},
+                                    {"RMS (N)", true},
+                                    {"% range", true},
+                                    {"max (N)", true},
+                                    {"held-out RMS (N)", true},
+                                    {"held-out max (N)", true},
+                                    {""},
+                                    {"created"}};
   std::vector<std::vector<std::string>> rows;
   bool star = false, dash = false;
   const auto or_dash = [&dash](const std::string& v) { return v.empty() ? (dash = true, std::string("-")) : v; };
@@ -165,7 +173,8 @@ int print_preview(const nlohmann::json& p) {
   if (p.contains("peak_force_N") && p["peak_force_N"].is_number())
     std::cout << ", peak force " << round_g(p["peak_force_N"].get<double>()) << " N (limit " << round_g(p.value("force_limit_N", 0.0)) << " N; from "
               << p.value("force_source", "") << ")";
-  if (p.contains("peak_accel_m_s2") && p["peak_accel_m_s2"].is_number()) std::cout << ", peak acceleration " << round_g(p["peak_accel_m_s2"].get<double>()) << " m/s^2";
+  if (p.contains("peak_accel_m_s2") && p["peak_accel_m_s2"].is_number())
+    std::cout << ", peak acceleration " << round_g(p["peak_accel_m_s2"].get<double>()) << " m/s^2";
   std::cout << "\n";
   return 0;
 }
@@ -201,21 +210,30 @@ void print_sweep(db::Store& store, const db::CampaignRow& row) {
     }
     for (const auto& a : r.jumps)
       for (const auto& j : a.jumps)
-        std::cout << "    " << what << " " << round_g(a.amplitude_mm) << " mm: up and down differ by up to " << round_g(100 * j.max_difference)
-                  << " % between " << round_g(j.lo_hz) << " and " << round_g(j.hi_hz) << " Hz\n";
+        std::cout << "    " << what << " " << round_g(a.amplitude_mm) << " mm: up and down differ by up to " << round_g(100 * j.max_difference) << " % between "
+                  << round_g(j.lo_hz) << " and " << round_g(j.hi_hz) << " Hz\n";
   }
 }
 
 void show_json(db::Store& store, const db::CampaignRow& row) {
   const auto plan = nlohmann::json::parse(row.plan, nullptr, false);
   const std::string why = store.state_reason(row.id, row.state);
-  nlohmann::json j{{"id", row.id}, {"kind", db::to_string(row.kind)}, {"rig", store.rig_name(row.rig_id)}, {"state", db::to_string(row.state)},
-                   {"reason", why.empty() ? nlohmann::json() : nlohmann::json(why)}, {"created_at", row.created_at}, {"updated_at", row.updated_at},
-                   {"plan", plan}, {"runs", nlohmann::json::array()}, {"tables", nlohmann::json::array()}, {"events", nlohmann::json::array()}};
+  nlohmann::json j{{"id", row.id},
+                   {"kind", db::to_string(row.kind)},
+                   {"rig", store.rig_name(row.rig_id)},
+                   {"state", db::to_string(row.state)},
+                   {"reason", why.empty() ? nlohmann::json() : nlohmann::json(why)},
+                   {"created_at", row.created_at},
+                   {"updated_at", row.updated_at},
+                   {"plan", plan},
+                   {"runs", nlohmann::json::array()},
+                   {"tables", nlohmann::json::array()},
+                   {"events", nlohmann::json::array()}};
   const db::CampaignRecord record = db::campaign_record(store, row);  // the plan's, or as changed since
   j["specimen"] = record.specimen.empty() ? nlohmann::json() : nlohmann::json(record.specimen);
   j["notes"] = record.notes.empty() ? nlohmann::json() : nlohmann::json(record.notes);
-  for (const auto& r : store.runs(row.id)) j["runs"].push_back({{"id", r.id}, {"role", r.role}, {"state", r.state}, {"samples", r.samples}, {"nodes", r.nodes}});
+  for (const auto& r : store.runs(row.id))
+    j["runs"].push_back({{"id", r.id}, {"role", r.role}, {"state", r.state}, {"samples", r.samples}, {"nodes", r.nodes}});
   j["loops"] = nlohmann::json::array();
   for (const auto& l : store.loops(row.id)) {
     auto fig = nlohmann::json::parse(l.figures_json, nullptr, false);
@@ -225,7 +243,8 @@ void show_json(db::Store& store, const db::CampaignRow& row) {
   }
   for (const auto& t : store.tables(row.id))
     j["tables"].push_back({{"id", t.id}, {"method", t.method}, {"n", t.n}, {"accuracy", nlohmann::json::parse(t.accuracy_json, nullptr, false)}});
-  for (const auto& e : store.events(row.id)) j["events"].push_back({{"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", e.detail}});
+  for (const auto& e : store.events(row.id))
+    j["events"].push_back({{"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", e.detail}});
   std::cout << j.dump(2) << "\n";
 }
 
@@ -267,8 +286,8 @@ int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
   }
   print_heading(store, row);
   for (const auto& r : store.runs(row.id))
-    std::cout << "  run " << r.id << (r.role == "validation" ? " (validation)" : "") << ": " << r.state << ", " << r.samples << " samples, "
-              << r.nodes << " FOT nodes\n";
+    std::cout << "  run " << r.id << (r.role == "validation" ? " (validation)" : "") << ": " << r.state << ", " << r.samples << " samples, " << r.nodes
+              << " FOT nodes\n";
   for (const std::string& d : store.event_details(row.id, "training"))
     std::cout << "  training: " << nlohmann::json::parse(d, nullptr, false).value("why", std::string("?")) << "\n";
   for (const auto& t : store.tables(row.id)) {
@@ -338,7 +357,8 @@ int run_campaign_cmd(const Args& args) {
     refuse_db_option(args, "campaign " + verb);
     const Options opt(rest(args, 2), {"daemon", "token"}, {});
     const auto a = post_to_daemon(daemon_address(opt), "/api/campaigns/" + std::to_string(id) + "/" + verb, "");
-    std::cout << verb << " " << (a.value("result", "") == "done" ? "done" : "sent") << ": campaign " << id << " (" << a.value("state", "") << ": " << a.value("reason", "") << ")\n";
+    std::cout << verb << " " << (a.value("result", "") == "done" ? "done" : "sent") << ": campaign " << id << " (" << a.value("state", "") << ": "
+              << a.value("reason", "") << ")\n";
     return 0;
   }
   const Options opt(rest(args, 2), {"db"}, {"json"});

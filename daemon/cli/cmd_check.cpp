@@ -43,20 +43,18 @@ std::string pct(double v) {
 std::string accuracy_text(const models::AccuracyReport& r) {
   std::string out;
   char buf[200];
-  std::snprintf(buf, sizeof buf, "%-11s %8s %12s %12s %10s %10s\n", "branch", "samples", "rms (N)", "max (N)",
-                "rms/range", "max/range");
+  std::snprintf(buf, sizeof buf, "%-11s %8s %12s %12s %10s %10s\n", "branch", "samples", "rms (N)", "max (N)", "rms/range", "max/range");
   out += buf;
-  const std::pair<const char*, const models::ErrorStats*> rows[] = {
-      {"overall", &r.overall}, {"ascending", &r.ascending}, {"descending", &r.descending}};
+  const std::pair<const char*, const models::ErrorStats*> rows[] = {{"overall", &r.overall}, {"ascending", &r.ascending}, {"descending", &r.descending}};
   for (const auto& [name, s] : rows) {
-    std::snprintf(buf, sizeof buf, "%-11s %8zu %12.6g %12.6g %10s %10s\n", name, s->count, s->rms, s->max_abs,
-                  pct(s->rms_norm).c_str(), pct(s->max_norm).c_str());
+    std::snprintf(buf, sizeof buf, "%-11s %8zu %12.6g %12.6g %10s %10s\n", name, s->count, s->rms, s->max_abs, pct(s->rms_norm).c_str(),
+                  pct(s->max_norm).c_str());
     out += buf;
   }
   out += "reference force range: " + format_number(r.reference_range) + " N\n";
   if (r.energy_rel_error)
-    out += "loop energy: reference " + format_number(*r.energy_reference) + " N*mm, model " +
-           format_number(*r.energy_model) + " N*mm, relative error " + pct(*r.energy_rel_error) + "\n";
+    out += "loop energy: reference " + format_number(*r.energy_reference) + " N*mm, model " + format_number(*r.energy_model) + " N*mm, relative error " +
+           pct(*r.energy_rel_error) + "\n";
   else
     out += "loop energy: not applicable (the input does not return to where it began)\n";
   return out;
@@ -73,18 +71,14 @@ int run_check(const Args& args) {
   if (opt.has("dead-band") && ro.dead_band < 0) throw CliError("option --dead-band: must be >= 0");
   if (opt.has("tolerance") && ro.extremum_tolerance < 0) throw CliError("option --tolerance: must be >= 0");
   const models::RepresentationReport r = models::check_representation(x, f, ro);
-  std::cout << "samples: " << x.size() << ", reversals: " << r.reversals << ", force range "
-            << format_number(r.force_range) << " N\n"
-            << "wiping-out: " << r.wiping_out.events << " returns to a turning point; deviation max "
-            << format_number(r.wiping_out.max_deviation) << " N (" << pct(r.wiping_out.max_deviation_norm)
-            << "), rms " << format_number(r.wiping_out.rms_deviation) << " N\n"
+  std::cout << "samples: " << x.size() << ", reversals: " << r.reversals << ", force range " << format_number(r.force_range) << " N\n"
+            << "wiping-out: " << r.wiping_out.events << " returns to a turning point; deviation max " << format_number(r.wiping_out.max_deviation) << " N ("
+            << pct(r.wiping_out.max_deviation_norm) << "), rms " << format_number(r.wiping_out.rms_deviation) << " N\n"
             << "congruency: " << r.congruency.loops << " closed minor loops, " << r.congruency.compared_pairs
-            << " pairs with the same extrema; shape deviation max " << format_number(r.congruency.max_deviation)
-            << " N (" << pct(r.congruency.max_deviation_norm) << "), rms "
-            << format_number(r.congruency.rms_deviation) << " N\n";
+            << " pairs with the same extrema; shape deviation max " << format_number(r.congruency.max_deviation) << " N ("
+            << pct(r.congruency.max_deviation_norm) << "), rms " << format_number(r.congruency.rms_deviation) << " N\n";
   if (r.wiping_out.events == 0 || r.congruency.compared_pairs == 0)
-    std::cout << "note: the record has too few closed minor loops to judge "
-              << (r.wiping_out.events == 0 ? "wiping-out" : "congruency") << "\n";
+    std::cout << "note: the record has too few closed minor loops to judge " << (r.wiping_out.events == 0 ? "wiping-out" : "congruency") << "\n";
   return 0;
 }
 
@@ -138,8 +132,7 @@ int run_compare(const Args& args) {
                        " mm is outside the table's range (--clamp clamps and counts)");
   std::vector<double> y(x.size());
   m.model->evaluate(x, y);
-  std::cout << "model: " << m.description << "\ndata: " << path << " (" << x.size() << " samples)\n"
-            << accuracy_text(models::compare(x, ref, y));
+  std::cout << "model: " << m.description << "\ndata: " << path << " (" << x.size() << " samples)\n" << accuracy_text(models::compare(x, ref, y));
   if (const auto sat = m.model->saturation_count())
     std::cout << sat << " input(s) beyond the table's range " << format_number(m.lo) << ".." << format_number(m.hi) << " mm were clamped\n";
   return 0;

@@ -7,8 +7,8 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "hystlab/models/accuracy.hpp"
-#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/simplified_sma.hpp"
 #include "svg_plot.hpp"
@@ -55,9 +55,8 @@ struct Row {
 
 std::string row_text(const Row& r) {
   char b[220];
-  std::snprintf(b, sizeof b, "| %3d | %5zu | %9.3f | %9.3f | %7.2f %% | %7.2f %% | %9.3f | %9.3f | %8.2f %% | %4zu |\n",
-                r.n, r.nodes, r.acc.overall.rms, r.acc.overall.max_abs, 100 * r.acc.overall.rms_norm,
-                100 * r.acc.overall.max_norm, r.acc.ascending.rms, r.acc.descending.rms,
+  std::snprintf(b, sizeof b, "| %3d | %5zu | %9.3f | %9.3f | %7.2f %% | %7.2f %% | %9.3f | %9.3f | %8.2f %% | %4zu |\n", r.n, r.nodes, r.acc.overall.rms,
+                r.acc.overall.max_abs, 100 * r.acc.overall.rms_norm, 100 * r.acc.overall.max_norm, r.acc.ascending.rms, r.acc.descending.rms,
                 r.acc.energy_rel_error ? 100 * *r.acc.energy_rel_error : 0.0, r.negative_cells);
   return b;
 }
@@ -76,8 +75,7 @@ std::string refined_grid_text(const models::SmaParameters& params) {
     models::PreisachModel u(models::identify_virtual(s1, models::Grid::make(kLo, kHi, n)));
     models::PreisachModel r(models::identify_virtual(s2, models::Grid::refined(kLo, kHi, n, 2.0, 1.0)));
     char b[160];
-    std::snprintf(b, sizeof b, "| %3d | %.3g | %.3g |\n", n, models::compare(x, ref, run(u, x)).overall.rms,
-                  models::compare(x, ref, run(r, x)).overall.rms);
+    std::snprintf(b, sizeof b, "| %3d | %.3g | %.3g |\n", n, models::compare(x, ref, run(u, x)).overall.rms, models::compare(x, ref, run(r, x)).overall.rms);
     out += b;
   }
   return out;
@@ -122,8 +120,7 @@ int run_demo(const Args& args) {
     table_text += row_text(row);
     models::TableProvenance prov{"simplified SMA model", "virtual-fot", now_iso8601(), "hystlab demo", {}};
     prov.extra = {{"rms_error_N", row.acc.overall.rms}, {"max_error_N", row.acc.overall.max_abs}};
-    write_file((dir / ("table_n" + std::to_string(n) + ".json")).string(),
-               models::table_to_json(id.table, prov).dump(2) + "\n");
+    write_file((dir / ("table_n" + std::to_string(n) + ".json")).string(), models::table_to_json(id.table, prov).dump(2) + "\n");
     const std::string color = colors[c++];
     if (n == 4 || n == 12 || n == 48) {
       major_plot.push_back({"Preisach n = " + std::to_string(n), color, major, run(pm, major), true, false});
@@ -140,39 +137,34 @@ int run_demo(const Args& args) {
     }
   }
   write_file((dir / "major_loop.svg").string(),
-             svg_plot("Major loop: simplified model and identified Preisach tables", "displacement (mm)",
-                      "force (N)", major_plot));
+             svg_plot("Major loop: simplified model and identified Preisach tables", "displacement (mm)", "force (N)", major_plot));
   write_file((dir / "minor_loops.svg").string(),
-             svg_plot("Minor loops: simplified model and identified Preisach tables", "displacement (mm)",
-                      "force (N)", minor_plot));
-  write_file((dir / "random_input.svg").string(),
-             svg_plot("Random input (seed " + std::to_string(seed) + ")", "sample", "force (N)", random_plot));
+             svg_plot("Minor loops: simplified model and identified Preisach tables", "displacement (mm)", "force (N)", minor_plot));
+  write_file((dir / "random_input.svg").string(), svg_plot("Random input (seed " + std::to_string(seed) + ")", "sample", "force (N)", random_plot));
   const models::SmaTransitions tr = models::transitions(params);
   std::string report = "# hystlab demo: Preisach identification from the simplified SMA model (paper §3.3)\n\n";
-  report += "Parameters: KA " + format_number(params.KA) + " N/mm, KM " + format_number(params.KM) + " N/mm, dtr_max " +
-            format_number(params.dtr_max) + " mm, C " + format_number(params.C) + " N/degC, T " +
-            format_number(params.T) + " degC.\n\nTransition points (mm, N): Ms (" +
-            format_number(tr.Ms.displacement) + ", " + format_number(tr.Ms.force) + "), Mf (" +
-            format_number(tr.Mf.displacement) + ", " + format_number(tr.Mf.force) + "), As (" +
-            format_number(tr.As.displacement) + ", " + format_number(tr.As.force) + "), Af (" +
+  report += "Parameters: KA " + format_number(params.KA) + " N/mm, KM " + format_number(params.KM) + " N/mm, dtr_max " + format_number(params.dtr_max) +
+            " mm, C " + format_number(params.C) + " N/degC, T " + format_number(params.T) + " degC.\n\nTransition points (mm, N): Ms (" +
+            format_number(tr.Ms.displacement) + ", " + format_number(tr.Ms.force) + "), Mf (" + format_number(tr.Mf.displacement) + ", " +
+            format_number(tr.Mf.force) + "), As (" + format_number(tr.As.displacement) + ", " + format_number(tr.As.force) + "), Af (" +
             format_number(tr.Af.displacement) + ", " + format_number(tr.Af.force) + ").\n\n";
-  report += "Errors of each identified table against the simplified model on one random input (seed " +
-            std::to_string(seed) + ", " + std::to_string(x.size()) + " samples, 0.." + format_number(kHi) +
+  report += "Errors of each identified table against the simplified model on one random input (seed " + std::to_string(seed) + ", " + std::to_string(x.size()) +
+            " samples, 0.." + format_number(kHi) +
             " mm). `neg cells`: cells of the table whose Preisach weight is negative: the simplified model's "
             "minor loops are not of Preisach type, so its FOT table is not monotone everywhere.\n\n" +
             table_text +
             "\nPlots: [major loop](major_loop.svg), [minor loops](minor_loops.svg), [random input](random_input.svg)."
             " Tables: table_n4.json ... table_n48.json.\n";
   const std::string refined = refined_grid_text(params);
-  report += "\n## A grid refined where the part works\n\nAn isolator works about its preload: small loops there "
-            "matter more than the major loop. At the same node count, a table whose grid puts half its cells in "
-            "1.5..2.5 mm (table format version 2) against the uniform one, on loops of ±0.3 mm about 2 mm:\n\n" +
-            refined;
+  report +=
+      "\n## A grid refined where the part works\n\nAn isolator works about its preload: small loops there "
+      "matter more than the major loop. At the same node count, a table whose grid puts half its cells in "
+      "1.5..2.5 mm (table format version 2) against the uniform one, on loops of ±0.3 mm about 2 mm:\n\n" +
+      refined;
   write_file((dir / "report.md").string(), report);
-  std::cout << "Preisach tables identified from the simplified SMA model, errors on a random input (" << x.size()
-            << " samples):\n\n"
-            << table_text << "\nSmall loops about a 2 mm preload, uniform against refined grids of the same n:\n\n" << refined
-            << "\nwrote " << (dir / "report.md").string() << ", major_loop.svg, minor_loops.svg, "
+  std::cout << "Preisach tables identified from the simplified SMA model, errors on a random input (" << x.size() << " samples):\n\n"
+            << table_text << "\nSmall loops about a 2 mm preload, uniform against refined grids of the same n:\n\n"
+            << refined << "\nwrote " << (dir / "report.md").string() << ", major_loop.svg, minor_loops.svg, "
             << "random_input.svg and table_n*.json in " << dir.string() << "\n";
   return 0;
 }

@@ -36,16 +36,15 @@ int run_eval(const Args& args) {
   if (m.hi > m.lo && !opt.has("clamp")) {
     for (std::size_t k = 0; k < x.size(); ++k)
       if (x[k] < m.lo || x[k] > m.hi)
-        throw CliError(opt.get("input") + ": line " + std::to_string(csv.line_of(k)) + ": displacement " +
-                       format_number(x[k]) + " mm is outside the table's range " + format_number(m.lo) + ".." +
-                       format_number(m.hi) + " mm (--clamp clamps and counts)");
+        throw CliError(opt.get("input") + ": line " + std::to_string(csv.line_of(k)) + ": displacement " + format_number(x[k]) +
+                       " mm is outside the table's range " + format_number(m.lo) + ".." + format_number(m.hi) + " mm (--clamp clamps and counts)");
   }
   std::vector<double> f(x.size());
   m.model->evaluate(x, f);
   write_output(opt.get("output"), to_csv({"displacement_mm", "force_N"}, {x, f}));
   if (const auto sat = m.model->saturation_count())
-    std::cerr << "hystlab: " << sat << " of " << x.size() << " inputs were outside " << format_number(m.lo) << ".."
-              << format_number(m.hi) << " mm and were clamped\n";
+    std::cerr << "hystlab: " << sat << " of " << x.size() << " inputs were outside " << format_number(m.lo) << ".." << format_number(m.hi)
+              << " mm and were clamped\n";
   return 0;
 }
 
@@ -61,9 +60,9 @@ int run_invert(const Args& args) {
   for (std::size_t k = 0; k < target.size(); ++k) {
     const models::InverseResult r = models::invert(model, target[k], g.lo, g.hi, 1e-9 * (g.hi - g.lo));
     if (r.error)
-      throw CliError(opt.get("input") + ": line " + std::to_string(csv.line_of(k)) + ": force " +
-                     format_number(target[k]) + " N cannot be reached from the current state (reachable " +
-                     format_number(model.peek(g.lo)) + ".." + format_number(model.peek(g.hi)) + " N)");
+      throw CliError(opt.get("input") + ": line " + std::to_string(csv.line_of(k)) + ": force " + format_number(target[k]) +
+                     " N cannot be reached from the current state (reachable " + format_number(model.peek(g.lo)) + ".." + format_number(model.peek(g.hi)) +
+                     " N)");
     x[k] = r.displacement;
     f[k] = model.step(r.displacement);
   }

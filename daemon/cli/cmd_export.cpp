@@ -23,8 +23,7 @@ void write_export(const std::string& document, const std::string& format, const 
                   std::optional<models::ElementKind> kind) {
   if (!fmu::is_export_format(format)) throw CliError("--format: '" + format + "' is not " + std::string(fmu::kExportFormats));
   const fmu::ExportedFile f = fmu::export_element(document, format, name, now_iso8601(), kind);
-  if (f.binary && (output.empty() || output == "-"))
-    throw CliError("--format " + format + " writes a binary archive: give -o FILE." + format);
+  if (f.binary && (output.empty() || output == "-")) throw CliError("--format " + format + " writes a binary archive: give -o FILE." + format);
   write_output(output, f.bytes);
 }
 
@@ -37,8 +36,10 @@ int run_export(const Args& args) {
   const bool table = opt.has("table");
   const std::string path = opt.get(table ? "table" : "params");
   // The document checked as its file first: a fault names the file (the export re-reads the text).
-  if (table) (void)read_table_file(path);
-  else (void)read_params_file(path);
+  if (table)
+    (void)read_table_file(path);
+  else
+    (void)read_params_file(path);
   const std::string doc = read_file(path);
   write_export(doc, format, opt.get("name", table ? "hystlab_table" : "hystlab_params"), opt.get("output"),
                table ? models::ElementKind::Table : models::ElementKind::Params);

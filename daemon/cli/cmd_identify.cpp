@@ -4,9 +4,9 @@
 
 #include "cli_support.hpp"
 #include "commands.hpp"
-#include "hystlab/models/fot_identification.hpp"
-#include "hystlab/models/formats.hpp"
 #include "hystlab/models/fit_report.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/sma_calibration.hpp"
 
 namespace hystlab::cli {
@@ -65,7 +65,8 @@ std::string grid_text(const models::Grid& g) {
 models::Grid grid_option(const Options& opt) {
   try {
     if (opt.has("nodes")) {
-      if (opt.has("range") || opt.has("subdivisions") || opt.has("refine")) throw CliError("--nodes gives the whole grid: leave out --range, --subdivisions and --refine");
+      if (opt.has("range") || opt.has("subdivisions") || opt.has("refine"))
+        throw CliError("--nodes gives the whole grid: leave out --range, --subdivisions and --refine");
       return models::Grid::from_nodes(opt.numbers("nodes"));
     }
     const auto [lo, hi] = opt.range("range");
@@ -108,12 +109,11 @@ int run_identify(const Args& args) {
                   {"drift_pooled_std_N", id.drift.pooled_std},
                   {"violations", id.violations.size()}};
     std::cout << "identified " << grid_text(table.grid()) << " from " << id.node_count << " nodes\n"
-              << "drift: max spread of f_alpha " << format_number(id.drift.max_spread) << " N, pooled std "
-              << format_number(id.drift.pooled_std) << " N over " << id.drift.repeated_rows << " repeated rows\n";
+              << "drift: max spread of f_alpha " << format_number(id.drift.max_spread) << " N, pooled std " << format_number(id.drift.pooled_std) << " N over "
+              << id.drift.repeated_rows << " repeated rows\n";
     for (const auto& c : id.violations)
-      std::cout << "warning: cell alpha in [" << format_number(table.grid().node(c.p - 1)) << ", "
-                << format_number(table.grid().node(c.p)) << "] beta in [" << format_number(table.grid().node(c.q - 1))
-                << ", " << format_number(table.grid().node(c.q)) << "] has weight " << format_number(c.weight)
+      std::cout << "warning: cell alpha in [" << format_number(table.grid().node(c.p - 1)) << ", " << format_number(table.grid().node(c.p)) << "] beta in ["
+                << format_number(table.grid().node(c.q - 1)) << ", " << format_number(table.grid().node(c.q)) << "] has weight " << format_number(c.weight)
                 << " N (below -" << format_number(id.violation_threshold) << " N): F is not monotone there\n";
   } else {
     LoadedModel m = load_model(opt);
@@ -122,8 +122,7 @@ int run_identify(const Args& args) {
     prov.source = m.description;
     prov.method = "virtual-fot";
     prov.from = opt.get("params", "built-in Table 1");
-    std::cout << "identified " << grid_text(g) << " (" << g.node_count() << " nodes) from the " << m.description
-              << "\n";
+    std::cout << "identified " << grid_text(g) << " (" << g.node_count() << " nodes) from the " << m.description << "\n";
   }
   write_file(out, models::table_to_json(table, prov).dump(2) + "\n");
   std::cout << "wrote " << out << "\n";
@@ -170,16 +169,17 @@ int run_fit(const Args& args) {
   const models::PriorFit& c = r.chosen;
   models::TableProvenance prov{"displacement/force record", "lsq", now_iso8601(), path, models::fit_provenance(r)};
   write_file(out, models::table_to_json(c.table, prov).dump(2) + "\n");
-  std::cout << "fitted " << grid_text(c.table.grid()) << " to " << x.size() << " samples in "
-            << format_number(r.seconds) << " s (" << format_number(static_cast<double>(r.peak_bytes) / 1048576.0)
-            << " MiB)" << (r.selection_samples < x.size() ? "; the prior and lambda chosen on " + std::to_string(r.selection_samples) +
-                                                   " of them (every turning point kept)" : std::string()) << "\n"
+  std::cout << "fitted " << grid_text(c.table.grid()) << " to " << x.size() << " samples in " << format_number(r.seconds) << " s ("
+            << format_number(static_cast<double>(r.peak_bytes) / 1048576.0) << " MiB)"
+            << (r.selection_samples < x.size()
+                    ? "; the prior and lambda chosen on " + std::to_string(r.selection_samples) + " of them (every turning point kept)"
+                    : std::string())
+            << "\n"
             << "prior " << models::to_string(c.prior) << ": " << r.reason << "\n"
-            << "smoothing lambda " << format_number(c.lambda)
-            << (opt.has("lambda") ? " (given)" : " (" + std::to_string(fo.folds) + "-fold cross-validation)") << "\n"
+            << "smoothing lambda " << format_number(c.lambda) << (opt.has("lambda") ? " (given)" : " (" + std::to_string(fo.folds) + "-fold cross-validation)")
+            << "\n"
             << "residual: rms " << format_number(c.rms_residual) << " N, max " << format_number(c.max_residual)
-            << " N; cells of negative mass: " << c.negative_cells << ", held at zero: " << c.cells_at_bound << " of "
-            << c.cell_weight.size() << "\n"
+            << " N; cells of negative mass: " << c.negative_cells << ", held at zero: " << c.cells_at_bound << " of " << c.cell_weight.size() << "\n"
             << "wrote " << out << "\n";
   return 0;
 }
@@ -204,16 +204,13 @@ int run_calibrate(const Args& args) {
   const models::SmaCalibration c = models::calibrate_simplified_sma(x, y, co);
   write_file(out, models::params_to_json(c.parameters, "calibrated from " + path).dump(2) + "\n");
   const auto& p = c.parameters;
-  std::cout << "KA " << format_number(p.KA) << " N/mm, KM " << format_number(p.KM) << " N/mm, dtr_max "
-            << format_number(p.dtr_max) << " mm\n"
-            << "transition forces: Ms " << format_number(c.transitions.Ms.force) << " N, Mf "
-            << format_number(c.transitions.Mf.force) << " N, As " << format_number(c.transitions.As.force)
-            << " N, Af " << format_number(c.transitions.Af.force) << " N\n"
-            << "temperatures (C = " << format_number(p.C) << " N/degC, T = " << format_number(p.T) << " degC): Mf0 "
-            << format_number(p.Mf0) << ", Ms0 " << format_number(p.Ms0) << ", As0 " << format_number(p.As0)
-            << ", Af0 " << format_number(p.Af0) << "\n"
-            << "residual: rms " << format_number(c.rms_residual) << " N, max " << format_number(c.max_residual)
-            << " N after " << c.iterations << " iterations\n"
+  std::cout << "KA " << format_number(p.KA) << " N/mm, KM " << format_number(p.KM) << " N/mm, dtr_max " << format_number(p.dtr_max) << " mm\n"
+            << "transition forces: Ms " << format_number(c.transitions.Ms.force) << " N, Mf " << format_number(c.transitions.Mf.force) << " N, As "
+            << format_number(c.transitions.As.force) << " N, Af " << format_number(c.transitions.Af.force) << " N\n"
+            << "temperatures (C = " << format_number(p.C) << " N/degC, T = " << format_number(p.T) << " degC): Mf0 " << format_number(p.Mf0) << ", Ms0 "
+            << format_number(p.Ms0) << ", As0 " << format_number(p.As0) << ", Af0 " << format_number(p.Af0) << "\n"
+            << "residual: rms " << format_number(c.rms_residual) << " N, max " << format_number(c.max_residual) << " N after " << c.iterations
+            << " iterations\n"
             << "wrote " << out << "\n";
   return 0;
 }

@@ -40,15 +40,14 @@ std::string text_report(const std::vector<models::LoopFigures>& loops) {
   for (std::size_t k = 0; k < loops.size(); ++k) {
     const models::LoopFigures& L = loops[k];
     char line[256];
-    std::snprintf(line, sizeof line, "%3zu   %7zu..%-8zu %8.4g %8.4g %8.4g %11.5g %11.5g %8.4f %9.4g %12.4g\n", k + 1, L.begin, L.end, L.min_mm,
-                  L.max_mm, L.peak_force_N, L.energy_Nmm, L.secant_stiffness_N_mm, L.damping_ratio, L.return_N, L.residual_mm);
+    std::snprintf(line, sizeof line, "%3zu   %7zu..%-8zu %8.4g %8.4g %8.4g %11.5g %11.5g %8.4f %9.4g %12.4g\n", k + 1, L.begin, L.end, L.min_mm, L.max_mm,
+                  L.peak_force_N, L.energy_Nmm, L.secant_stiffness_N_mm, L.damping_ratio, L.return_N, L.residual_mm);
     s += line;
     for (const models::PlateauForce& p : L.plateaus)
       s += "        plateau at " + fmt(p.at_mm) + " mm: loading " + fmt(p.loading_N) + " N, unloading " + fmt(p.unloading_N) + " N\n";
     if (const auto& t = L.transformation)
-      s += "        Ms (" + fmt(t->Ms.displacement) + " mm, " + fmt(t->Ms.force) + " N)  Mf (" + fmt(t->Mf.displacement) + ", " +
-           fmt(t->Mf.force) + ")  As (" + fmt(t->As.displacement) + ", " + fmt(t->As.force) + ")  Af (" + fmt(t->Af.displacement) +
-           ", " + fmt(t->Af.force) + ")\n";
+      s += "        Ms (" + fmt(t->Ms.displacement) + " mm, " + fmt(t->Ms.force) + " N)  Mf (" + fmt(t->Mf.displacement) + ", " + fmt(t->Mf.force) + ")  As (" +
+           fmt(t->As.displacement) + ", " + fmt(t->As.force) + ")  Af (" + fmt(t->Af.displacement) + ", " + fmt(t->Af.force) + ")\n";
   }
   return s;
 }

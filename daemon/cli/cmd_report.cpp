@@ -32,7 +32,8 @@ from the stored data. -o NAME.pdf prints it to PDF with Chromium ($CHROMIUM, def
 void print_pdf(const std::string& html, const std::string& pdf) {
   const char* env = std::getenv("CHROMIUM");
   const std::string chromium = env && *env ? env : "/usr/bin/chromium";
-  if (!std::filesystem::exists(chromium)) throw CliError("-o " + pdf + ": a PDF is printed by Chromium, and there is none at " + chromium + " (apt install chromium, or set $CHROMIUM)");
+  if (!std::filesystem::exists(chromium))
+    throw CliError("-o " + pdf + ": a PDF is printed by Chromium, and there is none at " + chromium + " (apt install chromium, or set $CHROMIUM)");
   const std::string out = "--print-to-pdf=" + pdf, url = "file://" + std::filesystem::absolute(html).string();
   const pid_t pid = fork();
   if (pid == 0) {

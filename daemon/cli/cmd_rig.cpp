@@ -36,8 +36,8 @@ int run_rig_cmd(const Args& args) {
   const Options opt(Args(args.begin() + 2, args.end()), {"daemon", "token"}, {});
   const auto a = post_to_daemon(daemon_address(opt), "/api/rigs/" + url_segment(name) + "/" + verb, "");
   // done: latched and seen by the rig (or reset); pending: taken, not yet confirmed; refusals exit 2 above.
-  std::cout << verb << " " << (a.value("result", "") == "done" ? "done" : "sent") << ": rig '" << a.value("rig", name) << "' is " << a.value("state", "") << " ("
-            << a.value("reason", "") << ")\n";
+  std::cout << verb << " " << (a.value("result", "") == "done" ? "done" : "sent") << ": rig '" << a.value("rig", name) << "' is " << a.value("state", "")
+            << " (" << a.value("reason", "") << ")\n";
   return 0;
 }
 

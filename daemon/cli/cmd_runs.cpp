@@ -33,8 +33,7 @@ A failed export leaves no file behind.
 std::int64_t whole_number(const std::string& text, const std::string& what) {
   std::int64_t v = 0;
   const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (r.ec != std::errc() || r.ptr != text.data() + text.size() || v <= 0)
-    throw CliError(what + " must be a positive whole number, got '" + text + "'");
+  if (r.ec != std::errc() || r.ptr != text.data() + text.size() || v <= 0) throw CliError(what + " must be a positive whole number, got '" + text + "'");
   return v;
 }
 
@@ -80,8 +79,7 @@ void export_csv(db::Store& store, std::int64_t id, const std::string& path) {
 
 // HDF5 beside the target, then renamed: the export removes its own file when it fails.
 void export_h5(db::Store& store, std::int64_t id, bool campaign, const std::string& path) {
-  if (path.empty() || path == "-")
-    throw CliError("-o: HDF5 is a binary file: give its name (-o run.h5); it is not written to stdout");
+  if (path.empty() || path == "-") throw CliError("-o: HDF5 is a binary file: give its name (-o run.h5); it is not written to stdout");
   const std::string tmp = path + ".tmp";
   try {
     const db::H5ExportStats s = campaign ? db::export_campaign_h5(store, id, tmp) : db::export_run_h5(store, id, tmp);
@@ -113,8 +111,10 @@ int run_runs_cmd(const Args& args) {
   const std::int64_t id = positional ? whole_number(args[1], "RUN_ID") : whole_number(opt.get("campaign"), "--campaign");
   db::Store store = open_store(opt);
   if (positional && !store.run(id)) throw CliError("no samples for run " + std::to_string(id) + ": there is no run " + std::to_string(id));
-  if (format == "csv") export_csv(store, id, opt.get("output"));
-  else export_h5(store, id, !positional, opt.get("output"));
+  if (format == "csv")
+    export_csv(store, id, opt.get("output"));
+  else
+    export_h5(store, id, !positional, opt.get("output"));
   return 0;
 }
 

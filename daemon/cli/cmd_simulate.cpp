@@ -4,8 +4,8 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
-#include "hystlab/models/formats.hpp"
 #include <sstream>
+#include "hystlab/models/formats.hpp"
 
 #include "cli_support.hpp"
 #include "commands.hpp"
@@ -98,8 +98,8 @@ std::vector<double> sweep_frequencies(const Options& opt) {
 }
 
 // Up then down over the list, carrying the state: jumps show up as a difference.
-std::pair<std::vector<models::SteadyResponse>, std::vector<models::SteadyResponse>> sweep(models::SdofSystem sys, double y,
-                                                                                          const std::vector<double>& f, int settle, int measured) {
+std::pair<std::vector<models::SteadyResponse>, std::vector<models::SteadyResponse>> sweep(models::SdofSystem sys, double y, const std::vector<double>& f,
+                                                                                          int settle, int measured) {
   std::vector<models::SteadyResponse> up, down(f.size());
   try {
     for (double fr : f) up.push_back(models::steady_response(sys, y, fr, settle, measured));
@@ -139,8 +139,8 @@ int run_sweep(const Options& opt, const Springs& protos, const models::SdofOptio
       for (const auto& r : lup) cols.back().push_back(r.ratio);
       plot.push_back({"linear, ζ = " + format_number(zetas[z]), colours[z % 6], f, cols.back()});
     }
-    std::cerr << "hystlab: linear comparison: k = " << format_number(k_eq) << " N/mm per spring, f_n = "
-              << format_number(wn / (2 * 3.141592653589793)) << " Hz\n";
+    std::cerr << "hystlab: linear comparison: k = " << format_number(k_eq) << " N/mm per spring, f_n = " << format_number(wn / (2 * 3.141592653589793))
+              << " Hz\n";
   } else {
     std::cerr << "hystlab: no linear comparison without --preload-mm > 0 (no static deflection to match)\n";
   }
@@ -157,8 +157,9 @@ int run_simulate(const Args& args) {
     return args.empty() ? 2 : 0;
   }
   const Options opt(Args(args.begin() + 1, args.end()),
-                    {"mass", "springs", "table", "tables", "model", "params", "linear", "damping", "preload-mm", "dt", "amplitude-mm", "frequency-hz",
-                     "duration-s", "every", "frequencies", "from-hz", "to-hz", "steps", "settle-cycles", "measured-cycles", "zetas", "svg", "output"},
+                    {"mass",       "springs", "table",         "tables",          "model",      "params", "linear",      "damping",
+                     "preload-mm", "dt",      "amplitude-mm",  "frequency-hz",    "duration-s", "every",  "frequencies", "from-hz",
+                     "to-hz",      "steps",   "settle-cycles", "measured-cycles", "zetas",      "svg",    "output"},
                     {"sweep", "log"});
   models::SdofOptions o;
   if (!opt.has("mass")) throw CliError("--mass KG is required");
@@ -197,11 +198,13 @@ int run_simulate(const Args& args) {
     if (k % every) continue;
     const auto& s = sys.state();
     const auto& e = sys.energy();
-    for (auto [c, v] : {std::pair{0, s.t}, {1, s.y}, {2, s.x}, {3, s.delta}, {4, s.force}, {5, e.input}, {6, e.spring}, {7, e.damper}, {8, e.kinetic}, {9, e.gravity}})
+    for (auto [c, v] :
+         {std::pair{0, s.t}, {1, s.y}, {2, s.x}, {3, s.delta}, {4, s.force}, {5, e.input}, {6, e.spring}, {7, e.damper}, {8, e.kinetic}, {9, e.gravity}})
       cols[static_cast<std::size_t>(c)].push_back(v);
   }
-  write_output(opt.get("output"), to_csv({"t_s", "base_mm", "mass_mm", "compression_mm", "force_N", "input_work_Nmm", "spring_work_Nmm",
-                                          "damper_work_Nmm", "kinetic_Nmm", "gravity_Nmm"}, cols));
+  write_output(opt.get("output"), to_csv({"t_s", "base_mm", "mass_mm", "compression_mm", "force_N", "input_work_Nmm", "spring_work_Nmm", "damper_work_Nmm",
+                                          "kinetic_Nmm", "gravity_Nmm"},
+                                         cols));
   if (sys.lift_off_steps()) std::cerr << "hystlab: the mass left the springs during " << sys.lift_off_steps() << " steps\n";
   return 0;
 }

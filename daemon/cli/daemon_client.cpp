@@ -34,11 +34,15 @@ constexpr int kAnswerSeconds = 30;  // a submit waits for the daemon's main loop
 // httplib's names for a failed request ("Connection", "Read"), in the words of a lab user.
 std::string failure_words(httplib::Error e) {
   switch (e) {
-    case httplib::Error::Connection: return "nothing accepts a connection there";
-    case httplib::Error::ConnectionTimeout: return "no connection within " + std::to_string(kConnectSeconds) + " s";
+    case httplib::Error::Connection:
+      return "nothing accepts a connection there";
+    case httplib::Error::ConnectionTimeout:
+      return "no connection within " + std::to_string(kConnectSeconds) + " s";
     case httplib::Error::SSLConnection:
-    case httplib::Error::SSLServerVerification: return "no TLS connection (" + httplib::to_string(e) + ")";
-    default: return httplib::to_string(e);
+    case httplib::Error::SSLServerVerification:
+      return "no TLS connection (" + httplib::to_string(e) + ")";
+    default:
+      return httplib::to_string(e);
   }
 }
 
@@ -72,8 +76,7 @@ void check_answer(const DaemonAddress& to, const httplib::Result& r) {
   if (!r)
     throw CliError("no hystlabd answers at " + to.url + " (" + failure_words(r.error()) +
                    "): start it, or give its address with --daemon URL or $HYSTLAB_DAEMON");
-  if (r->status == 401)
-    throw CliError("hystlabd at " + to.url + " needs its token (" + api_reason(*r) + "): give it with --token or $HYSTLAB_TOKEN");
+  if (r->status == 401) throw CliError("hystlabd at " + to.url + " needs its token (" + api_reason(*r) + "): give it with --token or $HYSTLAB_TOKEN");
   if (r->status < 200 || r->status >= 300) throw CliError(api_reason(*r));
 }
 }  // namespace
@@ -84,7 +87,8 @@ nlohmann::json post_to_daemon(const DaemonAddress& to, const std::string& path, 
   const httplib::Headers headers = token_headers(to);
   const auto r = body.empty() ? client.Post(path.c_str(), headers) : client.Post(path.c_str(), headers, body, "application/json");
   if (!r && r.error() == httplib::Error::Read)  // it may have acted: a blind retry could queue a campaign twice
-    throw CliError("hystlabd at " + to.url + " did not answer within " + std::to_string(kAnswerSeconds) + " s; it may still carry the request out: check with 'hystlab campaign list' before sending it again");
+    throw CliError("hystlabd at " + to.url + " did not answer within " + std::to_string(kAnswerSeconds) +
+                   " s; it may still carry the request out: check with 'hystlab campaign list' before sending it again");
   if (!r && r.error() == httplib::Error::Write)
     throw CliError("hystlabd at " + to.url + " closed the connection while the request was sent (a plan larger than its http.max_body_bytes?)");
   check_answer(to, r);

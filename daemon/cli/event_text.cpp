@@ -15,8 +15,10 @@ using nlohmann::json;
 std::string g(double v) {
   char b[32];
   if (v == 0) return "0";  // never "-0"
-  if (v == std::floor(v) && std::fabs(v) < 1e15) std::snprintf(b, sizeof b, "%.0f", v);
-  else std::snprintf(b, sizeof b, "%.4g", v);
+  if (v == std::floor(v) && std::fabs(v) < 1e15)
+    std::snprintf(b, sizeof b, "%.0f", v);
+  else
+    std::snprintf(b, sizeof b, "%.4g", v);
   return b;
 }
 
@@ -37,9 +39,7 @@ std::string text(const json& d, const char* key) {
 }
 
 // "1 sample", "3 samples"
-std::string count(double n, const std::string& one, const std::string& many = "") {
-  return g(n) + " " + (n == 1 ? one : many.empty() ? one + "s" : many);
-}
+std::string count(double n, const std::string& one, const std::string& many = "") { return g(n) + " " + (n == 1 ? one : many.empty() ? one + "s" : many); }
 
 std::string range(const json& d, const char* key, const char* unit) {
   const auto it = d.find(key);
@@ -56,8 +56,8 @@ std::string signed_pct(const json& d, const char* key) {
 
 std::string limits(const json& d) {
   return "displacement " + range(d, "displacement_mm", "mm") + ", force up to " + num(d, "force_N") + " N, rate up to " + num(d, "rate_mm_s") +
-         " mm/s; safe position " + num(d, "safe_position_mm") + " mm at " + num(d, "safe_rate_mm_s") + " mm/s; in position within " +
-         num(d, "in_position_mm") + " mm";
+         " mm/s; safe position " + num(d, "safe_position_mm") + " mm at " + num(d, "safe_rate_mm_s") + " mm/s; in position within " + num(d, "in_position_mm") +
+         " mm";
 }
 
 std::string envelope(const json& d) {
@@ -70,8 +70,8 @@ std::string envelope(const json& d) {
 
 std::string fit(const json& d) {
   const json overall = d.contains("accuracy") ? d["accuracy"].value("overall", json::object()) : json::object();
-  return "partial table (" + num(d, "nodes") + " of " + num(d, "required") + " nodes): RMS " + num(overall, "rms_N") + " N, max " +
-         num(overall, "max_N") + " N on the run so far";
+  return "partial table (" + num(d, "nodes") + " of " + num(d, "required") + " nodes): RMS " + num(overall, "rms_N") + " N, max " + num(overall, "max_N") +
+         " N on the run so far";
 }
 
 std::string quality(const json& d) {
@@ -79,28 +79,26 @@ std::string quality(const json& d) {
                   num(d, "rate_hz") + " Hz; " + num(d, "expected_rate_hz") + " Hz expected)";
   std::string issues;
   const auto add = [&issues](const std::string& what) { issues += (issues.empty() ? "" : ", ") + what; };
-  if (value(d, "gaps") == 1) add("1 gap of " + g(1e3 * value(d, "gap_total_s")) + " ms");
+  if (value(d, "gaps") == 1)
+    add("1 gap of " + g(1e3 * value(d, "gap_total_s")) + " ms");
   else if (value(d, "gaps") > 1)
     add(count(value(d, "gaps"), "gap") + " (" + g(1e3 * value(d, "gap_total_s")) + " ms in all, the longest " + g(1e3 * value(d, "longest_gap_s")) + " ms)");
   struct Counted {
     const char *key, *one, *many;
   };
-  static const Counted counted[] = {{"lost_samples", "sample lost", "samples lost"},
-                                    {"missed_deadlines", "missed deadline", "missed deadlines"},
-                                    {"late_wakeups", "late wake-up", "late wake-ups"},
-                                    {"dropped", "sample dropped by the writer", "samples dropped by the writer"},
-                                    {"io_errors", "I/O error", "I/O errors"},
-                                    {"timeouts", "timeout", "timeouts"},
-                                    {"reconnects", "reconnection", "reconnections"}};
+  static const Counted counted[] = {
+      {"lost_samples", "sample lost", "samples lost"},   {"missed_deadlines", "missed deadline", "missed deadlines"},
+      {"late_wakeups", "late wake-up", "late wake-ups"}, {"dropped", "sample dropped by the writer", "samples dropped by the writer"},
+      {"io_errors", "I/O error", "I/O errors"},          {"timeouts", "timeout", "timeouts"},
+      {"reconnects", "reconnection", "reconnections"}};
   for (const Counted& c : counted)
     if (value(d, c.key) > 0) add(count(value(d, c.key), c.one, c.many));
   return s + (issues.empty() ? ", nothing lost" : ": " + issues);
 }
 
 std::string shakedown(const json& d) {
-  return "cycle " + num(d, "cycle") + ": peak force " + num(d, "peak_force_N") + " N" + signed_pct(d, "peak_change_pct") + ", energy " +
-         num(d, "energy_Nmm") + " N·mm" + signed_pct(d, "energy_change_pct") + ", damping ratio " + num(d, "damping_ratio") +
-         (d.value("stable", false) ? ", stable" : "");
+  return "cycle " + num(d, "cycle") + ": peak force " + num(d, "peak_force_N") + " N" + signed_pct(d, "peak_change_pct") + ", energy " + num(d, "energy_Nmm") +
+         " N·mm" + signed_pct(d, "energy_change_pct") + ", damping ratio " + num(d, "damping_ratio") + (d.value("stable", false) ? ", stable" : "");
 }
 
 std::string retake(const json& d) {
@@ -111,15 +109,13 @@ std::string retake(const json& d) {
 }
 
 std::string sine_step(const json& d) {
-  return "step " + num(d, "k") + " of " + num(d, "of") + " (pass " + num(d, "pass") + " of " + num(d, "passes") + "): " + num(d, "frequency_hz") +
-         " Hz, " + num(d, "amplitude_mm") + " mm " + text(d, "direction") + ", drive " + num(d, "drive_mm") + " mm; about " + num(d, "eta_s") +
-         " s left";
+  return "step " + num(d, "k") + " of " + num(d, "of") + " (pass " + num(d, "pass") + " of " + num(d, "passes") + "): " + num(d, "frequency_hz") + " Hz, " +
+         num(d, "amplitude_mm") + " mm " + text(d, "direction") + ", drive " + num(d, "drive_mm") + " mm; about " + num(d, "eta_s") + " s left";
 }
 
 std::string transmissibility(const json& d) {
-  return "point " + num(d, "k") + " of " + num(d, "of") + ": " + num(d, "frequency_hz") + " Hz, " + num(d, "amplitude_mm") + " mm " +
-         text(d, "direction") + ": ratio " + num(d, "ratio") + ", phase " + num(d, "phase_rad") + " rad, control error " +
-         num(d, "control_error_pct") + " %";
+  return "point " + num(d, "k") + " of " + num(d, "of") + ": " + num(d, "frequency_hz") + " Hz, " + num(d, "amplitude_mm") + " mm " + text(d, "direction") +
+         ": ratio " + num(d, "ratio") + ", phase " + num(d, "phase_rad") + " rad, control error " + num(d, "control_error_pct") + " %";
 }
 
 std::string sweep_done(const json& d) {
@@ -132,8 +128,8 @@ std::string sweep_done(const json& d) {
 std::string control(const json& d, const std::string& kind) {
   const std::string at = "at " + num(d, "frequency_hz") + " Hz: ";
   if (kind == "control_unreached")
-    return at + "the demand " + num(d, "demand_mm") + " mm not reached in " + count(value(d, "windows"), "window") + " (error " +
-           num(d, "error_pct") + " %, drive " + num(d, "drive_mm") + " mm" + (d.value("limited", false) ? ", at its limit" : "") + ")" +
+    return at + "the demand " + num(d, "demand_mm") + " mm not reached in " + count(value(d, "windows"), "window") + " (error " + num(d, "error_pct") +
+           " %, drive " + num(d, "drive_mm") + " mm" + (d.value("limited", false) ? ", at its limit" : "") + ")" +
            (d.contains("while") ? "; measured anyway" : "");
   const std::string base = at + "base " + num(d, "base_mm") + " mm for a demand of " + num(d, "demand_mm") + " mm (error " + num(d, "error_pct") + " %";
   if (kind == "control_abort") return base + "): stopped, drive " + num(d, "drive_mm") + " mm";
@@ -157,21 +153,35 @@ const std::map<std::string, Sentence>& sentences() {
       {"envelope", envelope},
       {"fit", fit},
       {"quality", quality},
-      {"validation", [](const json& d) { return "run " + num(d, "run") + ": " + num(d, "reversals") + " reversals from seed " + num(d, "seed") + " (" + text(d, "why") + ")"; }},
+      {"validation",
+       [](const json& d) {
+         return "run " + num(d, "run") + ": " + num(d, "reversals") + " reversals from seed " + num(d, "seed") + " (" + text(d, "why") + ")";
+       }},
       {"recommendation", [](const json& d) { return "table " + num(d, "table") + " (" + text(d, "method") + ", n = " + num(d, "n") + "): " + text(d, "why"); }},
-      {"training", [](const json& d) { return count(value(d, "cycles"), "cycle") + (d.value("stable", false) ? ", stable: " : ", not stable: ") + text(d, "why"); }},
+      {"training",
+       [](const json& d) { return count(value(d, "cycles"), "cycle") + (d.value("stable", false) ? ", stable: " : ", not stable: ") + text(d, "why"); }},
       {"shakedown", shakedown},
       {"retake", retake},
-      {"gap", [](const json& d) { return "no samples from " + num(d, "from_s") + " s to " + num(d, "to_s") + " s of rig time (" + num(d, "length_ms") + " ms)"; }},
-      {"gaps", [](const json& d) { return count(value(d, "count"), "gap") + " in the data, " + num(d, "total_ms") + " ms in all, the longest " + num(d, "longest_ms") + " ms"; }},
-      {"safe", [](const json& d) { return "at the safe position: " + num(d, "position_mm") + " mm (target " + num(d, "target_mm") + " mm) after " + num(d, "seconds") + " s"; }},
+      {"gap",
+       [](const json& d) { return "no samples from " + num(d, "from_s") + " s to " + num(d, "to_s") + " s of rig time (" + num(d, "length_ms") + " ms)"; }},
+      {"gaps",
+       [](const json& d) {
+         return count(value(d, "count"), "gap") + " in the data, " + num(d, "total_ms") + " ms in all, the longest " + num(d, "longest_ms") + " ms";
+       }},
+      {"safe",
+       [](const json& d) {
+         return "at the safe position: " + num(d, "position_mm") + " mm (target " + num(d, "target_mm") + " mm) after " + num(d, "seconds") + " s";
+       }},
       {"sine_step", sine_step},
       {"transmissibility", transmissibility},
       {"sweep_done", sweep_done},
       {"control_abort", [](const json& d) { return control(d, "control_abort"); }},
       {"control_warning", [](const json& d) { return control(d, "control_warning"); }},
       {"control_unreached", [](const json& d) { return control(d, "control_unreached"); }},
-      {"unsettled", [](const json& d) { return "at " + num(d, "frequency_hz") + " Hz: not settled after " + num(d, "cycles") + " cycles (still changing " + num(d, "change_pct") + " %)"; }},
+      {"unsettled",
+       [](const json& d) {
+         return "at " + num(d, "frequency_hz") + " Hz: not settled after " + num(d, "cycles") + " cycles (still changing " + num(d, "change_pct") + " %)";
+       }},
   };
   return m;
 }
@@ -182,8 +192,10 @@ void flatten(const json& v, const std::string& key, std::string& out) {
     return;
   }
   std::string s;
-  if (v.is_string()) s = v.get<std::string>();
-  else if (v.is_number()) s = g(v.get<double>());
+  if (v.is_string())
+    s = v.get<std::string>();
+  else if (v.is_number())
+    s = g(v.get<double>());
   else if (v.is_array()) {
     std::size_t k = 0;
     for (const json& x : v) {

@@ -18,10 +18,14 @@ std::string num(double v) {
 std::string escape(const std::string& s) {
   std::string o;
   for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else o += c;
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else
+      o += c;
   }
   return o;
 }
@@ -41,8 +45,7 @@ double tick_step(double span) {
 }
 }  // namespace
 
-std::string svg_plot(const std::string& title, const std::string& x_label, const std::string& y_label,
-                     const std::vector<PlotSeries>& series) {
+std::string svg_plot(const std::string& title, const std::string& x_label, const std::string& y_label, const std::vector<PlotSeries>& series) {
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
   for (const auto& s : series)
     for (std::size_t k = 0; k < s.x.size(); ++k) {
@@ -65,29 +68,23 @@ std::string svg_plot(const std::string& title, const std::string& x_label, const
                   "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   o += "<text x=\"" + num(kW / 2) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" + escape(title) + "</text>\n";
   for (double t = x0; t <= x1 + xs * 1e-6; t += xs) {
-    o += "<line x1=\"" + num(px(t)) + "\" y1=\"" + num(kTop) + "\" x2=\"" + num(px(t)) + "\" y2=\"" + num(kTop + ph) +
-         "\" stroke=\"#e5e5e5\"/>\n<text x=\"" + num(px(t)) + "\" y=\"" + num(kTop + ph + 16) +
-         "\" text-anchor=\"middle\">" + tick_label(t, xs) + "</text>\n";
+    o += "<line x1=\"" + num(px(t)) + "\" y1=\"" + num(kTop) + "\" x2=\"" + num(px(t)) + "\" y2=\"" + num(kTop + ph) + "\" stroke=\"#e5e5e5\"/>\n<text x=\"" +
+         num(px(t)) + "\" y=\"" + num(kTop + ph + 16) + "\" text-anchor=\"middle\">" + tick_label(t, xs) + "</text>\n";
   }
   for (double t = y0; t <= y1 + ys * 1e-6; t += ys) {
-    o += "<line x1=\"" + num(kLeft) + "\" y1=\"" + num(py(t)) + "\" x2=\"" + num(kLeft + pw) + "\" y2=\"" + num(py(t)) +
-         "\" stroke=\"#e5e5e5\"/>\n<text x=\"" + num(kLeft - 6) + "\" y=\"" + num(py(t) + 4) +
-         "\" text-anchor=\"end\">" + tick_label(t, ys) + "</text>\n";
+    o += "<line x1=\"" + num(kLeft) + "\" y1=\"" + num(py(t)) + "\" x2=\"" + num(kLeft + pw) + "\" y2=\"" + num(py(t)) + "\" stroke=\"#e5e5e5\"/>\n<text x=\"" +
+         num(kLeft - 6) + "\" y=\"" + num(py(t) + 4) + "\" text-anchor=\"end\">" + tick_label(t, ys) + "</text>\n";
   }
-  o += "<rect x=\"" + num(kLeft) + "\" y=\"" + num(kTop) + "\" width=\"" + num(pw) + "\" height=\"" + num(ph) +
-       "\" fill=\"none\" stroke=\"#333\"/>\n";
+  o += "<rect x=\"" + num(kLeft) + "\" y=\"" + num(kTop) + "\" width=\"" + num(pw) + "\" height=\"" + num(ph) + "\" fill=\"none\" stroke=\"#333\"/>\n";
   o += "<text x=\"" + num(kLeft + pw / 2) + "\" y=\"" + num(kH - 12) + "\" text-anchor=\"middle\">" + escape(x_label) +
-       "</text>\n<text transform=\"translate(18," + num(kTop + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
-       escape(y_label) + "</text>\n";
+       "</text>\n<text transform=\"translate(18," + num(kTop + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" + escape(y_label) + "</text>\n";
   for (std::size_t s = 0; s < series.size(); ++s) {
     const PlotSeries& ser = series[s];
     if (ser.markers) {
       for (std::size_t k = 0; k < ser.x.size(); ++k)
-        o += "<circle cx=\"" + num(px(ser.x[k])) + "\" cy=\"" + num(py(ser.y[k])) + "\" r=\"2.5\" fill=\"" + ser.color +
-             "\"/>\n";
+        o += "<circle cx=\"" + num(px(ser.x[k])) + "\" cy=\"" + num(py(ser.y[k])) + "\" r=\"2.5\" fill=\"" + ser.color + "\"/>\n";
     } else {
-      o += "<polyline fill=\"none\" stroke=\"" + ser.color + "\" stroke-width=\"1.5\"" +
-           (ser.dashed ? " stroke-dasharray=\"6 4\"" : "") + " points=\"";
+      o += "<polyline fill=\"none\" stroke=\"" + ser.color + "\" stroke-width=\"1.5\"" + (ser.dashed ? " stroke-dasharray=\"6 4\"" : "") + " points=\"";
       for (std::size_t k = 0; k < ser.x.size(); ++k) o += num(px(ser.x[k])) + "," + num(py(ser.y[k])) + " ";
       o += "\"/>\n";
     }
@@ -95,11 +92,9 @@ std::string svg_plot(const std::string& title, const std::string& x_label, const
     if (ser.markers)
       o += "<circle cx=\"" + num(kLeft + 22) + "\" cy=\"" + num(ly - 4) + "\" r=\"3\" fill=\"" + ser.color + "\"/>\n";
     else
-      o += "<line x1=\"" + num(kLeft + 10) + "\" y1=\"" + num(ly - 4) + "\" x2=\"" + num(kLeft + 34) + "\" y2=\"" +
-           num(ly - 4) + "\" stroke=\"" + ser.color + "\" stroke-width=\"2\"" +
-           (ser.dashed ? " stroke-dasharray=\"6 4\"" : "") + "/>\n";
-    o += "<text x=\"" + num(kLeft + 40) + "\" y=\"" + num(ly) +
-         "\">" + escape(ser.name) + "</text>\n";
+      o += "<line x1=\"" + num(kLeft + 10) + "\" y1=\"" + num(ly - 4) + "\" x2=\"" + num(kLeft + 34) + "\" y2=\"" + num(ly - 4) + "\" stroke=\"" + ser.color +
+           "\" stroke-width=\"2\"" + (ser.dashed ? " stroke-dasharray=\"6 4\"" : "") + "/>\n";
+    o += "<text x=\"" + num(kLeft + 40) + "\" y=\"" + num(ly) + "\">" + escape(ser.name) + "</text>\n";
   }
   return o + "</svg>\n";
 }

@@ -13,7 +13,6 @@ struct PlotSeries {
   bool markers = false;  // points instead of a line
 };
 
-[[nodiscard]] std::string svg_plot(const std::string& title, const std::string& x_label, const std::string& y_label,
-                                   const std::vector<PlotSeries>& series);
+[[nodiscard]] std::string svg_plot(const std::string& title, const std::string& x_label, const std::string& y_label, const std::vector<PlotSeries>& series);
 
 }  // namespace hystlab::cli

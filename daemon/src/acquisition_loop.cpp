@@ -13,11 +13,16 @@ using nlohmann::json;
 
 db::CampaignState state_of(CampaignEnd e) noexcept {
   switch (e) {
-    case CampaignEnd::completed: return db::CampaignState::completed;
-    case CampaignEnd::failed: return db::CampaignState::failed;
-    case CampaignEnd::aborted: return db::CampaignState::aborted;
-    case CampaignEnd::interrupted: return db::CampaignState::interrupted;
-    case CampaignEnd::none: break;
+    case CampaignEnd::completed:
+      return db::CampaignState::completed;
+    case CampaignEnd::failed:
+      return db::CampaignState::failed;
+    case CampaignEnd::aborted:
+      return db::CampaignState::aborted;
+    case CampaignEnd::interrupted:
+      return db::CampaignState::interrupted;
+    case CampaignEnd::none:
+      break;
   }
   return db::CampaignState::running;
 }
@@ -27,26 +32,44 @@ const char* to_string(CampaignEnd e) noexcept { return db::to_string(state_of(e)
 const char* to_string(CampaignPhase p) noexcept {
   using P = CampaignPhase;
   switch (p) {
-    case P::none: return "none";
-    case P::arming: return "arming";
-    case P::preamble: return "preamble";
-    case P::training: return "training";
-    case P::ramping: return "ramping";
-    case P::dwelling: return "dwelling";
-    case P::retake: return "retake";
-    case P::validation: return "validation";
-    case P::paused: return "paused";
-    case P::held: return "held";
-    case P::safing: return "safing";
-    case P::shaker_control: return "shaker_control";
-    case P::shaker_measure: return "shaker_measure";
+    case P::none:
+      return "none";
+    case P::arming:
+      return "arming";
+    case P::preamble:
+      return "preamble";
+    case P::training:
+      return "training";
+    case P::ramping:
+      return "ramping";
+    case P::dwelling:
+      return "dwelling";
+    case P::retake:
+      return "retake";
+    case P::validation:
+      return "validation";
+    case P::paused:
+      return "paused";
+    case P::held:
+      return "held";
+    case P::safing:
+      return "safing";
+    case P::shaker_control:
+      return "shaker_control";
+    case P::shaker_measure:
+      return "shaker_measure";
   }
   return "?";
 }
 
 Loop::Loop(const CampaignJob& j, RunnerContext& c)
-    : job(j), plan(j.plan), ctx(c), shaker(j.plan.kind == db::CampaignKind::sine), safety(j.plan.limits),
-      watchdog(c.watchdog_hold_periods, c.watchdog_fail_periods), health0(c.rig.health()) {}
+    : job(j),
+      plan(j.plan),
+      ctx(c),
+      shaker(j.plan.kind == db::CampaignKind::sine),
+      safety(j.plan.limits),
+      watchdog(c.watchdog_hold_periods, c.watchdog_fail_periods),
+      health0(c.rig.health()) {}
 
 void Loop::state(db::CampaignState to, const std::string& reason) {
   const std::string now = ctx.now_iso();
@@ -137,8 +160,8 @@ bool Loop::command_failed(double t, std::error_code ec, const char* what) {
     return true;
   }
   ctx.supervisor.hold(t, std::string(what) + " refused: held");
-  end(CampaignEnd::failed, std::string(what) + " refused: " + ec.message() +
-                               (lost ? " (" + std::to_string(lost_commands) + " times in a row)" : std::string()));
+  end(CampaignEnd::failed,
+      std::string(what) + " refused: " + ec.message() + (lost ? " (" + std::to_string(lost_commands) + " times in a row)" : std::string()));
   return false;
 }
 
@@ -153,8 +176,7 @@ bool arm(Loop& L) {
   double next = c.clock.now();
   // A rig that does not answer for 2 s plus the arming timeout is not armed (on a time-scaled rig
   // at least the host-stall allowance of wall time: 3 s of rig time is 15 ms at scale 200).
-  const double give_up = L.rig_time() + std::max(2.0 + c.supervisor.settings().arm_timeout_s,
-                                                 c.time_scale > 1 ? kHostStallAllowance_s * c.time_scale : 0.0);
+  const double give_up = L.rig_time() + std::max(2.0 + c.supervisor.settings().arm_timeout_s, c.time_scale > 1 ? kHostStallAllowance_s * c.time_scale : 0.0);
   bool begun = false;
   (void)c.rig.connect(L.rig_time());
   for (;;) {
@@ -170,8 +192,10 @@ bool arm(Loop& L) {
     const auto ctl = c.next_control();
     if (ctl && (*ctl == Control::pause || *ctl == Control::resume)) L.pause_pending = *ctl == Control::pause;  // applied once armed
     if (ctl && (*ctl == Control::abort || *ctl == Control::estop)) {
-      if (*ctl == Control::estop) c.supervisor.estop(t, "e-stop by the operator");
-      else c.supervisor.disarm(t, "aborted while arming");
+      if (*ctl == Control::estop)
+        c.supervisor.estop(t, "e-stop by the operator");
+      else
+        c.supervisor.disarm(t, "aborted while arming");
       return L.end(CampaignEnd::aborted, *ctl == Control::estop ? "e-stop by the operator" : "aborted by the operator while arming"), false;
     }
     StatusView v;
@@ -186,8 +210,8 @@ bool arm(Loop& L) {
       v = view_of(s);
     }
     if (ec == drivers::RigError::unsupported)
-      return L.end(CampaignEnd::failed, std::string("a ") + db::to_string(L.plan.kind) + " campaign needs a " + (L.shaker ? "shaker" : "load frame") +
-                                            "; this rig is not one"),
+      return L.end(CampaignEnd::failed,
+                   std::string("a ") + db::to_string(L.plan.kind) + " campaign needs a " + (L.shaker ? "shaker" : "load frame") + "; this rig is not one"),
              false;
     if (ec) {
       c.supervisor.on_link_error(t, ec);
@@ -220,8 +244,10 @@ void pause_now(Loop& L, Strategy& strategy, double t) {
 bool latched_end(Loop& L) {
   const Supervisor& sup = L.ctx.supervisor;
   if (!sup.latched()) return false;
-  if (L.result.end == CampaignEnd::none) L.end(CampaignEnd::aborted, sup.latch_reason());
-  else if (L.result.reason.find(sup.latch_reason()) == std::string::npos) L.result.reason += "; then " + sup.latch_reason();
+  if (L.result.end == CampaignEnd::none)
+    L.end(CampaignEnd::aborted, sup.latch_reason());
+  else if (L.result.reason.find(sup.latch_reason()) == std::string::npos)
+    L.result.reason += "; then " + sup.latch_reason();
   L.safing = false;
   return true;
 }
@@ -265,8 +291,7 @@ bool safing_step(Loop& L, double t, double x) {
   if (t > L.safe_deadline + (L.stalled - L.safe_stalled)) {
     L.ctx.supervisor.hold(t, "the safe position was not reached: held");
     char buf[160];
-    std::snprintf(buf, sizeof buf, "; the safe position %.3f mm was not reached in %.1f s: held at %.3f mm", l.safe_position_mm,
-                  t - L.safe_started, x);
+    std::snprintf(buf, sizeof buf, "; the safe position %.3f mm was not reached in %.1f s: held at %.3f mm", l.safe_position_mm, t - L.safe_started, x);
     L.result.reason += buf;
     return false;
   }
@@ -442,8 +467,7 @@ void hand_off(Loop& L, Strategy& strategy, bool drove = true) {
   strategy.fill_finish(L, fj);  // first: the last descent's bottom node is counted there
   if (fj.validation.x.empty() && !L.job.prior_validation.x.empty()) fj.validation = L.job.prior_validation;
   fj.result = L.result;
-  if (L.result.gaps > 0)
-    L.event("gaps", {{"count", L.result.gaps}, {"total_ms", L.result.gap_total_s * 1e3}, {"longest_ms", L.result.longest_gap_s * 1e3}});
+  if (L.result.gaps > 0) L.event("gaps", {{"count", L.result.gaps}, {"total_ms", L.result.gap_total_s * 1e3}, {"longest_ms", L.result.longest_gap_s * 1e3}});
   if (drove) record_quality(L);
   if (L.ctx.finish) {
     L.ctx.finish(std::move(fj));
@@ -461,8 +485,7 @@ bool create_run(Loop& L) {
   const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(), mono = L.wall0;
   const bool validation = L.plan.kind == db::CampaignKind::fot && L.plan.validation.enabled;
   const auto runs = L.ctx.writer.call<std::pair<std::int64_t, std::int64_t>>(
-      [id, now, wall, mono, validation](db::Store& s) { return s.add_runs(id, now, wall, mono, validation); },
-      L.ctx.db_timeout_s);
+      [id, now, wall, mono, validation](db::Store& s) { return s.add_runs(id, now, wall, mono, validation); }, L.ctx.db_timeout_s);
   if (!runs) return L.end(CampaignEnd::failed, "the database did not take the new run in time: the rig was not armed"), false;
   L.result.run_id = runs->first;
   L.result.validation_run_id = runs->second;
@@ -477,8 +500,11 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
   ctx.supervisor.set_time_scale(ctx.time_scale);
   ctx.supervisor.set_time_offset(std::isnan(ctx.epoch) ? 0.0 : (L.wall0 - ctx.epoch) * ctx.time_scale);
   const Limits& l = job.plan.limits;
-  L.event("limits", {{"displacement_mm", {l.displacement_min_mm, l.displacement_max_mm}}, {"force_N", l.force_max_N},
-                     {"rate_mm_s", l.rate_max_mm_s}, {"safe_position_mm", l.safe_position_mm}, {"safe_rate_mm_s", l.safe_rate_mm_s},
+  L.event("limits", {{"displacement_mm", {l.displacement_min_mm, l.displacement_max_mm}},
+                     {"force_N", l.force_max_N},
+                     {"rate_mm_s", l.rate_max_mm_s},
+                     {"safe_position_mm", l.safe_position_mm},
+                     {"safe_rate_mm_s", l.safe_rate_mm_s},
                      {"in_position_mm", ctx.supervisor.settings().in_position_mm}});
   if (!strategy->has_work()) {  // a resume with every node measured: finish without moving
     L.end(CampaignEnd::completed, "every node was measured by earlier runs: finished without driving the rig");
@@ -496,7 +522,8 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
   leave_rig(L);
   L.result.dropped = ctx.writer.stats().dropped_full - L.dropped_before;
   if (L.result.gaps > 0 && L.result.end == CampaignEnd::completed)
-    L.result.reason = std::to_string(L.result.gaps) + " gap(s) in the data, the longest " + std::to_string(static_cast<int>(L.result.longest_gap_s * 1e3)) + " ms";
+    L.result.reason =
+        std::to_string(L.result.gaps) + " gap(s) in the data, the longest " + std::to_string(static_cast<int>(L.result.longest_gap_s * 1e3)) + " ms";
   hand_off(L, *strategy);
   ctx.supervisor.set_time_offset(0.0);
   return L.result;

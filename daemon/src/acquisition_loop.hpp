@@ -55,7 +55,7 @@ struct Loop {
   double stalled = 0;
   static constexpr double kLoopStall_s = 0.02;  // of wall time: beyond any scheduling delay of a host that runs
   CampaignEnd safing_end = CampaignEnd::aborted;
-  double last_t = NAN, spacing = 0;  // the time axis: the last sample's time and the expected spacing
+  double last_t = NAN, spacing = 0;   // the time axis: the last sample's time and the expected spacing
   drivers::IoHealthSnapshot health0;  // the rig's I/O counters when the run began (the run's own are the difference)
   // The run the quality figures are gathered for, and the counters when it began: the campaign's
   // run and its validation run each get a record of their own (run_quality.cpp).
@@ -81,7 +81,7 @@ struct Loop {
   void begin_safing(double t, CampaignEnd e, const std::string& reason, double position_mm);
   void publish(double t, double a, double b, double c, std::uint16_t status);
   void publish(const drivers::ShakerSample& s);  // stored with the drive in force (drive_hz, drive_mm)
-  double drive_hz = 0, drive_mm = 0;              // the shaker's drive as last commanded
+  double drive_hz = 0, drive_mm = 0;             // the shaker's drive as last commanded
   // The shaker's drive; false (result set, rig held) when the rig refused it.
   bool command_drive(double t, double f_hz, double amplitude_mm);
   void check_gap(double t);

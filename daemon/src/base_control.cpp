@@ -7,10 +7,14 @@ namespace hystlab::daemon {
 
 const char* to_string(ControlBand b) noexcept {
   switch (b) {
-    case ControlBand::within: return "within tolerance";
-    case ControlBand::outside: return "outside tolerance";
-    case ControlBand::warning: return "warning";
-    case ControlBand::abort: return "abort";
+    case ControlBand::within:
+      return "within tolerance";
+    case ControlBand::outside:
+      return "outside tolerance";
+    case ControlBand::warning:
+      return "warning";
+    case ControlBand::abort:
+      return "abort";
   }
   return "?";
 }

@@ -13,10 +13,10 @@
 #include <thread>
 
 #include "finisher.hpp"
-#include "monotonic_clock.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/db/campaign_record.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
+#include "monotonic_clock.hpp"
 #include "rig_worker.hpp"
 
 namespace hystlab::daemon {
@@ -43,8 +43,8 @@ struct Daemon::Impl {
     std::lock_guard lk(finishing_mu);
     return finishing.count(id) > 0;
   }
-  double db_backoff_s = 0;            // a busy or failing database: retried, reported once per episode
-  bool redispatch = true;             // queued rows to hand over (start-up, a resume, a failed pass)
+  double db_backoff_s = 0;  // a busy or failing database: retried, reported once per episode
+  bool redispatch = true;   // queued rows to hand over (start-up, a resume, a failed pass)
 
   explicit Impl(const DaemonConfig& c) : config(c), store(c.db_path) {}
 
@@ -94,8 +94,12 @@ struct Daemon::Impl {
     const auto row = store.campaign(campaign);
     if (!row) return {R::conflict, false, false, "", "no campaign " + std::to_string(campaign), 0};
     if (being_finished(campaign))
-      return {R::conflict, false, false, "finishing",
-              "campaign " + std::to_string(campaign) + " no longer moves the rig: its tables are being built, '" + to_string(cmd) + "' does not apply", 0};
+      return {R::conflict,
+              false,
+              false,
+              "finishing",
+              "campaign " + std::to_string(campaign) + " no longer moves the rig: its tables are being built, '" + to_string(cmd) + "' does not apply",
+              0};
     using C = CampaignCommand;
     using S = db::CampaignState;
     RigWorker* w = worker_of(row->rig_id);
@@ -180,10 +184,9 @@ struct Daemon::Impl {
     }
     record_envelope(w, id);
     for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) job.prior_nodes.push_back({a, b, fa, fab});
-    if (job.plan.kind == db::CampaignKind::fot && !job.prior_nodes.empty()) {  // the fits after a resume use every run
+    if (job.plan.kind == db::CampaignKind::fot && !job.prior_nodes.empty()) {             // the fits after a resume use every run
       for (const std::int64_t run : store.runs_of_campaign(id, db::RunRole::campaign)) {  // never the validation runs
-        store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(),
-                              [&job](const db::SampleRow& r) { job.prior_series.add(r.disp, r.force); });
+        store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(), [&job](const db::SampleRow& r) { job.prior_series.add(r.disp, r.force); });
         job.prior_run = run;
       }
       // The last validation run that holds samples: a resume with every node measured scores its
@@ -202,8 +205,8 @@ struct Daemon::Impl {
   void store_io_stats() {
     for (auto& w : workers) {
       const auto h = w->rig->health();
-      const json stats{{"reads", h.reads}, {"writes", h.writes}, {"errors", h.total_errors()}, {"reconnects", h.reconnects},
-                       {"max_transaction_us", h.max_transaction_us}};
+      const json stats{
+          {"reads", h.reads}, {"writes", h.writes}, {"errors", h.total_errors()}, {"reconnects", h.reconnects}, {"max_transaction_us", h.max_transaction_us}};
       const auto id = w->info.id;
       const std::string now = now_iso();
       writer->post([id, stats, now](db::Store& s) { s.add_io_stats(id, stats.dump(), now); });
@@ -269,14 +272,14 @@ Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config
     // SCHED_FIFO it starved the daemon (a campaign stalled at time scale 100 in an ASan build).
     w->entry.sim.cpu = resolve_cpu(config.acquisition.cpu);
     if (w->entry.sim.realtime_priority < 0)
-      w->entry.sim.realtime_priority =
-          w->entry.sim.cpu >= 0 && config.acquisition.priority > 1 && e.sim.time_scale <= 1 ? config.acquisition.priority - 1 : 0;
+      w->entry.sim.realtime_priority = w->entry.sim.cpu >= 0 && config.acquisition.priority > 1 && e.sim.time_scale <= 1 ? config.acquisition.priority - 1 : 0;
     try {
       w->build_rig(config.base_dir);
     } catch (const drivers::RigConfigError& err) {
       throw ConfigError(std::string("config: ") + err.what());
     }
-    w->info.id = d.store.upsert_rig(e.name, e.simulated ? json{{"simulate", {{"time_scale", e.sim.time_scale}, {"rig", e.sim.rig}}}}.dump() : e.driver.dump(), now_iso());
+    w->info.id = d.store.upsert_rig(e.name, e.simulated ? json{{"simulate", {{"time_scale", e.sim.time_scale}, {"rig", e.sim.rig}}}}.dump() : e.driver.dump(),
+                                    now_iso());
     spdlog::info("rig '{}': {}", e.name, w->info.description);
     d.workers.push_back(std::move(w));
   }
@@ -322,8 +325,7 @@ void Daemon::run(const std::atomic<bool>& stop) {
     }
     d.finisher->submit(std::move(j));
   };
-  for (auto& w : d.workers)
-    w->thread = std::thread(rig_thread, std::ref(*w), std::ref(*d.writer), finish, std::cref(stop), d.config.base_dir);
+  for (auto& w : d.workers) w->thread = std::thread(rig_thread, std::ref(*w), std::ref(*d.writer), finish, std::cref(stop), d.config.base_dir);
   spdlog::info("hystlabd running: database {}", d.config.db_path);
   auto last_stats = std::chrono::steady_clock::now();
   while (!stop) {
@@ -361,9 +363,7 @@ const RigLive& Daemon::rig_live(std::size_t k) const { return impl_->workers.at(
 drivers::IoHealthSnapshot Daemon::rig_health(std::size_t k) const { return impl_->workers.at(k)->rig->health(); }
 RigSupervision Daemon::rig_supervision(std::size_t k) const { return impl_->workers.at(k)->snapshot(); }
 db::WriterStats Daemon::writer_stats() const { return impl_->writer->stats(); }
-double Daemon::uptime_s() const noexcept {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - impl_->started).count();
-}
+double Daemon::uptime_s() const noexcept { return std::chrono::duration<double>(std::chrono::steady_clock::now() - impl_->started).count(); }
 
 // Without a name: the only rig, or the only one of the kind the plan needs (the embedded
 // defaults have a load frame and a shaker, and a FOT plan can only mean the frame).
@@ -378,8 +378,8 @@ std::size_t Daemon::rig_index(const std::string& name, std::string_view plan_kin
     for (std::size_t k = 0; k < ws.size(); ++k)
       if (!want.empty() && ws[k]->info.kind == want) fit.push_back(k);
     if (fit.size() == 1) return fit[0];
-    throw std::invalid_argument("rig: several rigs " + (want.empty() ? std::string("are configured") : "can run a " + std::string(plan_kind) + " plan") +
-                                " (" + names + "); name one with \"rig\" (--rig NAME)");
+    throw std::invalid_argument("rig: several rigs " + (want.empty() ? std::string("are configured") : "can run a " + std::string(plan_kind) + " plan") + " (" +
+                                names + "); name one with \"rig\" (--rig NAME)");
   }
   for (std::size_t k = 0; k < ws.size(); ++k)
     if (ws[k]->info.name == name) return k;
@@ -392,7 +392,8 @@ std::pair<Plan, std::size_t> Daemon::check_plan(const std::string& rig_name, con
   const RigWorker& rig = *impl_->workers.at(k);
   const bool shaker = rig.info.kind == "shaker";
   if ((plan.kind == db::CampaignKind::sine) != shaker)
-    throw std::invalid_argument(std::string("plan.kind: a ") + db::to_string(plan.kind) + " plan cannot run on rig '" + rig.info.name + "', a " + rig.info.kind);
+    throw std::invalid_argument(std::string("plan.kind: a ") + db::to_string(plan.kind) + " plan cannot run on rig '" + rig.info.name + "', a " +
+                                rig.info.kind);
   (void)check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, shaker);  // PlanError names the field
   return {std::move(plan), k};
 }
@@ -424,8 +425,8 @@ std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) 
 void Daemon::set_record(std::int64_t campaign_id, const json& changes) {
   if (!changes.is_object() || changes.empty()) throw control::PlanError("", "record: give the specimen, the notes or both");
   for (const auto& [field, value] : changes.items()) {
-    const auto problem = value.is_string() ? db::record_field_problem(field, value.get<std::string>())
-                                           : db::record_field_problem(field, "").value_or("must be text");
+    const auto problem =
+        value.is_string() ? db::record_field_problem(field, value.get<std::string>()) : db::record_field_problem(field, "").value_or("must be text");
     if (problem) throw control::PlanError(field, field + " " + *problem);
   }
   impl_->on_main<bool>([this, campaign_id, changes] {
@@ -444,10 +445,11 @@ CommandOutcome Daemon::command(std::int64_t campaign_id, CampaignCommand cmd) {
   auto& d = *impl_;
   if (cmd == CampaignCommand::estop) {  // the rig first, latched and confirmed; the campaign ends by the latch
     RigWorker* w = d.rig_of_campaign(campaign_id);
-    if (!w) w = d.on_main<RigWorker*>([&d, campaign_id]() -> RigWorker* {
-      const auto row = d.store.campaign(campaign_id);
-      return row && !db::is_final(row->state) ? d.worker_of(row->rig_id) : nullptr;
-    });
+    if (!w)
+      w = d.on_main<RigWorker*>([&d, campaign_id]() -> RigWorker* {
+        const auto row = d.store.campaign(campaign_id);
+        return row && !db::is_final(row->state) ? d.worker_of(row->rig_id) : nullptr;
+      });
     if (w) {
       CommandOutcome rig = d.rig_command(*w, RigCommand::estop, 2.0);
       if (w->running_campaign != campaign_id)  // not running: the record ends here (running: the latch ended it)
@@ -475,8 +477,12 @@ CommandOutcome Daemon::Impl::rig_command(RigWorker& w, RigCommand c, double wait
     }
   }
   const RigSupervision s = w.snapshot();
-  return {CommandOutcome::Result::pending, s.latched, false, s.state,
-          "the rig's thread has not confirmed it within " + std::to_string(wait_s).substr(0, 3) + " s", wait_s};
+  return {CommandOutcome::Result::pending,
+          s.latched,
+          false,
+          s.state,
+          "the rig's thread has not confirmed it within " + std::to_string(wait_s).substr(0, 3) + " s",
+          wait_s};
 }
 
 int run_daemon(const DaemonConfig& config, const std::atomic<bool>& stop) {

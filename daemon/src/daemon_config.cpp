@@ -10,8 +10,7 @@ using nlohmann::json;
 
 double positive(const json& j, const char* f, double def, const std::string& where) {
   if (!j.contains(f)) return def;
-  if (!j[f].is_number() || !(j[f].get<double>() > 0) || !std::isfinite(j[f].get<double>()))
-    fail(where + "." + f, "must be a positive number");
+  if (!j[f].is_number() || !(j[f].get<double>() > 0) || !std::isfinite(j[f].get<double>())) fail(where + "." + f, "must be a positive number");
   return j[f].get<double>();
 }
 bool loopback(const std::string& host) { return host == "127.0.0.1" || host == "localhost" || host == "::1"; }
@@ -24,8 +23,7 @@ HttpConfig parse_http(const json& h, HttpConfig c) {
       c.enabled = v.get<bool>();
     } else if (k == "bind" || k == "token" || k == "read_token" || k == "web_root" || k == "vendor_root") {
       if (!v.is_string() || (k == "bind" && v.get<std::string>().empty())) fail("http." + k, "must be a non-empty string");
-      (k == "bind" ? c.bind : k == "token" ? c.token : k == "read_token" ? c.read_token : k == "web_root" ? c.web_root : c.vendor_root) =
-          v.get<std::string>();
+      (k == "bind" ? c.bind : k == "token" ? c.token : k == "read_token" ? c.read_token : k == "web_root" ? c.web_root : c.vendor_root) = v.get<std::string>();
     } else if (k == "allowed_hosts") {
       if (!v.is_array()) fail("http.allowed_hosts", "must be a list of host names (the names this daemon is reached by)");
       for (const auto& name : v) {
@@ -56,10 +54,14 @@ AcquisitionSettings parse_acquisition(const json& a) {
         fail("acquisition.priority", "must be a whole number from 0 (normal scheduling) to 98 (SCHED_FIFO)");
       s.priority = v.get<int>();
     } else if (k == "cpu") {
-      if (v == "last") s.cpu = AcquisitionSettings::kLastCpu;
-      else if (v == "any") s.cpu = AcquisitionSettings::kAnyCpu;
-      else if (v.is_number_integer() && v.get<long long>() >= 0 && v.get<long long>() < 4096) s.cpu = v.get<int>();
-      else fail("acquisition.cpu", "must be a CPU number, \"last\" or \"any\"");
+      if (v == "last")
+        s.cpu = AcquisitionSettings::kLastCpu;
+      else if (v == "any")
+        s.cpu = AcquisitionSettings::kAnyCpu;
+      else if (v.is_number_integer() && v.get<long long>() >= 0 && v.get<long long>() < 4096)
+        s.cpu = v.get<int>();
+      else
+        fail("acquisition.cpu", "must be a CPU number, \"last\" or \"any\"");
     } else {
       fail("acquisition." + k, "is not a known field (priority, cpu)");
     }
@@ -118,8 +120,7 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
     json r = j["rigs"][k];
     if (!r.is_object()) fail(where, "must be an object");
     RigEntry e;
-    if (r.contains("name") && (!r["name"].is_string() || r["name"].get<std::string>().empty()))
-      fail(where + ".name", "must be a non-empty string");
+    if (r.contains("name") && (!r["name"].is_string() || r["name"].get<std::string>().empty())) fail(where + ".name", "must be a non-empty string");
     e.name = r.value("name", "rig " + std::to_string(k + 1));
     for (std::size_t m = 0; m < k; ++m)
       if (j["rigs"][m].value("name", "") == e.name) fail(where + ".name", "repeats the name of rigs[" + std::to_string(m) + "]");
@@ -140,8 +141,8 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
       e.sim.corner_width_mm = s.contains("corner_width_mm") && s["corner_width_mm"] == 0 ? 0.0 : positive(s, "corner_width_mm", 0.05, where + ".simulate");
       if (s.contains("shakedown")) {  // [extra_N, tau_cycles]
         const json& sd = s["shakedown"];
-        if (!sd.is_array() || sd.size() != 2 || !sd[0].is_number() || !sd[1].is_number() || !(sd[0].get<double>() > 0) ||
-            !(sd[1].get<double>() > 0) || sd[0].get<double>() > 1e4 || sd[1].get<double>() > 1e4)
+        if (!sd.is_array() || sd.size() != 2 || !sd[0].is_number() || !sd[1].is_number() || !(sd[0].get<double>() > 0) || !(sd[1].get<double>() > 0) ||
+            sd[0].get<double>() > 1e4 || sd[1].get<double>() > 1e4)
           fail(where + ".simulate.shakedown", "must be [extra_N, tau_cycles], both above 0 (e.g. [8, 4])");
         if (e.sim.rig != "load_frame") fail(where + ".simulate.shakedown", "applies to a load frame's specimen only");
         e.sim.shakedown_extra_N = sd[0].get<double>();

@@ -7,8 +7,8 @@ namespace hystlab::daemon {
 namespace {
 
 // drivers::RigError's values, as the API and /metrics name them (index = the enum's value).
-constexpr const char* kErrorNames[] = {"", "timeout", "exception_response", "connection_lost", "crc_error",
-                                       "out_of_range", "protocol_error", "not_connected", "stale_data", "unsupported"};
+constexpr const char* kErrorNames[] = {
+    "", "timeout", "exception_response", "connection_lost", "crc_error", "out_of_range", "protocol_error", "not_connected", "stale_data", "unsupported"};
 static_assert(sizeof kErrorNames / sizeof kErrorNames[0] == drivers::kRigErrorCount);
 
 control::LinkHealth link_health(const drivers::IoHealthSnapshot& h) {
@@ -35,8 +35,13 @@ class DaemonControl final : public control::DaemonInterface {
   control::LinkHealth rig_health(std::size_t k) const override { return link_health(d_.rig_health(k)); }
   control::AcquisitionCounters rig_counters(std::size_t k) const override {
     const RigLive& live = d_.rig_live(k);
-    return {live.samples.load(), live.missed_deadlines.load(), live.late_wakeups.load(),
-            live.campaign.load(), live.run.load(), live.sample_rate_hz.load(), to_string(static_cast<CampaignPhase>(live.phase.load())),
+    return {live.samples.load(),
+            live.missed_deadlines.load(),
+            live.late_wakeups.load(),
+            live.campaign.load(),
+            live.run.load(),
+            live.sample_rate_hz.load(),
+            to_string(static_cast<CampaignPhase>(live.phase.load())),
             live.submit_latency_s.load()};
   }
   std::size_t rig_index(const std::string& name, std::string_view plan_kind) const override { return d_.rig_index(name, plan_kind); }
@@ -46,8 +51,7 @@ class DaemonControl final : public control::DaemonInterface {
   }
 
   std::uint64_t live_head(std::size_t k) const noexcept override { return k < d_.rig_count() ? d_.rig_live(k).ring.head() : 0; }
-  std::uint64_t read_live(std::size_t k, std::uint64_t from, std::size_t stride, std::vector<control::LiveSample>& out,
-                          std::uint64_t* lost) const override {
+  std::uint64_t read_live(std::size_t k, std::uint64_t from, std::size_t stride, std::vector<control::LiveSample>& out, std::uint64_t* lost) const override {
     return d_.rig_live(k).ring.read(from, stride, out, lost);
   }
 
@@ -73,9 +77,7 @@ class DaemonControl final : public control::DaemonInterface {
   }
   double uptime_s() const noexcept override { return d_.uptime_s(); }
   std::string db_path() const override { return d_.config().db_path; }
-  void keep_off_acquisition_cpu(bool off) const noexcept override {
-    (void)avoid_cpu(off ? resolve_cpu(d_.config().acquisition.cpu) : -1);
-  }
+  void keep_off_acquisition_cpu(bool off) const noexcept override { (void)avoid_cpu(off ? resolve_cpu(d_.config().acquisition.cpu) : -1); }
 
  private:
   Daemon& d_;

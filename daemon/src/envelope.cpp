@@ -18,8 +18,7 @@ std::string num(double v) {  // short, as a person writes it: 20, 0.5, 1.5e+04
 
 double positive(const json& j, const char* f, double def, const std::string& where) {
   if (!j.contains(f)) return def;
-  if (!j[f].is_number() || !std::isfinite(j[f].get<double>()) || !(j[f].get<double>() > 0))
-    bad(where + "." + f, "must be a positive number");
+  if (!j[f].is_number() || !std::isfinite(j[f].get<double>()) || !(j[f].get<double>() > 0)) bad(where + "." + f, "must be a positive number");
   return j[f].get<double>();
 }
 std::pair<double, double> range(const json& j, const char* f, std::pair<double, double> def, const std::string& where) {
@@ -64,8 +63,7 @@ RigEnvelope parse_envelope(const json& j, const std::string& where, bool shaker)
 SupervisionSettings parse_supervision(const json& j, const std::string& where) {
   SupervisionSettings s;
   if (j.is_null()) return s;
-  known(j, where, {"in_position_mm", "lag_s", "settle_s", "arm_timeout_s", "reset_timeout_s", "mode", "heartbeat_ms", "safe_rate_mm_s",
-                   "safe_timeout_s"});
+  known(j, where, {"in_position_mm", "lag_s", "settle_s", "arm_timeout_s", "reset_timeout_s", "mode", "heartbeat_ms", "safe_rate_mm_s", "safe_timeout_s"});
   s.in_position_mm = positive(j, "in_position_mm", s.in_position_mm, where);
   s.lag_s = positive(j, "lag_s", s.lag_s, where);
   s.settle_s = positive(j, "settle_s", s.settle_s, where);
@@ -84,16 +82,23 @@ SupervisionSettings parse_supervision(const json& j, const std::string& where) {
 
 json envelope_json(const RigEnvelope& e, bool shaker) {
   if (shaker)
-    return {{"displacement_mm", e.shaker_displacement_max_mm}, {"velocity_mm_s", e.shaker_velocity_max_mm_s},
-            {"accel_g", e.shaker_accel_max_g}, {"frequency_hz", {e.shaker_freq_min_hz, e.shaker_freq_max_hz}}};
-  return {{"stroke_mm", {e.stroke_min_mm, e.stroke_max_mm}}, {"force_N", e.force_max_N}, {"speed_mm_s", e.speed_max_mm_s},
-          {"accel_mm_s2", e.accel_max_mm_s2}};
+    return {{"displacement_mm", e.shaker_displacement_max_mm},
+            {"velocity_mm_s", e.shaker_velocity_max_mm_s},
+            {"accel_g", e.shaker_accel_max_g},
+            {"frequency_hz", {e.shaker_freq_min_hz, e.shaker_freq_max_hz}}};
+  return {{"stroke_mm", {e.stroke_min_mm, e.stroke_max_mm}}, {"force_N", e.force_max_N}, {"speed_mm_s", e.speed_max_mm_s}, {"accel_mm_s2", e.accel_max_mm_s2}};
 }
 
 json supervision_json(const SupervisionSettings& s) {
-  return {{"in_position_mm", s.in_position_mm}, {"lag_s", s.lag_s}, {"settle_s", s.settle_s}, {"arm_timeout_s", s.arm_timeout_s},
-          {"reset_timeout_s", s.reset_timeout_s}, {"mode", s.mode}, {"heartbeat_ms", s.heartbeat_period_s * 1000},
-          {"safe_rate_mm_s", s.safe_rate_mm_s}, {"safe_timeout_s", s.safe_timeout_s}};
+  return {{"in_position_mm", s.in_position_mm},
+          {"lag_s", s.lag_s},
+          {"settle_s", s.settle_s},
+          {"arm_timeout_s", s.arm_timeout_s},
+          {"reset_timeout_s", s.reset_timeout_s},
+          {"mode", s.mode},
+          {"heartbeat_ms", s.heartbeat_period_s * 1000},
+          {"safe_rate_mm_s", s.safe_rate_mm_s},
+          {"safe_timeout_s", s.safe_timeout_s}};
 }
 
 namespace {
@@ -104,8 +109,7 @@ void check_shaker(const Plan& p, const RigEnvelope& e) {
   const double a = s.max_amplitude_mm(), lo = s.lowest_hz(), hi = s.highest_hz(), w = 2 * std::numbers::pi * hi;
   const std::string amp = p.source.contains("amplitudes_mm") ? "amplitudes_mm" : "amplitude_mm";
   const std::string freq = p.source.contains("frequencies_hz") ? "frequencies_hz" : "sweep";
-  if (a > e.shaker_displacement_max_mm)
-    refuse(amp, num(a) + " mm exceeds the shaker's maximum displacement " + num(e.shaker_displacement_max_mm) + " mm");
+  if (a > e.shaker_displacement_max_mm) refuse(amp, num(a) + " mm exceeds the shaker's maximum displacement " + num(e.shaker_displacement_max_mm) + " mm");
   for (const double f : {lo, hi})
     if (f < e.shaker_freq_min_hz * (1 - 1e-9) || f > e.shaker_freq_max_hz * (1 + 1e-9))
       refuse(freq, num(f) + " Hz is outside the shaker's range " + num(e.shaker_freq_min_hz) + "–" + num(e.shaker_freq_max_hz) + " Hz");
@@ -114,8 +118,8 @@ void check_shaker(const Plan& p, const RigEnvelope& e) {
                      num(e.shaker_velocity_max_mm_s) + " mm/s");
   const double g = w * w * a / 9806.65;
   if (g > e.shaker_accel_max_g)
-    refuse(freq, num(hi) + " Hz at " + num(a) + " mm needs a peak acceleration of " + num(g) + " g; the shaker's maximum is " +
-                     num(e.shaker_accel_max_g) + " g");
+    refuse(freq,
+           num(hi) + " Hz at " + num(a) + " mm needs a peak acceleration of " + num(g) + " g; the shaker's maximum is " + num(e.shaker_accel_max_g) + " g");
 }
 
 void check_frame(const Plan& p, const RigEnvelope& e) {
@@ -145,8 +149,8 @@ std::vector<std::string> limits_tightened(const Plan& p, const Limits& a) {
   if (given("rate_mm_s") && asked.rate_max_mm_s > a.rate_max_mm_s)
     out.push_back("rate limit: the rig's " + num(a.rate_max_mm_s) + " mm/s applies (the plan asked " + num(asked.rate_max_mm_s) + " mm/s)");
   if (given("displacement_mm") && (asked.displacement_min_mm < a.displacement_min_mm || asked.displacement_max_mm > a.displacement_max_mm))
-    out.push_back("displacement limits: " + num(a.displacement_min_mm) + " to " + num(a.displacement_max_mm) + " mm apply, within the rig's stroke (the plan asked " +
-                  num(asked.displacement_min_mm) + " to " + num(asked.displacement_max_mm) + " mm)");
+    out.push_back("displacement limits: " + num(a.displacement_min_mm) + " to " + num(a.displacement_max_mm) +
+                  " mm apply, within the rig's stroke (the plan asked " + num(asked.displacement_min_mm) + " to " + num(asked.displacement_max_mm) + " mm)");
   return out;
 }
 
@@ -167,8 +171,7 @@ Limits check_plan_against(const Plan& p, const RigEnvelope& e, const Supervision
   l.rate_max_mm_s = std::min(l.rate_max_mm_s, e.speed_max_mm_s);
   if (!own_safe_rate) l.safe_rate_mm_s = std::min(s.safe_rate_mm_s, e.speed_max_mm_s);
   // A ramp must fit under the rate limit that trips it (with room for the servo's overshoot).
-  if (p.ramp_rate_mm_s > l.rate_max_mm_s)
-    refuse("ramp_rate_mm_s", num(p.ramp_rate_mm_s) + " exceeds the rate limit " + num(l.rate_max_mm_s) + " mm/s");
+  if (p.ramp_rate_mm_s > l.rate_max_mm_s) refuse("ramp_rate_mm_s", num(p.ramp_rate_mm_s) + " exceeds the rate limit " + num(l.rate_max_mm_s) + " mm/s");
   if (p.validation.enabled && p.validation.rate_mm_s > l.rate_max_mm_s)
     refuse("validation.rate_mm_s", num(p.validation.rate_mm_s) + " exceeds the rate limit " + num(l.rate_max_mm_s) + " mm/s");
   return l;

@@ -54,7 +54,8 @@ IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where) 
   if (j.contains("springs") && (!j["springs"].is_number_integer() || j["springs"] < 1 || j["springs"] > 1000))
     isolator_fail(where + ".springs", "must be an integer from 1 to 1000");
   m.springs = j.value("springs", m.springs);
-  m.damping_N_s_per_m = j.contains("damping_N_s_per_m") && j["damping_N_s_per_m"] == 0 ? 0.0 : isolator_positive(j, "damping_N_s_per_m", m.damping_N_s_per_m, where);
+  m.damping_N_s_per_m =
+      j.contains("damping_N_s_per_m") && j["damping_N_s_per_m"] == 0 ? 0.0 : isolator_positive(j, "damping_N_s_per_m", m.damping_N_s_per_m, where);
   if (!j.contains("params")) return with_spring(m, models::table1_parameters(), "simplified model, Table 1");
   try {
     return with_spring(m, models::params_from_json(j["params"].dump()), "simplified model, the rig's parameters");

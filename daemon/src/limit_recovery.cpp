@@ -14,7 +14,7 @@
 namespace hystlab::daemon {
 namespace st = protocols::status;
 namespace {
-constexpr double kInsideMargin_mm = 0.5;  // the target: this far inside the configured stroke
+constexpr double kInsideMargin_mm = 0.5;   // the target: this far inside the configured stroke
 constexpr double kAwayTolerance_mm = 0.1;  // motion away from the target beyond this stops it
 
 std::string mm(double x) {
@@ -31,8 +31,7 @@ std::optional<std::string> Supervisor::begin_recovery(double now, double stroke_
   if (resetting_) return "the rig is being reset";
   if (!have_last_ || state_ == RigState::disconnected) return "the rig is not connected";
   const bool outside = last_.position_mm < stroke_min_mm || last_.position_mm > stroke_max_mm;
-  if (latched() && !(last_.status & st::limit_tripped))
-    return "the rig is latched for " + latch_reason_ + ", not for a tripped limit: reset it instead";
+  if (latched() && !(last_.status & st::limit_tripped)) return "the rig is latched for " + latch_reason_ + ", not for a tripped limit: reset it instead";
   if (!latched() && state_ != RigState::idle) return "the rig is " + std::string(to_string(state_)) + ": a campaign moves it";
   if (!latched() && !outside) return "the frame is within its stroke at " + mm(last_.position_mm) + " and nothing is latched: nothing to recover";
   if (latched())
@@ -47,7 +46,8 @@ std::optional<std::string> Supervisor::begin_recovery(double now, double stroke_
   if (intended_ == RigState::estopped) intended_ = RigState::faulted;  // the reset released it: never re-sent
   recovery_deadline_ = deadline(now, s_.reset_timeout_s);
   if (observer_)
-    observer_({now, state_, state_, std::string("limit recovery: ") + (latched() ? "reset, then " : "") + "back to " + mm(recovery_target_) + " at the safe rate"});
+    observer_(
+        {now, state_, state_, std::string("limit recovery: ") + (latched() ? "reset, then " : "") + "back to " + mm(recovery_target_) + " at the safe rate"});
   return std::nullopt;
 }
 
@@ -74,8 +74,7 @@ void Supervisor::recovery_step(double now, const StatusView& v) {
     if (rig_->hold(false) || rig_->command(recovery_target_, s_.safe_rate_mm_s)) return recovery_failed(now, "the rig did not take the ramp");
     recovery_ = Recovery::moving;
     recovery_closest_ = std::fabs(v.position_mm - recovery_target_);
-    recovery_deadline_ = now + recovery_closest_ / s_.safe_rate_mm_s + s_.lag_s + s_.settle_s + s_.safe_timeout_s +
-                         kHostStallAllowance_s * time_scale_;
+    recovery_deadline_ = now + recovery_closest_ / s_.safe_rate_mm_s + s_.lag_s + s_.settle_s + s_.safe_timeout_s + kHostStallAllowance_s * time_scale_;
     return;
   }
   (void)recovery_moving(now, v);
@@ -92,13 +91,11 @@ void Supervisor::recovery_enable(double now, const StatusView& v) {
     return;
   }
   const bool outside = v.position_mm < stroke_min_ || v.position_mm > stroke_max_;
-  if (!(v.status & st::limit_tripped) && !outside)
-    return recovery_done(now, "reset: the rig reports the frame within its limits at " + mm(v.position_mm));
+  if (!(v.status & st::limit_tripped) && !outside) return recovery_done(now, "reset: the rig reports the frame within its limits at " + mm(v.position_mm));
   (void)write_disable();  // a fresh rising edge of enable: a drive never re-enables itself after a reset
   if (auto ec = rig_->set_mode(s_.mode); ec && ec != drivers::RigError::unsupported)
     return recovery_failed(now, "cannot write mode " + std::to_string(s_.mode) + ": " + ec.message());
-  if (rig_->command(v.position_mm, s_.safe_rate_mm_s) || rig_->hold(true) || rig_->arm(true))
-    return recovery_failed(now, "the rig did not take enable");
+  if (rig_->command(v.position_mm, s_.safe_rate_mm_s) || rig_->hold(true) || rig_->arm(true)) return recovery_failed(now, "the rig did not take enable");
   recovery_ = Recovery::enabling;
   recovery_deadline_ = deadline(now, s_.arm_timeout_s);
 }

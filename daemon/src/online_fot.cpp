@@ -4,8 +4,7 @@
 
 namespace hystlab::daemon {
 
-OnlineFot::OnlineFot(models::Grid grid, double dead_band_mm, NodeSink sink)
-    : grid_(grid), band_(dead_band_mm), sink_(std::move(sink)) {}
+OnlineFot::OnlineFot(models::Grid grid, double dead_band_mm, NodeSink sink) : grid_(grid), band_(dead_band_mm), sink_(std::move(sink)) {}
 
 bool OnlineFot::take_descent_completed() noexcept {
   const bool f = descent_flag_;
@@ -24,8 +23,7 @@ void OnlineFot::top_reached(double, double x, double f, bool collect) {
 }
 
 void OnlineFot::bottom_reached(double t, double f) {
-  if (row_ >= 1 && next_j_ == 0 && std::fabs(ext_x_ - grid_.lo) <= 0.25 * grid_.step())
-    sink_(models::FotNode{grid_.node(row_), grid_.lo, f_alpha_, f}, t);
+  if (row_ >= 1 && next_j_ == 0 && std::fabs(ext_x_ - grid_.lo) <= 0.25 * grid_.step()) sink_(models::FotNode{grid_.node(row_), grid_.lo, f_alpha_, f}, t);
   if (row_ >= 1) {
     ++descents_;
     descent_flag_ = true;
@@ -52,10 +50,12 @@ void OnlineFot::feed(double t, double x, double f, bool collect) {
     if (!have_prev_) ext_x_ = x, ext_f_ = f, ext_t_ = t;
     if (std::fabs(x - ext_x_) > band_) dir_ = x > ext_x_ ? 1 : -1;
   } else if ((dir_ > 0 && x >= ext_x_) || (dir_ < 0 && x <= ext_x_)) {
-    ext_x_ = x, ext_f_ = f, ext_t_ = t;  // still going the same way: a new extreme
+    ext_x_ = x, ext_f_ = f, ext_t_ = t;        // still going the same way: a new extreme
   } else if (std::fabs(x - ext_x_) > band_) {  // a reversal at the last extreme
-    if (dir_ > 0) top_reached(ext_t_, ext_x_, ext_f_, collect);
-    else bottom_reached(ext_t_, ext_f_);
+    if (dir_ > 0)
+      top_reached(ext_t_, ext_x_, ext_f_, collect);
+    else
+      bottom_reached(ext_t_, ext_f_);
     dir_ = -dir_;
     ext_x_ = x, ext_f_ = f, ext_t_ = t;  // (the dead band is far smaller than a cell: no δ_j was passed yet)
   }

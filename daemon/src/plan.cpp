@@ -188,8 +188,7 @@ Plan parse_plan(const json& j) {
     p.repeats = static_cast<int>(number(j, "repeats", 1, 1, 100));
     p.training = parse_training(j);
     p.limits = parse_limits(j.value("limits", json()), p.lo_mm, p.hi_mm);
-    if (p.lo_mm < p.limits.displacement_min_mm || p.hi_mm > p.limits.displacement_max_mm)
-      fail("range_mm", "must lie inside limits.displacement_mm");
+    if (p.lo_mm < p.limits.displacement_min_mm || p.hi_mm > p.limits.displacement_max_mm) fail("range_mm", "must lie inside limits.displacement_mm");
     p.validation = parse_validation(j, p);
     p.plateaus_mm = parse_plateaus(j, p);
   } else if (p.kind == db::CampaignKind::waveform) {
@@ -209,16 +208,14 @@ Plan parse_plan(const json& j) {
       if (p.points_mm[k] < p.limits.displacement_min_mm || p.points_mm[k] > p.limits.displacement_max_mm)
         fail("points_mm[" + std::to_string(k) + "]", "lies outside limits.displacement_mm");
   } else {
-    known({"frequencies_hz", "sweep", "amplitude_mm", "amplitudes_mm", "direction", "settle_cycles", "settle", "measured_cycles", "control",
-           "jump_threshold"});
+    known({"frequencies_hz", "sweep", "amplitude_mm", "amplitudes_mm", "direction", "settle_cycles", "settle", "measured_cycles", "control", "jump_threshold"});
     parse_sine(j, p);
   }
   // Only against a rate the plan wrote: without one, the rig's envelope decides at submission and
   // names its own maximum (check_plan_against), not a default the user never saw.
   const bool own_rate = j.contains("limits") && j["limits"].is_object() && j["limits"].contains("rate_mm_s");
   if (own_rate && p.ramp_rate_mm_s > p.limits.rate_max_mm_s) fail("ramp_rate_mm_s", "is above limits.rate_mm_s");
-  if (own_rate && p.validation.enabled && p.validation.rate_mm_s > p.limits.rate_max_mm_s)
-    fail("validation.rate_mm_s", "is above limits.rate_mm_s");
+  if (own_rate && p.validation.enabled && p.validation.rate_mm_s > p.limits.rate_max_mm_s) fail("validation.rate_mm_s", "is above limits.rate_mm_s");
   return p;
 }
 

@@ -37,8 +37,9 @@ PlanPreview preview_plan(const Plan& plan, models::HysteresisModel* model) {
       }
       x = s.target_mm;
     }
-    if (plan.kind == db::CampaignKind::fot) v.nodes = static_cast<std::size_t>(plan.subdivisions) * static_cast<std::size_t>(plan.subdivisions + 1) / 2 *
-                                      static_cast<std::size_t>(std::max(plan.repeats, 1));
+    if (plan.kind == db::CampaignKind::fot)
+      v.nodes = static_cast<std::size_t>(plan.subdivisions) * static_cast<std::size_t>(plan.subdivisions + 1) / 2 *
+                static_cast<std::size_t>(std::max(plan.repeats, 1));
   }
   v.samples = v.duration_s * plan.sample_rate_hz;
   v.kind = plan.kind;

@@ -20,8 +20,11 @@ namespace {
 class RampStrategy final : public Strategy {
  public:
   explicit RampStrategy(Loop& L)
-      : plan_(L.plan), seq_(schedule(L.plan), L.ctx.supervisor.settings().in_position_mm), settings_(L.ctx.supervisor.settings()),
-        time_scale_(L.ctx.time_scale), shakedown_(L.plan.training) {
+      : plan_(L.plan),
+        seq_(schedule(L.plan), L.ctx.supervisor.settings().in_position_mm),
+        settings_(L.ctx.supervisor.settings()),
+        time_scale_(L.ctx.time_scale),
+        shakedown_(L.plan.training) {
     series_ = L.job.prior_series;
     rows_begin_ = series_.x.size();
     halvings_seen_ = series_.halvings;
@@ -134,14 +137,13 @@ class RampStrategy final : public Strategy {
   // Returns the command to give (another segment's, when the schedule changed).
   std::optional<SetpointCommand> segment_changed(Loop& L, const drivers::RigSample& s, std::size_t before, SetpointCommand cmd) {
     const Segment* cur = seq_.current();
-    if (before < seq_.size() && seq_.at(before).kind == SegmentKind::training && seq_.at(before).target_mm == plan_.lo_mm &&
-        cycle_start_ && end_training_cycle(L)) {
+    if (before < seq_.size() && seq_.at(before).kind == SegmentKind::training && seq_.at(before).target_mm == plan_.lo_mm && cycle_start_ &&
+        end_training_cycle(L)) {
       seq_.restart_at(seq_.find(SegmentKind::rise, seq_.index()));
       return seq_.step(s.time_s, s.displacement_mm);
     }
     if (cur && cur->kind == SegmentKind::training && cur->target_mm == plan_.hi_mm) cycle_start_ = series_.x.size() - 1;
-    if (cur && cur->kind != SegmentKind::training && before < seq_.size() && seq_.at(before).kind == SegmentKind::training)
-      rows_begin_ = series_.x.size() - 1;
+    if (cur && cur->kind != SegmentKind::training && before < seq_.size() && seq_.at(before).kind == SegmentKind::training) rows_begin_ = series_.x.size() - 1;
     if (cur && cur->kind == SegmentKind::validation && !validating_) {
       const std::size_t at = seq_.index();
       if (builder_) retake_rows(L);
@@ -157,14 +159,19 @@ class RampStrategy final : public Strategy {
     const std::size_t b = *cycle_start_, e = series_.x.size() - 1;
     cycle_start_.reset();
     const std::span<const double> x(series_.x), f(series_.f);
-    const std::size_t top = b + static_cast<std::size_t>(std::max_element(x.begin() + static_cast<std::ptrdiff_t>(b),
-                                                                          x.begin() + static_cast<std::ptrdiff_t>(e) + 1) -
-                                                         (x.begin() + static_cast<std::ptrdiff_t>(b)));
+    const std::size_t top =
+        b + static_cast<std::size_t>(std::max_element(x.begin() + static_cast<std::ptrdiff_t>(b), x.begin() + static_cast<std::ptrdiff_t>(e) + 1) -
+                                     (x.begin() + static_cast<std::ptrdiff_t>(b)));
     if (!(b < top && top < e)) return false;
     const models::LoopFigures fig = models::loop_figures(x, f, b, top, e);
     const ShakedownStep st = shakedown_.add(fig.peak_force_N, fig.energy_Nmm);
-    nlohmann::json ev{{"cycle", st.cycle}, {"peak_force_N", st.peak_force_N}, {"energy_Nmm", st.energy_Nmm}, {"consecutive", st.consecutive},
-                      {"stable", st.stable}, {"damping_ratio", fig.damping_ratio}, {"secant_stiffness_N_mm", fig.secant_stiffness_N_mm}};
+    nlohmann::json ev{{"cycle", st.cycle},
+                      {"peak_force_N", st.peak_force_N},
+                      {"energy_Nmm", st.energy_Nmm},
+                      {"consecutive", st.consecutive},
+                      {"stable", st.stable},
+                      {"damping_ratio", fig.damping_ratio},
+                      {"secant_stiffness_N_mm", fig.secant_stiffness_N_mm}};
     if (st.peak_change_pct) ev["peak_change_pct"] = *st.peak_change_pct;
     if (st.energy_change_pct) ev["energy_change_pct"] = *st.energy_change_pct;
     L.event("shakedown", ev);
@@ -189,7 +196,9 @@ class RampStrategy final : public Strategy {
       L.result.run_id = L.result.validation_run_id;
       L.next_seq = 0;
     }
-    L.event("validation", {{"run", L.result.run_id}, {"reversals", plan_.validation.reversals}, {"seed", plan_.validation.seed},
+    L.event("validation", {{"run", L.result.run_id},
+                           {"reversals", plan_.validation.reversals},
+                           {"seed", plan_.validation.seed},
                            {"points_mm", validation_points(plan_.validation)},
                            {"why", "a seeded random input after the rows, not used to build any table: every table is scored on it"}});
   }
@@ -208,8 +217,8 @@ class RampStrategy final : public Strategy {
   bool target_missed(Loop& L, const drivers::RigSample& s) {
     L.ctx.supervisor.hold(s.time_s, "target not reached: held");
     char buf[200];
-    std::snprintf(buf, sizeof buf, "target %.3f mm not reached in %.1f s: stopped at %.3f mm (in-position tolerance %.3g mm)", target_,
-                  s.time_s - started_, s.displacement_mm, settings_.in_position_mm);
+    std::snprintf(buf, sizeof buf, "target %.3f mm not reached in %.1f s: stopped at %.3f mm (in-position tolerance %.3g mm)", target_, s.time_s - started_,
+                  s.displacement_mm, settings_.in_position_mm);
     L.end(CampaignEnd::failed, buf);
     return false;
   }

@@ -20,8 +20,8 @@ std::string now_iso() {
   gmtime_r(&s, &tm);
   char buf[96];
   const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count() % 1000;
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
-                tm.tm_hour, tm.tm_min, tm.tm_sec, static_cast<int>(ms));
+  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec,
+                static_cast<int>(ms));
   return buf;
 }
 
@@ -31,7 +31,8 @@ void RigWorker::build_rig(const std::string& base) {
     if (!sim) sim = std::make_unique<SimChild>(entry.sim);
     // In real time the simulated controller is read as a real one is best read: in blocks from its
     // own sample buffer. Faster than real time its clock outruns any reader; the latest value then.
-    cfg = json{{"name", entry.name}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", sim->ensure_running()},
+    cfg = json{{"name", entry.name},   {"transport", "modbus-tcp"},
+               {"host", "127.0.0.1"},  {"port", sim->ensure_running()},
                {"rig", entry.sim.rig}, {"block_reads", entry.sim.rig == "load_frame" && entry.sim.time_scale <= 1}};
     entry.time_scale = entry.sim.time_scale;
   }
@@ -42,8 +43,10 @@ void RigWorker::build_rig(const std::string& base) {
   info.kind = cfg.value("rig", std::string("load_frame"));
   info.description = rig->describe();
   const bool shaker = info.kind == "shaker";
-  if (supervisor) supervisor->rebind(*rig);
-  else supervisor = std::make_unique<Supervisor>(*rig, entry.supervision, shaker, [this](const RigTransition& t) { record(t); });
+  if (supervisor)
+    supervisor->rebind(*rig);
+  else
+    supervisor = std::make_unique<Supervisor>(*rig, entry.supervision, shaker, [this](const RigTransition& t) { record(t); });
   supervisor->set_time_scale(entry.time_scale);
   std::lock_guard lk(mu_);
   snap_.envelope = envelope_json(entry.envelope, shaker);
@@ -124,8 +127,8 @@ void RigWorker::carry_out(PendingCommand c, double t) {
   Supervisor& sup = *supervisor;
   if (c.command == RigCommand::estop) {
     if (const std::error_code ec = sup.estop(t, "e-stop by the operator")) {
-      answer(c, R::unreachable, "the rig did not take the e-stop (" + ec.message() +
-                                    "): latched here, nothing arms, and the e-stop is written again the moment the rig answers");
+      answer(c, R::unreachable,
+             "the rig did not take the e-stop (" + ec.message() + "): latched here, nothing arms, and the e-stop is written again the moment the rig answers");
       return;
     }
     waiting_.push_back(std::move(c));
@@ -234,8 +237,8 @@ RigSupervision RigWorker::snapshot() const {
 
 namespace {
 
-void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish,
-             const std::atomic<bool>& stop, double epoch) {
+void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish, const std::atomic<bool>& stop,
+             double epoch) {
   SteadyClock clock;
   RunnerContext ctx(*w.rig, *w.supervisor, writer, clock);
   ctx.time_scale = w.entry.time_scale;
@@ -252,8 +255,8 @@ void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std:
   w.live.campaign = id;
   const RunnerResult r = run_campaign(job, ctx);
   w.live.campaign = 0;
-  spdlog::info("rig '{}': campaign {} ended {} ({} samples, {} missed deadlines, {} late wake-ups, {} gaps, {} dropped){}{}", w.entry.name,
-               id, to_string(r.end), r.samples, r.missed_deadlines, r.late_wakeups, r.gaps, r.dropped, r.reason.empty() ? "" : ": ", r.reason);
+  spdlog::info("rig '{}': campaign {} ended {} ({} samples, {} missed deadlines, {} late wake-ups, {} gaps, {} dropped){}{}", w.entry.name, id,
+               to_string(r.end), r.samples, r.missed_deadlines, r.late_wakeups, r.gaps, r.dropped, r.reason.empty() ? "" : ": ", r.reason);
 }
 
 constexpr int kIdleMissesForLinkLoss = 3;  // 150 ms of 50 ms idle ticks, plus the read timeouts
@@ -286,8 +289,10 @@ void idle_tick(RigWorker& w, double t, const std::string& base, double host_s) {
   // row: one late answer is no lost link (a starved CI host timed out a read every few seconds,
   // and the rig flapped between idle and disconnected, holding it each time).
   const bool gone = ec == drivers::RigError::connection_lost || ec == drivers::RigError::not_connected;
-  if (!ec) w.idle_misses = 0, (void)w.supervisor->on_status(t, v);
-  else if (gone || ++w.idle_misses >= kIdleMissesForLinkLoss) w.supervisor->on_link_error(t, ec);
+  if (!ec)
+    w.idle_misses = 0, (void)w.supervisor->on_status(t, v);
+  else if (gone || ++w.idle_misses >= kIdleMissesForLinkLoss)
+    w.supervisor->on_link_error(t, ec);
   w.supervisor->heartbeat(host_s);
   w.update_snapshot(v, x, f, !ec);
 }
@@ -313,8 +318,7 @@ void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, do
   w.live.phase = 0;
 }
 
-void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish, const std::atomic<bool>& stop,
-                const std::string& base) {
+void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish, const std::atomic<bool>& stop, const std::string& base) {
   // Ahead of everything else in the process when the system allows it; otherwise it says so once.
   spdlog::info("rig '{}': acquisition thread at {}", w.entry.name, enter_acquisition_thread(w.acquisition));
   const double t0 = mono_now();

@@ -11,9 +11,9 @@
 
 #include "hystlab/db/sqlite.hpp"
 #include "hystlab/models/accuracy.hpp"
-#include "hystlab/models/fot_identification.hpp"
-#include "hystlab/models/formats.hpp"
 #include "hystlab/models/fit_report.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/loop_figures.hpp"
 #include "hystlab/models/loop_report.hpp"
 #include "hystlab/models/table_score.hpp"
@@ -22,13 +22,11 @@ namespace hystlab::daemon {
 namespace {
 using nlohmann::json;
 
-json evaluate(const models::EverettTable& table, const RunSeries& s) {
-  return models::accuracy_json(models::score_table(table, s.x, s.f));
-}
+json evaluate(const models::EverettTable& table, const RunSeries& s) { return models::accuracy_json(models::score_table(table, s.x, s.f)); }
 }  // namespace
 
-void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const models::OnlineTableBuilder& builder,
-                     const RunSeries& series, const std::string& now) {
+void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const models::OnlineTableBuilder& builder, const RunSeries& series,
+                     const std::string& now) {
   auto table = builder.table();
   const std::size_t known = builder.identified_nodes(), needed = builder.required_nodes();
   // On at most 65,536 samples of the run, evenly spread: a copy of the whole run after every
@@ -70,8 +68,7 @@ struct Candidate {
   std::optional<double> heldout_rms;
 };
 
-Candidate candidate(const FinishJob& j, std::string label, std::string method, int n, const models::EverettTable& table,
-                    models::TableProvenance prov) {
+Candidate candidate(const FinishJob& j, std::string label, std::string method, int n, const models::EverettTable& table, models::TableProvenance prov) {
   Candidate c{std::move(label), {std::move(method), n, j.plan.lo_mm, j.plan.hi_mm, "", ""}, std::move(prov), table, evaluate(table, j.series), {}};
   if (j.validation.x.size() >= 2) {
     json held = evaluate(table, j.validation);
@@ -147,8 +144,8 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   if (r.end == CampaignEnd::completed && j.builder) {
     if (!j.builder->complete()) {
       r.end = CampaignEnd::failed;
-      r.reason = "the input ended with " + std::to_string(j.builder->identified_nodes()) + " of " +
-                 std::to_string(j.builder->required_nodes()) + " FOT nodes measured";
+      r.reason = "the input ended with " + std::to_string(j.builder->identified_nodes()) + " of " + std::to_string(j.builder->required_nodes()) +
+                 " FOT nodes measured";
     } else {
       end.tables = fot_tables(j, now, note, recommendation);
       for (std::size_t k = 0; k < end.tables.size(); ++k)
@@ -202,17 +199,19 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   const auto a = std::make_shared<Attempt>();
   a->end = std::move(end);
   for (int attempt = 0; attempt < 30; ++attempt) {
-    auto ids = writer.call<std::vector<std::int64_t>>([a](db::Store& s) {
-      try {
-        return s.finish_run(a->end);
-      } catch (const db::DbError& e) {
-        a->failed(e.what(), (e.code & 0xff) == 5 || (e.code & 0xff) == 6);
-        throw;
-      } catch (const std::exception& e) {
-        a->failed(e.what(), false);
-        throw;
-      }
-    }, 10.0);
+    auto ids = writer.call<std::vector<std::int64_t>>(
+        [a](db::Store& s) {
+          try {
+            return s.finish_run(a->end);
+          } catch (const db::DbError& e) {
+            a->failed(e.what(), (e.code & 0xff) == 5 || (e.code & 0xff) == 6);
+            throw;
+          } catch (const std::exception& e) {
+            a->failed(e.what(), false);
+            throw;
+          }
+        },
+        10.0);
     if (ids) {
       if (ids->size() > 0) r.table_id = (*ids)[0];
       if (ids->size() > 1) r.lsq_table_id = (*ids)[1];
@@ -228,10 +227,12 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   r.reason = a->end.reason + "; the database did not take the end of the campaign" + (refused.empty() ? std::string() : " (" + refused + ")");
   const std::string reason = r.reason;
   const auto id = j.campaign;
-  const auto last = writer.call<int>([id, reason, now](db::Store& s) {
-    s.transition(id, db::CampaignState::failed, reason, now);
-    return 0;
-  }, 10.0);
+  const auto last = writer.call<int>(
+      [id, reason, now](db::Store& s) {
+        s.transition(id, db::CampaignState::failed, reason, now);
+        return 0;
+      },
+      10.0);
   if (!last) r.reason += "; nor its failure";
   return r;
 }

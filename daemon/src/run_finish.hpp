@@ -11,7 +11,7 @@ namespace hystlab::daemon {
 // them, evenly spread), per branch, stored as an event by the writer thread (the acquisition
 // thread only copies that many).
 inline constexpr std::size_t kEvaluationSamples = 65536;
-void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const models::OnlineTableBuilder& builder,
-                     const RunSeries& series, const std::string& now);
+void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const models::OnlineTableBuilder& builder, const RunSeries& series,
+                     const std::string& now);
 
 }  // namespace hystlab::daemon

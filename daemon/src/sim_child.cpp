@@ -2,9 +2,9 @@
 
 #include <poll.h>
 #include <sched.h>
-#include <spdlog/spdlog.h>
 #include <signal.h>
 #include <spawn.h>
+#include <spdlog/spdlog.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -49,7 +49,8 @@ int SimChild::ensure_running() {
   posix_spawn_file_actions_addclose(&fa, out[0]);
   std::string exe = find_simulator(), scale = std::to_string(opt_.time_scale), noise = std::to_string(opt_.noise_N),
               corner = std::to_string(opt_.corner_width_mm);
-  std::vector<std::string> args{exe, "--port", "0", "--time-scale", scale, "--noise", noise, "--corner-width", corner, "--exit-with-parent", "1", "--rig", opt_.rig};
+  std::vector<std::string> args{exe, "--port", "0",     "--time-scale", scale, "--noise", noise, "--corner-width", corner, "--exit-with-parent",
+                                "1", "--rig",  opt_.rig};
   // --realtime only when configured: at a large time scale the physics catch-up is real work, and
   // at SCHED_FIFO it starved the daemon's other threads (a campaign stalled in a sanitizer build).
   if (opt_.host_timeout_ms > 0) args.insert(args.end(), {"--host-timeout-ms", std::to_string(opt_.host_timeout_ms)});
@@ -70,8 +71,7 @@ int SimChild::ensure_running() {
   posix_spawnattr_destroy(&attr);
   posix_spawn_file_actions_destroy(&fa);
   close(out[1]);
-  if (rc == 0 && opt_.cpu >= 0 && !pin_process(pid_, opt_.cpu))
-    spdlog::info("hystlab-sim: not pinned to CPU {} (refused)", opt_.cpu);
+  if (rc == 0 && opt_.cpu >= 0 && !pin_process(pid_, opt_.cpu)) spdlog::info("hystlab-sim: not pinned to CPU {} (refused)", opt_.cpu);
   if (rc != 0) {
     close(out[0]);
     pid_ = -1;

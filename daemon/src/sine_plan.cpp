@@ -10,9 +10,12 @@ using nlohmann::json;
 
 const char* to_string(SweepDirection d) noexcept {
   switch (d) {
-    case SweepDirection::up: return "up";
-    case SweepDirection::down: return "down";
-    case SweepDirection::up_down: return "up-down";
+    case SweepDirection::up:
+      return "up";
+    case SweepDirection::down:
+      return "down";
+    case SweepDirection::up_down:
+      return "up-down";
   }
   return "?";
 }
@@ -59,7 +62,8 @@ void parse_sweep(const json& s, SinePlan& p) {
 }
 
 std::vector<double> amplitudes(const json& j) {
-  if (j.contains("amplitude_mm") == j.contains("amplitudes_mm")) fields::fail("amplitudes_mm", "or amplitude_mm: exactly one is required (the base amplitude, peak, mm)");
+  if (j.contains("amplitude_mm") == j.contains("amplitudes_mm"))
+    fields::fail("amplitudes_mm", "or amplitude_mm: exactly one is required (the base amplitude, peak, mm)");
   if (j.contains("amplitude_mm")) return {fields::number(j, "amplitude_mm", 0, 1e-4, 100)};
   const json& a = j["amplitudes_mm"];
   if (!a.is_array() || a.empty() || a.size() > 20) fields::fail("amplitudes_mm", "must be an array of 1 to 20 base amplitudes (mm)");
@@ -120,16 +124,23 @@ SineControl parse_control(const json& j) {
 SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   SinePlan p;
   if (j.contains("frequencies_hz") && j.contains("sweep")) fields::fail("frequencies_hz", "or sweep: give one of them");
-  if (!j.contains("frequencies_hz") && !j.contains("sweep")) fields::fail("sweep", "is required (or frequencies_hz): {\"from_hz\": 5, \"to_hz\": 80, \"steps\": 24}");
-  if (j.contains("frequencies_hz")) p.frequencies_hz = frequency_list(j["frequencies_hz"]);
-  else parse_sweep(j["sweep"], p);
+  if (!j.contains("frequencies_hz") && !j.contains("sweep"))
+    fields::fail("sweep", "is required (or frequencies_hz): {\"from_hz\": 5, \"to_hz\": 80, \"steps\": 24}");
+  if (j.contains("frequencies_hz"))
+    p.frequencies_hz = frequency_list(j["frequencies_hz"]);
+  else
+    parse_sweep(j["sweep"], p);
   if (j.contains("direction")) {
     const json& d = j["direction"];
     const std::string v = d.is_string() ? d.get<std::string>() : "";
-    if (v == "up") p.direction = SweepDirection::up;
-    else if (v == "down") p.direction = SweepDirection::down;
-    else if (v == "up-down") p.direction = SweepDirection::up_down;
-    else fields::fail("direction", "must be \"up\", \"down\" or \"up-down\"");
+    if (v == "up")
+      p.direction = SweepDirection::up;
+    else if (v == "down")
+      p.direction = SweepDirection::down;
+    else if (v == "up-down")
+      p.direction = SweepDirection::up_down;
+    else
+      fields::fail("direction", "must be \"up\", \"down\" or \"up-down\"");
   }
   p.amplitudes_mm = amplitudes(j);
   p.settle = parse_settle(j);
@@ -137,8 +148,9 @@ SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   p.control = parse_control(j);
   p.jump_threshold_pct = fields::percent(j, "jump_threshold", p.jump_threshold_pct, "");
   if (p.highest_hz() > sample_rate_hz / 8)
-    fields::fail(p.continuous || j.contains("sweep") ? "sweep.to_hz" : "frequencies_hz",
-         "must stay below sample_rate_hz / 8 (at least 8 samples a cycle): " + plan_number(p.highest_hz()) + " Hz at " + plan_number(sample_rate_hz) + " Hz");
+    fields::fail(
+        p.continuous || j.contains("sweep") ? "sweep.to_hz" : "frequencies_hz",
+        "must stay below sample_rate_hz / 8 (at least 8 samples a cycle): " + plan_number(p.highest_hz()) + " Hz at " + plan_number(sample_rate_hz) + " Hz");
   return p;
 }
 
@@ -188,8 +200,8 @@ std::size_t step_count(const SinePlan& p) {
   const std::size_t passes = sweep_passes(p).size();
   if (!p.continuous) return passes * p.frequencies_hz.size();
   // cycles in a pass: ∫ f dt over the pass
-  const double cycles = p.rate_oct_min > 0 ? (p.to_hz - p.from_hz) * 60.0 / (p.rate_oct_min * std::log(2.0))
-                                           : (p.to_hz * p.to_hz - p.from_hz * p.from_hz) / (2 * p.rate_hz_s);
+  const double cycles =
+      p.rate_oct_min > 0 ? (p.to_hz - p.from_hz) * 60.0 / (p.rate_oct_min * std::log(2.0)) : (p.to_hz * p.to_hz - p.from_hz * p.from_hz) / (2 * p.rate_hz_s);
   return passes * static_cast<std::size_t>(std::max(1.0, std::floor(cycles / p.measured_cycles)));
 }
 

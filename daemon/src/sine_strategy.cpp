@@ -59,8 +59,12 @@ class SineStrategy final : public Strategy {
     fj.isolator = L.job.isolator;
     fj.sine_steps = steps_;
     if (points_ > 0)
-      L.event("sweep_done", {{"points", points_}, {"of", total_}, {"seconds", last_t_ - t0_}, {"nominal_seconds", nominal_duration_s(s_)},
-                             {"warnings", warnings_}, {"predicted_with", L.job.isolator ? L.job.isolator->describe : ""}});
+      L.event("sweep_done", {{"points", points_},
+                             {"of", total_},
+                             {"seconds", last_t_ - t0_},
+                             {"nominal_seconds", nominal_duration_s(s_)},
+                             {"warnings", warnings_},
+                             {"predicted_with", L.job.isolator ? L.job.isolator->describe : ""}});
   }
 
  private:
@@ -77,8 +81,15 @@ class SineStrategy final : public Strategy {
     control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false, established_ = !s_.control.closed;
     prev_mass_ = NAN;
     if (!L.command_drive(t, f_, drive_)) return false;
-    L.event("sine_step", {{"k", points_ + 1}, {"of", total_}, {"pass", pass_ + 1}, {"passes", passes_.size()}, {"frequency_hz", f_},
-                          {"amplitude_mm", demand()}, {"direction", up() ? "up" : "down"}, {"drive_mm", drive_}, {"eta_s", eta(t)}});
+    L.event("sine_step", {{"k", points_ + 1},
+                          {"of", total_},
+                          {"pass", pass_ + 1},
+                          {"passes", passes_.size()},
+                          {"frequency_hz", f_},
+                          {"amplitude_mm", demand()},
+                          {"direction", up() ? "up" : "down"},
+                          {"drive_mm", drive_},
+                          {"eta_s", eta(t)}});
     if (s_.control.closed) return open(Mode::control, 1, s_.control.window_cycles);
     return to_settle();
   }
@@ -119,10 +130,14 @@ class SineStrategy final : public Strategy {
     const ControlVerdict v = control_.update(demand(), drive_, b.fundamental.amplitude);
     if (!check_band(L, t, v, b.fundamental.amplitude)) return false;
     switch (mode_) {
-      case Mode::control: return after_control(L, t, v);
-      case Mode::settle: return after_settle(L, t, v, m.fundamental.amplitude);
-      case Mode::measure: return after_measure(L, t, b, m, v);
-      case Mode::sweep: return after_sweep_window(L, t, b, m, v);
+      case Mode::control:
+        return after_control(L, t, v);
+      case Mode::settle:
+        return after_settle(L, t, v, m.fundamental.amplitude);
+      case Mode::measure:
+        return after_measure(L, t, b, m, v);
+      case Mode::sweep:
+        return after_sweep_window(L, t, b, m, v);
     }
     return true;
   }
@@ -170,8 +185,13 @@ class SineStrategy final : public Strategy {
       return redrive(L, t, v);
     }
     if (s_.control.closed && v.band != ControlBand::within)  // measured anyway: said
-      L.event("control_unreached", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"error_pct", v.error_pct}, {"windows", control_windows_},
-                                    {"drive_mm", drive_}, {"limited", v.limited}, {"while", "measuring"}});
+      L.event("control_unreached", {{"frequency_hz", f_},
+                                    {"demand_mm", demand()},
+                                    {"error_pct", v.error_pct},
+                                    {"windows", control_windows_},
+                                    {"drive_mm", drive_},
+                                    {"limited", v.limited},
+                                    {"while", "measuring"}});
     store_point(L, t, b, m, v);
     ++step_;
     return next_step(L, t);
@@ -180,8 +200,12 @@ class SineStrategy final : public Strategy {
   bool after_control(Loop& L, double t, const ControlVerdict& v) {
     if (v.band == ControlBand::within) return to_settle();
     if (++control_windows_ >= s_.control.max_windows) {
-      L.event("control_unreached", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"error_pct", v.error_pct}, {"windows", control_windows_},
-                                    {"drive_mm", drive_}, {"limited", v.limited}});
+      L.event("control_unreached", {{"frequency_hz", f_},
+                                    {"demand_mm", demand()},
+                                    {"error_pct", v.error_pct},
+                                    {"windows", control_windows_},
+                                    {"drive_mm", drive_},
+                                    {"limited", v.limited}});
       return to_settle();
     }
     return redrive(L, t, v);
@@ -257,12 +281,27 @@ class SineStrategy final : public Strategy {
     const double f = s_.continuous ? w_.mean_frequency() : f_;
     ++points_;
     if (!s_.continuous) nominal_done_ += step_nominal_s(s_, f_);
-    const nlohmann::json rec{{"k", points_}, {"of", total_}, {"pass", pass_ + 1}, {"frequency_hz", f}, {"amplitude_mm", demand()},
-                             {"direction", up() ? "up" : "down"}, {"drive_mm", drive_}, {"base_amplitude_mm", b.fundamental.amplitude},
-                             {"base_phase_rad", b.fundamental.phase_rad}, {"mass_amplitude_mm", m.fundamental.amplitude},
-                             {"mass_phase_rad", m.fundamental.phase_rad}, {"ratio", ratio}, {"phase_rad", phase}, {"thd", m.thd},
-                             {"harmonics", m.harmonics}, {"control_error_pct", v.error_pct}, {"band", to_string(v.band)},
-                             {"control_windows", control_windows_}, {"settle_cycles", s_.settle.until ? settled_cycles_ : s_.settle.cycles}, {"t_s", t}, {"eta_s", eta(t)}};
+    const nlohmann::json rec{{"k", points_},
+                             {"of", total_},
+                             {"pass", pass_ + 1},
+                             {"frequency_hz", f},
+                             {"amplitude_mm", demand()},
+                             {"direction", up() ? "up" : "down"},
+                             {"drive_mm", drive_},
+                             {"base_amplitude_mm", b.fundamental.amplitude},
+                             {"base_phase_rad", b.fundamental.phase_rad},
+                             {"mass_amplitude_mm", m.fundamental.amplitude},
+                             {"mass_phase_rad", m.fundamental.phase_rad},
+                             {"ratio", ratio},
+                             {"phase_rad", phase},
+                             {"thd", m.thd},
+                             {"harmonics", m.harmonics},
+                             {"control_error_pct", v.error_pct},
+                             {"band", to_string(v.band)},
+                             {"control_windows", control_windows_},
+                             {"settle_cycles", s_.settle.until ? settled_cycles_ : s_.settle.cycles},
+                             {"t_s", t},
+                             {"eta_s", eta(t)}};
     steps_.push_back({points_, PredictStep{f, b.fundamental.amplitude, settled_cycles_ + s_.settle.cycles, s_.measured_cycles}});
     db::SinePointRow row{points_, f, demand(), b.fundamental.amplitude, m.fundamental.amplitude, ratio, phase, up() ? "up" : "down", rec.dump()};
     const auto run = L.result.run_id, id = L.job.id;

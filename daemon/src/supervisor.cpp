@@ -10,14 +10,22 @@ namespace st = protocols::status;
 
 std::string_view to_string(RigState s) noexcept {
   switch (s) {
-    case RigState::disconnected: return "disconnected";
-    case RigState::idle: return "idle";
-    case RigState::arming: return "arming";
-    case RigState::armed: return "armed";
-    case RigState::holding: return "holding";
-    case RigState::estopped: return "estopped";
-    case RigState::faulted: return "faulted";
-    case RigState::safing: return "safing";
+    case RigState::disconnected:
+      return "disconnected";
+    case RigState::idle:
+      return "idle";
+    case RigState::arming:
+      return "arming";
+    case RigState::armed:
+      return "armed";
+    case RigState::holding:
+      return "holding";
+    case RigState::estopped:
+      return "estopped";
+    case RigState::faulted:
+      return "faulted";
+    case RigState::safing:
+      return "safing";
   }
   return "unknown";
 }
@@ -25,8 +33,10 @@ std::string_view to_string(RigState s) noexcept {
 std::string describe_status(std::uint16_t status, std::uint16_t code, const std::string& code_text) {
   std::string out;
   auto add = [&](const std::string& part) { out += (out.empty() ? "" : ", ") + part; };
-  if (code != 0) add("fault " + std::to_string(code) + (code_text.empty() ? "" : " (" + code_text + ")"));
-  else if (status & st::fault) add("fault");
+  if (code != 0)
+    add("fault " + std::to_string(code) + (code_text.empty() ? "" : " (" + code_text + ")"));
+  else if (status & st::fault)
+    add("fault");
   if (status & st::estop) add("e-stop latched");
   if (status & st::limit_tripped) add("limit tripped");
   if (!(status & st::ready)) add("not ready");
@@ -78,7 +88,7 @@ void Supervisor::on_link_error(double now, std::error_code ec) {
   if (state_ == RigState::disconnected) return;
   ++link_losses_;
   if (recovering()) recovery_failed(now, "link lost (" + ec.message() + "): held and disabled the moment the rig answers");
-  if (latched()) return;  // the latch is the supervisor's: it outlives the link
+  if (latched()) return;                              // the latch is the supervisor's: it outlives the link
   if (moving_state()) intended_ = RigState::holding;  // whatever it was doing, it is held when it answers
   go(now, RigState::disconnected, "link lost: " + ec.message());
 }
@@ -111,8 +121,8 @@ std::optional<std::string> Supervisor::check_bits(double now, const StatusView& 
   }
   if (v.status & (st::fault | st::limit_tripped)) {
     (void)write_hold();
-    const std::string why = std::string(v.status & st::limit_tripped ? "limit tripped on the rig" : "rig fault") + ": " +
-                            describe_status(v.status, v.fault_code, text);
+    const std::string why =
+        std::string(v.status & st::limit_tripped ? "limit tripped on the rig" : "rig fault") + ": " + describe_status(v.status, v.fault_code, text);
     latch(now, RigState::faulted, why, v.fault_code);
     return why;
   }
@@ -145,7 +155,8 @@ std::optional<std::string> Supervisor::on_status(double now, const StatusView& v
   }
   if (auto why = check_bits(now, v)) return why;
   if (verify_disabled_ && state_ == RigState::idle) {
-    if (!(v.status & st::enabled)) verify_disabled_ = false;
+    if (!(v.status & st::enabled))
+      verify_disabled_ = false;
     else if (now > verify_deadline_) {  // the disable did not take: write it again, and again
       (void)write_disable();
       verify_deadline_ = deadline(now, s_.arm_timeout_s);
@@ -186,8 +197,7 @@ Supervisor::Arming Supervisor::arming_step(double now, const StatusView& v, std:
       return failed("cannot write mode " + std::to_string(s_.mode) + ": " + ec.message());
     // The setpoint is where the rig is, before enable: a stale setpoint from an earlier campaign
     // must never become motion the moment the drive is enabled.
-    std::error_code ec = shaker_ ? rig_->command_shaker(0.0, 0.0, true)
-                                 : rig_->command(v.position_mm, s_.safe_rate_mm_s);
+    std::error_code ec = shaker_ ? rig_->command_shaker(0.0, 0.0, true) : rig_->command(v.position_mm, s_.safe_rate_mm_s);
     if (!ec && !shaker_) ec = rig_->hold(true);
     if (!ec && !shaker_) ec = rig_->arm(true);
     if (ec) return failed("cannot enable the rig: " + ec.message());
@@ -203,8 +213,8 @@ Supervisor::Arming Supervisor::arming_step(double now, const StatusView& v, std:
   if (now > arming_deadline_) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.3g", s_.arm_timeout_s);
-    return failed("the rig did not report enabled within " + std::string(buf) + " s of enable (" +
-                  describe_status(v.status, v.fault_code, text) + "; is it in mode " + std::to_string(s_.mode) + "?)");
+    return failed("the rig did not report enabled within " + std::string(buf) + " s of enable (" + describe_status(v.status, v.fault_code, text) +
+                  "; is it in mode " + std::to_string(s_.mode) + "?)");
   }
   return Arming::pending;
 }

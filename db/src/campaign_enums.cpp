@@ -4,15 +4,24 @@ namespace hystlab::db {
 
 const char* to_string(CampaignState s) noexcept {
   switch (s) {
-    case CampaignState::queued: return "queued";
-    case CampaignState::held: return "held";
-    case CampaignState::arming: return "arming";
-    case CampaignState::running: return "running";
-    case CampaignState::paused: return "paused";
-    case CampaignState::completed: return "completed";
-    case CampaignState::aborted: return "aborted";
-    case CampaignState::failed: return "failed";
-    case CampaignState::interrupted: return "interrupted";
+    case CampaignState::queued:
+      return "queued";
+    case CampaignState::held:
+      return "held";
+    case CampaignState::arming:
+      return "arming";
+    case CampaignState::running:
+      return "running";
+    case CampaignState::paused:
+      return "paused";
+    case CampaignState::completed:
+      return "completed";
+    case CampaignState::aborted:
+      return "aborted";
+    case CampaignState::failed:
+      return "failed";
+    case CampaignState::interrupted:
+      return "interrupted";
   }
   return "?";
 }
@@ -23,19 +32,18 @@ std::optional<CampaignState> campaign_state_from(std::string_view text) noexcept
   return std::nullopt;
 }
 
-bool is_final(CampaignState s) noexcept {
-  return s == CampaignState::completed || s == CampaignState::aborted || s == CampaignState::failed;
-}
+bool is_final(CampaignState s) noexcept { return s == CampaignState::completed || s == CampaignState::aborted || s == CampaignState::failed; }
 
-bool is_active(CampaignState s) noexcept {
-  return s == CampaignState::arming || s == CampaignState::running || s == CampaignState::paused;
-}
+bool is_active(CampaignState s) noexcept { return s == CampaignState::arming || s == CampaignState::running || s == CampaignState::paused; }
 
 const char* to_string(CampaignKind k) noexcept {
   switch (k) {
-    case CampaignKind::fot: return "fot";
-    case CampaignKind::waveform: return "waveform";
-    case CampaignKind::sine: return "sine";
+    case CampaignKind::fot:
+      return "fot";
+    case CampaignKind::waveform:
+      return "waveform";
+    case CampaignKind::sine:
+      return "sine";
   }
   return "?";
 }
@@ -56,9 +64,12 @@ std::optional<RunRole> run_role_from(std::string_view text) noexcept {
 
 const char* to_string(LoopPhase p) noexcept {
   switch (p) {
-    case LoopPhase::training: return "training";
-    case LoopPhase::rows: return "rows";
-    case LoopPhase::validation: return "validation";
+    case LoopPhase::training:
+      return "training";
+    case LoopPhase::rows:
+      return "rows";
+    case LoopPhase::validation:
+      return "validation";
   }
   return "?";
 }

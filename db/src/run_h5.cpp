@@ -73,8 +73,8 @@ SampleColumns make_columns(hid_t group, const std::array<SignalName, N>& signals
 // Every sample of the run, in seq order; returns how many.
 std::int64_t write_samples(Store& store, hid_t group, const RunInfo& run, RigKind kind, const H5ExportOptions& opt) {
   const std::int64_t last = kind == RigKind::frame ? store.max_seq(run.id) : store.max_shaker_seq(run.id), step = opt.rows_per_read;
-  SampleColumns c = kind == RigKind::frame ? make_columns(group, kFrameSignals, run.wall_anchor_unix, opt)
-                                           : make_columns(group, kShakerSignals, run.wall_anchor_unix, opt);
+  SampleColumns c =
+      kind == RigKind::frame ? make_columns(group, kFrameSignals, run.wall_anchor_unix, opt) : make_columns(group, kShakerSignals, run.wall_anchor_unix, opt);
   std::int64_t n = 0;
   for (std::int64_t s0 = 0; s0 <= last; s0 += step) {
     if (kind == RigKind::frame) {
@@ -151,8 +151,7 @@ H5ExportStats write_runs(Store& store, hid_t file, const char* scope, std::int64
 }
 
 void check_options(const H5ExportOptions& opt) {
-  if (opt.rows_per_read < 1 || opt.rows_per_read > (std::int64_t{1} << 24))
-    throw H5ExportError(H5ExportError::Kind::write, "rows_per_read must be in 1..2^24");
+  if (opt.rows_per_read < 1 || opt.rows_per_read > (std::int64_t{1} << 24)) throw H5ExportError(H5ExportError::Kind::write, "rows_per_read must be in 1..2^24");
 }
 }  // namespace
 

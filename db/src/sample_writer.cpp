@@ -4,8 +4,7 @@
 
 namespace hystlab::db {
 
-SampleWriter::SampleWriter(const std::string& path, WriterOptions options)
-    : opt_(options), path_(path), ring_(options.capacity) {
+SampleWriter::SampleWriter(const std::string& path, WriterOptions options) : opt_(options), path_(path), ring_(options.capacity) {
   // Open (and migrate) here, so a bad path fails at start-up in the caller, not in the thread.
   { Store probe(path_, opt_.synchronous_full); }
   thread_ = std::thread([this] { run(); });

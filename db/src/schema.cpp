@@ -94,8 +94,8 @@ int schema_version(Database& db) {
 void migrate(Database& db) {
   const int v = schema_version(db);
   if (v > kSchemaVersion)
-    throw DbError("database '" + db.path() + "' has schema version " + std::to_string(v) + ", newer than this hystlab (" +
-                      std::to_string(kSchemaVersion) + "): refusing to touch it",
+    throw DbError("database '" + db.path() + "' has schema version " + std::to_string(v) + ", newer than this hystlab (" + std::to_string(kSchemaVersion) +
+                      "): refusing to touch it",
                   0);
   // Each step under the write lock, the version read again inside it: two processes opening a
   // new file at once (the daemon starting, a reader polling for it) both saw version 0, and the

@@ -7,9 +7,7 @@
 
 namespace hystlab::db {
 namespace {
-[[noreturn]] void fail(sqlite3* db, int rc, const std::string& what) {
-  throw DbError(what + ": " + (db ? sqlite3_errmsg(db) : sqlite3_errstr(rc)), rc);
-}
+[[noreturn]] void fail(sqlite3* db, int rc, const std::string& what) { throw DbError(what + ": " + (db ? sqlite3_errmsg(db) : sqlite3_errstr(rc)), rc); }
 }  // namespace
 
 Database::Database(const std::string& path, bool synchronous_full) : path_(path) {
@@ -62,8 +60,7 @@ Statement& Statement::bind(int i, double v) {
   return *this;
 }
 Statement& Statement::bind(int i, std::string_view v) {
-  if (const int rc = sqlite3_bind_text(st_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT); rc != SQLITE_OK)
-    fail(db_.handle(), rc, "bind");
+  if (const int rc = sqlite3_bind_text(st_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT); rc != SQLITE_OK) fail(db_.handle(), rc, "bind");
   return *this;
 }
 Statement& Statement::bind_null(int i) {

@@ -25,8 +25,7 @@ Database& migrated(Database& db) {
 
 struct BlockDelta {
   std::int64_t n = 0;
-  double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min, d_min = t_min, d_max = -t_min,
-         f_min = t_min, f_max = -t_min;
+  double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min, d_min = t_min, d_max = -t_min, f_min = t_min, f_max = -t_min;
   void add(double t, double d, double f) {
     ++n;
     t_min = std::min(t_min, t), t_max = std::max(t_max, t);
@@ -53,12 +52,14 @@ Store::Store(const std::string& path, bool synchronous_full)
                     "t_min = min(t_min, excluded.t_min), t_max = max(t_max, excluded.t_max), "
                     "disp_min = min(disp_min, excluded.disp_min), disp_max = max(disp_max, excluded.disp_max), "
                     "force_min = min(force_min, excluded.force_min), force_max = max(force_max, excluded.force_max)"),
-      insert_shaker_(db_, "INSERT INTO shaker_samples(run_id, seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, "
-                          "mass_displacement_mm, base_accel_m_s2, mass_accel_m_s2, status) VALUES(?,?,?,?,?,?,?,?,?,?)") {}
+      insert_shaker_(db_,
+                     "INSERT INTO shaker_samples(run_id, seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, "
+                     "mass_displacement_mm, base_accel_m_s2, mass_accel_m_s2, status) VALUES(?,?,?,?,?,?,?,?,?,?)") {}
 
 std::int64_t Store::upsert_rig(const std::string& name, const std::string& config, const std::string& now) {
-  Statement st(db_, "INSERT INTO rigs(name, config, created_at) VALUES(?,?,?) "
-                    "ON CONFLICT(name) DO UPDATE SET config = excluded.config RETURNING id");
+  Statement st(db_,
+               "INSERT INTO rigs(name, config, created_at) VALUES(?,?,?) "
+               "ON CONFLICT(name) DO UPDATE SET config = excluded.config RETURNING id");
   st.bind(1, name).bind(2, config).bind(3, now);
   st.step();
   return st.column_int(0);
@@ -128,8 +129,9 @@ std::int64_t Store::add_event(std::int64_t campaign, const std::string& kind, co
 }
 
 std::int64_t Store::add_transmissibility(std::int64_t run, double f, double base, double mass, double ratio, double phase) {
-  Statement st(db_, "INSERT INTO transmissibility(run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad) "
-                    "VALUES(?,?,?,?,?,?)");
+  Statement st(db_,
+               "INSERT INTO transmissibility(run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad) "
+               "VALUES(?,?,?,?,?,?)");
   st.bind(1, run).bind(2, f).bind(3, base).bind(4, mass).bind(5, ratio).bind(6, phase);
   st.step();
   records_changed();
@@ -137,8 +139,9 @@ std::int64_t Store::add_transmissibility(std::int64_t run, double f, double base
 }
 
 std::int64_t Store::add_sine_point(std::int64_t run, const SinePointRow& p) {
-  Statement st(db_, "INSERT INTO transmissibility(run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad, step, demand_mm, "
-                    "direction, detail) VALUES(?,?,?,?,?,?,?,?,?,?)");
+  Statement st(db_,
+               "INSERT INTO transmissibility(run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad, step, demand_mm, "
+               "direction, detail) VALUES(?,?,?,?,?,?,?,?,?,?)");
   st.bind(1, run).bind(2, p.frequency_hz).bind(3, p.base_amplitude_mm).bind(4, p.mass_amplitude_mm).bind(5, p.ratio).bind(6, p.phase_rad);
   st.bind(7, p.step).bind(8, p.demand_mm).bind(9, p.direction).bind(10, p.detail);
   st.step();
@@ -161,11 +164,11 @@ std::int64_t Store::add_fot_node(std::int64_t run, double a, double b, double fa
   return db_.last_insert_rowid();
 }
 
-std::int64_t Store::add_table(std::optional<std::int64_t> campaign, std::optional<std::int64_t> run, const std::string& method,
-                              int n, double lo, double hi, const std::string& now, const std::string& accuracy,
-                              const std::string& document) {
-  Statement st(db_, "INSERT INTO tables(campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy, document) "
-                    "VALUES(?,?,?,?,?,?,?,?,?)");
+std::int64_t Store::add_table(std::optional<std::int64_t> campaign, std::optional<std::int64_t> run, const std::string& method, int n, double lo, double hi,
+                              const std::string& now, const std::string& accuracy, const std::string& document) {
+  Statement st(db_,
+               "INSERT INTO tables(campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy, document) "
+               "VALUES(?,?,?,?,?,?,?,?,?)");
   campaign ? st.bind(1, *campaign) : st.bind_null(1);
   run ? st.bind(2, *run) : st.bind_null(2);
   st.bind(3, method).bind(4, n).bind(5, lo).bind(6, hi).bind(7, now).bind(8, accuracy).bind(9, document);
@@ -181,8 +184,10 @@ int Store::mark_interrupted(const std::string& now) {
     while (st.step()) ids.push_back(st.column_int(0));
   }
   for (auto id : ids)
-    if (table_count(id) > 0) transition(id, CampaignState::completed, "its tables were stored before the daemon stopped", now);
-    else transition(id, CampaignState::interrupted, "the daemon stopped without finishing it", now);
+    if (table_count(id) > 0)
+      transition(id, CampaignState::completed, "its tables were stored before the daemon stopped", now);
+    else
+      transition(id, CampaignState::interrupted, "the daemon stopped without finishing it", now);
   Statement runs(db_, "UPDATE runs SET state = 'interrupted', ended_at = ? WHERE state = 'running'");
   runs.bind(1, now);
   runs.step();
@@ -199,8 +204,9 @@ std::vector<std::int64_t> Store::queued_campaigns(std::int64_t rig) {
 
 std::vector<std::tuple<double, double, double, double>> Store::fot_nodes_of_campaign(std::int64_t campaign) {
   std::vector<std::tuple<double, double, double, double>> out;
-  Statement st(db_, "SELECT alpha, beta, force_alpha, force_alpha_beta FROM fot_nodes JOIN runs ON runs.id = fot_nodes.run_id "
-                    "WHERE runs.campaign_id = ? ORDER BY fot_nodes.id");
+  Statement st(db_,
+               "SELECT alpha, beta, force_alpha, force_alpha_beta FROM fot_nodes JOIN runs ON runs.id = fot_nodes.run_id "
+               "WHERE runs.campaign_id = ? ORDER BY fot_nodes.id");
   st.bind(1, campaign);
   while (st.step()) out.emplace_back(st.column_double(0), st.column_double(1), st.column_double(2), st.column_double(3));
   return out;
@@ -271,8 +277,7 @@ std::optional<CampaignRow> Store::campaign(std::int64_t id) {
 std::vector<CampaignRow> Store::campaigns() {
   std::vector<CampaignRow> out;
   Statement st(db_, "SELECT id, rig_id, kind, plan, state, created_at, updated_at FROM campaigns ORDER BY id");
-  while (st.step())
-    out.push_back(campaign_row(st));
+  while (st.step()) out.push_back(campaign_row(st));
   return out;
 }
 
@@ -308,8 +313,9 @@ std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int 
     const auto k = static_cast<long>((t - t0) / span * static_cast<double>(out.size()));
     return static_cast<std::size_t>(std::clamp<long>(k, 0, static_cast<long>(out.size()) - 1));
   };
-  Statement blocks(db_, "SELECT block, n, t_min, t_max, disp_min, disp_max, force_min, force_max FROM sample_blocks "
-                        "WHERE run_id = ? AND t_max >= ? AND t_min <= ? ORDER BY block");
+  Statement blocks(db_,
+                   "SELECT block, n, t_min, t_max, disp_min, disp_max, force_min, force_max FROM sample_blocks "
+                   "WHERE run_id = ? AND t_max >= ? AND t_min <= ? ORDER BY block");
   blocks.bind(1, run).bind(2, t0).bind(3, t1);
   std::int64_t first = -1, last = -1, total = 0;
   std::vector<Bucket> from_blocks(out.size());
@@ -319,8 +325,8 @@ std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int 
     last = b;
     total += blocks.column_int(1);
     const double tm = 0.5 * (blocks.column_double(2) + blocks.column_double(3));
-    merge(from_blocks[slot(tm)], blocks.column_double(2), blocks.column_double(3), blocks.column_double(4),
-          blocks.column_double(5), blocks.column_double(6), blocks.column_double(7), blocks.column_int(1));
+    merge(from_blocks[slot(tm)], blocks.column_double(2), blocks.column_double(3), blocks.column_double(4), blocks.column_double(5), blocks.column_double(6),
+          blocks.column_double(7), blocks.column_int(1));
   }
   if (first < 0) return {};
   const std::int64_t nblocks = last - first + 1;
@@ -336,9 +342,8 @@ std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int 
     if (t >= t0 && t <= t1) merge(out[slot(t)], t, t, d, d, f, f, 1);
   };
   if (shaker)
-    for_each_shaker_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const ShakerRow& r) {
-      take(r.t, r.v[shaker_signal::base_displacement], r.v[shaker_signal::mass_displacement]);
-    });
+    for_each_shaker_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1,
+                           [&](const ShakerRow& r) { take(r.t, r.v[shaker_signal::base_displacement], r.v[shaker_signal::mass_displacement]); });
   else
     for_each_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const SampleRow& r) { take(r.t, r.disp, r.force); });
   std::erase_if(out, [](const Bucket& b) { return b.n == 0; });
@@ -348,13 +353,13 @@ std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int 
 void Store::for_each_sample(std::int64_t run, std::int64_t seq0, std::int64_t seq1, const std::function<void(const SampleRow&)>& f) {
   Statement st(db_, "SELECT seq, t, cmd, disp, force, status FROM samples WHERE run_id = ? AND seq BETWEEN ? AND ? ORDER BY seq");
   st.bind(1, run).bind(2, seq0).bind(3, seq1);
-  while (st.step())
-    f(SampleRow{run, st.column_int(0), st.column_double(1), st.column_double(2), st.column_double(3), st.column_double(4), st.column_int(5)});
+  while (st.step()) f(SampleRow{run, st.column_int(0), st.column_double(1), st.column_double(2), st.column_double(3), st.column_double(4), st.column_int(5)});
 }
 
 void Store::for_each_shaker_sample(std::int64_t run, std::int64_t seq0, std::int64_t seq1, const std::function<void(const ShakerRow&)>& f) {
-  Statement st(db_, "SELECT seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, mass_displacement_mm, base_accel_m_s2, "
-                    "mass_accel_m_s2, status FROM shaker_samples WHERE run_id = ? AND seq BETWEEN ? AND ? ORDER BY seq");
+  Statement st(db_,
+               "SELECT seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, mass_displacement_mm, base_accel_m_s2, "
+               "mass_accel_m_s2, status FROM shaker_samples WHERE run_id = ? AND seq BETWEEN ? AND ? ORDER BY seq");
   st.bind(1, run).bind(2, seq0).bind(3, seq1);
   while (st.step()) {
     ShakerRow r{run, st.column_int(0), st.column_double(1), {}, st.column_int(8)};

@@ -42,8 +42,7 @@ std::vector<std::int64_t> Store::finish_run(const RunEnd& e) {
     st.step();
   }
   if (table_count(e.campaign) == 0) {
-    for (const TableRecord& t : e.tables)
-      ids.push_back(add_table(e.campaign, e.run, t.method, t.n, t.lo, t.hi, e.now, t.accuracy_json, t.document_json));
+    for (const TableRecord& t : e.tables) ids.push_back(add_table(e.campaign, e.run, t.method, t.n, t.lo, t.hi, e.now, t.accuracy_json, t.document_json));
     if (e.recommended && *e.recommended < ids.size()) {
       const TableRecord& t = e.tables[*e.recommended];
       // JSON by hand: db/ has no JSON library; the reason is escaped for its quotes and backslashes.
@@ -52,10 +51,10 @@ std::vector<std::int64_t> Store::finish_run(const RunEnd& e) {
         if (ch == '"' || ch == '\\') why += '\\';
         if (static_cast<unsigned char>(ch) >= 0x20) why += ch;
       }
-      add_event(e.campaign, "recommendation",
-                "{\"table\":" + std::to_string(ids[*e.recommended]) + ",\"method\":\"" + t.method + "\",\"n\":" + std::to_string(t.n) +
-                    ",\"why\":\"" + why + "\"}",
-                e.now);
+      add_event(
+          e.campaign, "recommendation",
+          "{\"table\":" + std::to_string(ids[*e.recommended]) + ",\"method\":\"" + t.method + "\",\"n\":" + std::to_string(t.n) + ",\"why\":\"" + why + "\"}",
+          e.now);
     }
   }
   for (const LoopRecord& l : e.loops) {

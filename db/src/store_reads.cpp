@@ -13,8 +13,8 @@ constexpr const char* kNodeSelect =
     "SELECT f.id, r.campaign_id, f.run_id, alpha, beta, force_alpha, force_alpha_beta, coalesce(f.t, 0) FROM fot_nodes f JOIN runs r ON r.id = f.run_id ";
 
 RunInfo run_row(Statement& st) {
-  return {st.column_int(0), st.column_int(1), st.column_text(2), st.column_text(3), st.column_text(4), st.column_double(5), st.column_int(6), st.column_int(7),
-          st.column_text(8)};
+  return {st.column_int(0),    st.column_int(1), st.column_text(2), st.column_text(3), st.column_text(4),
+          st.column_double(5), st.column_int(6), st.column_int(7),  st.column_text(8)};
 }
 TableInfo table_row(Statement& st) {
   TableInfo t;
@@ -26,8 +26,8 @@ TableInfo table_row(Statement& st) {
   return t;
 }
 NodeInfo node_row(Statement& st) {
-  return {st.column_int(0), st.column_int(1), st.column_int(2), st.column_double(3), st.column_double(4), st.column_double(5), st.column_double(6),
-          st.column_double(7)};
+  return {st.column_int(0),    st.column_int(1),    st.column_int(2),    st.column_double(3),
+          st.column_double(4), st.column_double(5), st.column_double(6), st.column_double(7)};
 }
 template <class Row, class F>
 std::vector<Row> all(Statement& st, F row) {
@@ -125,13 +125,14 @@ std::vector<NodeInfo> Store::nodes(std::int64_t campaign) {
 }
 
 std::vector<TransmissibilityInfo> Store::transmissibility(std::int64_t campaign) {
-  Statement st(db_, "SELECT t.id, t.run_id, frequency_hz, coalesce(base_amplitude_mm, 0), coalesce(mass_amplitude_mm, 0), coalesce(ratio, 0), "
-                    "coalesce(phase_rad, 0), coalesce(step, 0), coalesce(demand_mm, 0), coalesce(direction, ''), coalesce(detail, ''), "
-                    "predicted_ratio, predicted_phase_rad FROM transmissibility t JOIN runs r ON r.id = t.run_id WHERE r.campaign_id = ? ORDER BY t.id");
+  Statement st(db_,
+               "SELECT t.id, t.run_id, frequency_hz, coalesce(base_amplitude_mm, 0), coalesce(mass_amplitude_mm, 0), coalesce(ratio, 0), "
+               "coalesce(phase_rad, 0), coalesce(step, 0), coalesce(demand_mm, 0), coalesce(direction, ''), coalesce(detail, ''), "
+               "predicted_ratio, predicted_phase_rad FROM transmissibility t JOIN runs r ON r.id = t.run_id WHERE r.campaign_id = ? ORDER BY t.id");
   st.bind(1, campaign);
   return all<TransmissibilityInfo>(st, [](Statement& s) {
-    TransmissibilityInfo t{s.column_int(0), s.column_int(1), s.column_double(2), s.column_double(3), s.column_double(4), s.column_double(5),
-                           s.column_double(6), s.column_int(7), s.column_double(8), s.column_text(9), s.column_text(10)};
+    TransmissibilityInfo t{s.column_int(0),    s.column_int(1), s.column_double(2), s.column_double(3), s.column_double(4), s.column_double(5),
+                           s.column_double(6), s.column_int(7), s.column_double(8), s.column_text(9),   s.column_text(10)};
     if (!s.column_is_null(11)) t.predicted_ratio = s.column_double(11), t.predicted_phase_rad = s.column_double(12);
     return t;
   });
@@ -152,8 +153,9 @@ std::string Store::state_reason(std::int64_t campaign, CampaignState state) {
 }
 
 std::vector<EventInfo> Store::events_after(std::int64_t id, int limit) {
-  Statement st(db_, "SELECT id, coalesce(campaign_id, 0), at, kind, coalesce(from_state, ''), coalesce(to_state, ''), coalesce(detail, '') "
-                    "FROM events WHERE id > ? ORDER BY id LIMIT ?");
+  Statement st(db_,
+               "SELECT id, coalesce(campaign_id, 0), at, kind, coalesce(from_state, ''), coalesce(to_state, ''), coalesce(detail, '') "
+               "FROM events WHERE id > ? ORDER BY id LIMIT ?");
   st.bind(1, id);
   st.bind(2, static_cast<std::int64_t>(limit));
   return all<EventInfo>(st, [](Statement& s) {

@@ -57,15 +57,13 @@ void CanEndpoint::maybe_send(double now_s, const SignalValues& m, protocols::Rig
   if (faults.can_silent || gone_) return;
   auto g = [&](Signal s) { return m[static_cast<std::size_t>(s)]; };
   can::Message first;
-  if (kind == protocols::RigKind::load_frame) first = can::StatusA{g(Signal::displacement_mm), g(Signal::force_N)};
-  else first = can::ShakerStatus{g(Signal::base_accel_m_s2), g(Signal::mass_accel_m_s2), g(Signal::base_displacement_mm),
-                                 g(Signal::mass_displacement_mm)};
+  if (kind == protocols::RigKind::load_frame)
+    first = can::StatusA{g(Signal::displacement_mm), g(Signal::force_N)};
+  else
+    first = can::ShakerStatus{g(Signal::base_accel_m_s2), g(Signal::mass_accel_m_s2), g(Signal::base_displacement_mm), g(Signal::mass_displacement_mm)};
   const double cmd = kind == protocols::RigKind::load_frame ? g(Signal::command_mm) : 0.0;
-  const can::Message cycle[] = {
-      first,
-      can::StatusB{cmd, static_cast<std::uint16_t>(g(Signal::status_word)), static_cast<std::uint16_t>(g(Signal::fault_code))},
-      can::Heartbeat{heartbeat_++},
-      can::StatusC{static_cast<std::uint32_t>(g(Signal::sample_counter))}};
+  const can::Message cycle[] = {first, can::StatusB{cmd, static_cast<std::uint16_t>(g(Signal::status_word)), static_cast<std::uint16_t>(g(Signal::fault_code))},
+                                can::Heartbeat{heartbeat_++}, can::StatusC{static_cast<std::uint32_t>(g(Signal::sample_counter))}};
   for (const auto& msg : cycle) {
     can_frame f{};
     if (can::encode(msg, node_, f)) continue;  // a value the frame cannot carry is not sent

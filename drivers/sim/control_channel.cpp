@@ -59,15 +59,19 @@ bool ControlChannel::handle(int fd, Faults& faults, SimRig& rig, const std::stri
     buffer_.erase(0, nl + 1);
     if (!line.empty() && line.back() == '\r') line.pop_back();
     std::string answer;
-    if (line == "status") answer = "ok " + status + " faults: " + faults.describe() + " controller: " + rig.describe_controller();
-    else if (line == "quit") answer = "ok bye", quit = true;
-    else if (line == "clear") answer = "ok " + faults.apply("clear");  // latched controller faults stay: they need fault_reset
+    if (line == "status")
+      answer = "ok " + status + " faults: " + faults.describe() + " controller: " + rig.describe_controller();
+    else if (line == "quit")
+      answer = "ok bye", quit = true;
+    else if (line == "clear")
+      answer = "ok " + faults.apply("clear");  // latched controller faults stay: they need fault_reset
     else if (line.rfind("fault ", 0) == 0) {
       std::string spec = line.substr(6);
       if (const auto sp = spec.find(' '); sp != std::string::npos) spec[sp] = '=';
       const std::string err = apply_fault(spec, faults, rig);
       answer = err.empty() ? "ok " + faults.describe() + " controller: " + rig.describe_controller() : "error " + err;
-    } else answer = "error unknown command '" + line + "' (fault NAME [VALUE], clear, status, quit)";
+    } else
+      answer = "error unknown command '" + line + "' (fault NAME [VALUE], clear, status, quit)";
     answer += "\n";
     (void)!write(client_, answer.data(), answer.size());
   }

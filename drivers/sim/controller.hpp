@@ -18,8 +18,8 @@ enum FaultCode : std::uint16_t {
 struct ControllerParams {
   bool mode_interlock = false;  // the rig has a mode signal: it moves only in `mode`
   std::uint16_t mode = 1;
-  double host_timeout_s = 0;    // 0: no heartbeat watchdog
-  bool limit_recovery = true;   // a reset beyond the stroke enters limit recovery (a real frame's limit override)
+  double host_timeout_s = 0;   // 0: no heartbeat watchdog
+  bool limit_recovery = true;  // a reset beyond the stroke enters limit recovery (a real frame's limit override)
 };
 
 // The host's commands the controller logic watches (the rest is physics).
@@ -39,9 +39,9 @@ class Controller {
   // offers it): limit_tripped stays, the drive may be enabled, and the frame's owner lets it move
   // only back toward its stroke, slowly, until end_recovery().
   void command(const HostCommands& c, double now_s, bool cause_present) noexcept;
-  void press_estop() noexcept;               // the operator's button: latches like the signal
-  void latch(std::uint16_t code) noexcept;   // the first fault's code stays until the reset
-  void watch(double now_s) noexcept;         // the heartbeat watchdog, once per sample
+  void press_estop() noexcept;              // the operator's button: latches like the signal
+  void latch(std::uint16_t code) noexcept;  // the first fault's code stays until the reset
+  void watch(double now_s) noexcept;        // the heartbeat watchdog, once per sample
 
   [[nodiscard]] bool stopped() const noexcept { return estop_ || code_ != kNoFault; }
   [[nodiscard]] bool mode_ok() const noexcept { return !p_.mode_interlock || mode_ == p_.mode; }

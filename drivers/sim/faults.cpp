@@ -18,15 +18,24 @@ std::string Faults::apply(const std::string& spec) {
       return "fault '" + name + "': value '" + spec.substr(eq + 1) + "' is not a whole number";
     }
   }
-  if (name == "drop") drop = true;
-  else if (name == "delay") delay_ms = value > 0 ? value : 200;
-  else if (name == "stall") stall_ms = value > 0 ? value : 30;
-  else if (name == "exception") exception = value > 0 ? value : 4;
-  else if (name == "crc") crc = true;
-  else if (name == "freeze") freeze = true;
-  else if (name == "overload") overload = true;
-  else if (name == "can-silent") can_silent = true;
-  else if (name == "clear") *this = Faults{};
+  if (name == "drop")
+    drop = true;
+  else if (name == "delay")
+    delay_ms = value > 0 ? value : 200;
+  else if (name == "stall")
+    stall_ms = value > 0 ? value : 30;
+  else if (name == "exception")
+    exception = value > 0 ? value : 4;
+  else if (name == "crc")
+    crc = true;
+  else if (name == "freeze")
+    freeze = true;
+  else if (name == "overload")
+    overload = true;
+  else if (name == "can-silent")
+    can_silent = true;
+  else if (name == "clear")
+    *this = Faults{};
   else
     return "unknown fault '" + name +
            "' (drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload, can-silent, estop, latch=CODE, deadband=MM, overtravel=MM, clear)";

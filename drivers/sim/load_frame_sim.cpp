@@ -8,8 +8,7 @@
 namespace hystlab::sim {
 namespace st = protocols::status;
 
-SmoothedSpecimen::SmoothedSpecimen(std::unique_ptr<models::HysteresisModel> model, double width_mm)
-    : model_(std::move(model)), width_(width_mm) {
+SmoothedSpecimen::SmoothedSpecimen(std::unique_ptr<models::HysteresisModel> model, double width_mm) : model_(std::move(model)), width_(width_mm) {
   x_ = model_->input();
   f_ = sharp_ = model_->output();
 }
@@ -25,8 +24,10 @@ double SmoothedSpecimen::step(double x) noexcept {
   }
   const int dir = dx > 0 ? 1 : -1;
   const double k = (f - sharp_) / dx;
-  if (dir != dir_) slope_ = k;  // a reversal: the new branch's slope at once
-  else slope_ += (k - slope_) * (1.0 - std::exp(-std::fabs(dx) / width_));
+  if (dir != dir_)
+    slope_ = k;  // a reversal: the new branch's slope at once
+  else
+    slope_ += (k - slope_) * (1.0 - std::exp(-std::fabs(dx) / width_));
   f_ += slope_ * dx;
   f_ += (f - f_) * (1.0 - std::exp(-std::fabs(dx) / (4 * width_)));
   dir_ = dir;
@@ -72,8 +73,10 @@ void LoadFrameSim::check_limits() noexcept {
   const double x = std::fabs(state_.displacement_mm);
   if (ctl_.recovering()) {
     recovery_closest_ = std::min(recovery_closest_, x);
-    if (x <= p_.limit_mm) ctl_.end_recovery();
-    else if (x > recovery_closest_ + kRecoveryOutward) ctl_.end_recovery(), ctl_.latch(kDisplacementLimit);
+    if (x <= p_.limit_mm)
+      ctl_.end_recovery();
+    else if (x > recovery_closest_ + kRecoveryOutward)
+      ctl_.end_recovery(), ctl_.latch(kDisplacementLimit);
   } else if (x > p_.limit_mm) {
     ctl_.latch(kDisplacementLimit);
   }

@@ -13,18 +13,18 @@
 namespace hystlab::sim {
 
 struct LoadFrameParams {
-  double lag_s = 0.005;              // actuator time constant
-  double max_rate_mm_s = 500;        // the valve's limit, whatever the ramp rate asks
-  double limit_mm = 12.0;            // hard displacement limits ±limit_mm
-  double load_cell_range_N = 5000;   // beyond it the load cell trips the frame
-  double noise_N = 0.05;             // load cell noise, 1 σ
-  double drift_N_per_s = 0.0;        // slow load cell drift
+  double lag_s = 0.005;               // actuator time constant
+  double max_rate_mm_s = 500;         // the valve's limit, whatever the ramp rate asks
+  double limit_mm = 12.0;             // hard displacement limits ±limit_mm
+  double load_cell_range_N = 5000;    // beyond it the load cell trips the frame
+  double noise_N = 0.05;              // load cell noise, 1 σ
+  double drift_N_per_s = 0.0;         // slow load cell drift
   double corner_width_mm = 0.05;      // corner smoothing of the specimen (0: none)
-  double deadband_mm = 0;            // the servo stops correcting when |command - displacement| < this
-  double recovery_rate_mm_s = 1.0;   // limit recovery: the fastest the frame moves back into its stroke
-  double overtravel_rate_mm_s = 5.0; // the outside push of `fault overtravel` (a hand set's jog)
+  double deadband_mm = 0;             // the servo stops correcting when |command - displacement| < this
+  double recovery_rate_mm_s = 1.0;    // limit recovery: the fastest the frame moves back into its stroke
+  double overtravel_rate_mm_s = 5.0;  // the outside push of `fault overtravel` (a hand set's jog)
   std::uint64_t seed = 1;
-  ControllerParams controller;       // mode interlock and host watchdog (default: neither)
+  ControllerParams controller;  // mode interlock and host watchdog (default: neither)
 };
 
 // The specimen's force with its corners rounded, in displacement (not in time, so the loop keeps

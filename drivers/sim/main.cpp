@@ -77,7 +77,7 @@ struct Args {
   double time_scale = 1, sample_rate = 1000, can_rate = 1000, noise = 0.05, drift = 0, corner = 0.05, duration = 0;
   double deadband_mm = 0, host_timeout_ms = 0, mode = 1;
   double shakedown_N = 0, shakedown_tau = 0;  // 0: a trained specimen
-  double linear = 0;                           // > 0: a linear spring of this stiffness (N/mm)
+  double linear = 0;                          // > 0: a linear spring of this stiffness (N/mm)
   bool exit_with_parent = false;
   std::uint64_t seed = 1;
   std::vector<std::string> faults;
@@ -111,24 +111,42 @@ Args parse(int argc, char** argv) {
         throw std::runtime_error("option " + o + ": '" + v + "' is not a number");
       }
     };
-    if (o == "--rig") a.rig = v;
-    else if (o == "--transport") a.transport = v;
-    else if (o == "--address") a.address = v;
-    else if (o == "--port") a.port = static_cast<int>(num());
-    else if (o == "--map") a.map = v;
-    else if (o == "--can-fd") a.can_fd = static_cast<int>(num());
-    else if (o == "--can-node") a.can_node = static_cast<int>(num());
-    else if (o == "--can-rate") a.can_rate = num();
-    else if (o == "--time-scale") a.time_scale = num();
-    else if (o == "--pace") a.pace = v;
-    else if (o == "--sample-rate") a.sample_rate = num();
-    else if (o == "--seed") a.seed = static_cast<std::uint64_t>(num());
-    else if (o == "--noise") a.noise = num();
-    else if (o == "--drift") a.drift = num();
-    else if (o == "--params") a.params = v;
-    else if (o == "--table") a.table = v;
-    else if (o == "--linear") a.linear = num();
-    else if (o == "--corner-width") a.corner = num();
+    if (o == "--rig")
+      a.rig = v;
+    else if (o == "--transport")
+      a.transport = v;
+    else if (o == "--address")
+      a.address = v;
+    else if (o == "--port")
+      a.port = static_cast<int>(num());
+    else if (o == "--map")
+      a.map = v;
+    else if (o == "--can-fd")
+      a.can_fd = static_cast<int>(num());
+    else if (o == "--can-node")
+      a.can_node = static_cast<int>(num());
+    else if (o == "--can-rate")
+      a.can_rate = num();
+    else if (o == "--time-scale")
+      a.time_scale = num();
+    else if (o == "--pace")
+      a.pace = v;
+    else if (o == "--sample-rate")
+      a.sample_rate = num();
+    else if (o == "--seed")
+      a.seed = static_cast<std::uint64_t>(num());
+    else if (o == "--noise")
+      a.noise = num();
+    else if (o == "--drift")
+      a.drift = num();
+    else if (o == "--params")
+      a.params = v;
+    else if (o == "--table")
+      a.table = v;
+    else if (o == "--linear")
+      a.linear = num();
+    else if (o == "--corner-width")
+      a.corner = num();
     else if (o == "--shakedown") {
       const auto comma = v.find(',');
       char* end = nullptr;
@@ -138,16 +156,24 @@ Args parse(int argc, char** argv) {
       if (!first_ok || end != v.c_str() + v.size() || !(a.shakedown_N > 0) || !(a.shakedown_tau > 0) || !std::isfinite(a.shakedown_N) ||
           !std::isfinite(a.shakedown_tau))
         throw std::runtime_error("option --shakedown: expected EXTRA_N,TAU_CYCLES, both > 0 (e.g. 10,3), got '" + v + "'");
-    }
-    else if (o == "--fault") a.faults.push_back(v);
-    else if (o == "--deadband-mm") a.deadband_mm = num();
-    else if (o == "--mode") a.mode = num();
-    else if (o == "--host-timeout-ms") a.host_timeout_ms = num();
-    else if (o == "--control-port") a.control_port = static_cast<int>(num());
-    else if (o == "--duration") a.duration = num();
-    else if (o == "--exit-with-parent") a.exit_with_parent = num() != 0;
-    else if (o == "--realtime") a.realtime = static_cast<int>(num());
-    else throw std::runtime_error("unknown option " + o + " (see --help)");
+    } else if (o == "--fault")
+      a.faults.push_back(v);
+    else if (o == "--deadband-mm")
+      a.deadband_mm = num();
+    else if (o == "--mode")
+      a.mode = num();
+    else if (o == "--host-timeout-ms")
+      a.host_timeout_ms = num();
+    else if (o == "--control-port")
+      a.control_port = static_cast<int>(num());
+    else if (o == "--duration")
+      a.duration = num();
+    else if (o == "--exit-with-parent")
+      a.exit_with_parent = num() != 0;
+    else if (o == "--realtime")
+      a.realtime = static_cast<int>(num());
+    else
+      throw std::runtime_error("unknown option " + o + " (see --help)");
   }
   if (a.rig != "load_frame" && a.rig != "shaker") throw std::runtime_error("--rig must be load_frame or shaker");
   if (a.transport != "tcp" && a.transport != "rtu" && a.transport != "can") throw std::runtime_error("--transport must be tcp, rtu or can");
@@ -180,8 +206,8 @@ std::optional<protocols::RegisterMap> load_map(const Args& a) {
   protocols::RegisterMap map = protocols::RegisterMap::from_json(text);
   if ((map.kind() == protocols::RigKind::shaker) != (a.rig == "shaker")) throw std::runtime_error("the map is for another kind of rig than --rig " + a.rig);
   if (const double p = map.sample_period_s(); p > 0 && std::fabs(p * a.sample_rate - 1.0) > 1e-9)
-    throw std::runtime_error(std::string(map.sample_window() ? "the map's sample_window.period_s (" : "the map's sample_period_s (") +
-                             std::to_string(p) + " s) is not the period of --sample-rate " + std::to_string(a.sample_rate) + " Hz");
+    throw std::runtime_error(std::string(map.sample_window() ? "the map's sample_window.period_s (" : "the map's sample_period_s (") + std::to_string(p) +
+                             " s) is not the period of --sample-rate " + std::to_string(a.sample_rate) + " Hz");
   return map;
 }
 
@@ -224,8 +250,7 @@ int run(const Args& a) {
   if (a.transport == "can") {
     can.emplace(a.can_fd, a.can_node, a.can_rate);
   } else {
-    modbus.emplace(a.transport == "tcp" ? sim::ModbusEndpoint::Transport::tcp : sim::ModbusEndpoint::Transport::rtu,
-                   a.address, a.port, std::move(*map));
+    modbus.emplace(a.transport == "tcp" ? sim::ModbusEndpoint::Transport::tcp : sim::ModbusEndpoint::Transport::rtu, a.address, a.port, std::move(*map));
     std::cout << modbus->where() << "\n";
   }
   if (a.realtime > 0) {

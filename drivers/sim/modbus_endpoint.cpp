@@ -40,15 +40,13 @@ ModbusEndpoint::ModbusEndpoint(Transport t, const std::string& address, int port
     ctx_ = modbus_new_tcp(address.c_str(), port);
     if (!ctx_) throw std::runtime_error("hystlab-sim: bad TCP address " + address);
     listen_fd_ = modbus_tcp_listen(ctx_, 16);
-    if (listen_fd_ < 0)
-      throw std::runtime_error("hystlab-sim: cannot listen on " + address + ":" + std::to_string(port) + ": " + modbus_strerror(errno));
+    if (listen_fd_ < 0) throw std::runtime_error("hystlab-sim: cannot listen on " + address + ":" + std::to_string(port) + ": " + modbus_strerror(errno));
     sockaddr_in sa{};
     socklen_t len = sizeof sa;
     getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&sa), &len);
     port_ = ntohs(sa.sin_port);
   } else {
-    if (openpty(&pty_master_, &pty_slave_, nullptr, nullptr, nullptr) != 0)
-      throw std::runtime_error("hystlab-sim: cannot open a pseudo-terminal");
+    if (openpty(&pty_master_, &pty_slave_, nullptr, nullptr, nullptr) != 0) throw std::runtime_error("hystlab-sim: cannot open a pseudo-terminal");
     termios tio{};
     tcgetattr(pty_slave_, &tio);
     cfmakeraw(&tio);  // no echo or line editing before the client sets its own modes
@@ -170,7 +168,8 @@ SignalValues ModbusEndpoint::written_commands() const {
   for (const auto& e : map_.entries()) {
     if (!protocols::is_command(e.signal)) continue;
     std::uint16_t words[2] = {0, 0};
-    if (e.table == ModbusTable::coil) words[0] = mapping_->tab_bits[e.address];
+    if (e.table == ModbusTable::coil)
+      words[0] = mapping_->tab_bits[e.address];
     else
       for (int k = 0; k < e.width(); ++k) words[k] = mapping_->tab_registers[e.address + k];
     double value = 0;
@@ -195,8 +194,12 @@ void ModbusEndpoint::publish(const SignalValues& m) {
     std::uint16_t words[2] = {0, 0};
     if (protocols::encode(e, value, words)) continue;  // out of the type's range: keep the last value
     switch (e.table) {
-      case ModbusTable::coil: mapping_->tab_bits[e.address] = static_cast<std::uint8_t>(words[0]); break;
-      case ModbusTable::discrete_input: mapping_->tab_input_bits[e.address] = static_cast<std::uint8_t>(words[0]); break;
+      case ModbusTable::coil:
+        mapping_->tab_bits[e.address] = static_cast<std::uint8_t>(words[0]);
+        break;
+      case ModbusTable::discrete_input:
+        mapping_->tab_input_bits[e.address] = static_cast<std::uint8_t>(words[0]);
+        break;
       case ModbusTable::holding_register:
         for (int k = 0; k < e.width(); ++k) mapping_->tab_registers[e.address + k] = words[k];
         break;

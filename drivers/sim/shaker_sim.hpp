@@ -30,11 +30,11 @@ struct ShakerParams {
   double mass_kg = 13.0;
   int springs = 4;
   double damping_N_s_per_m = 58.0;  // structural damping beside the springs
-  double k_max_N_per_mm = 150;     // stiffest line of the spring model, for the stability check
+  double k_max_N_per_mm = 150;      // stiffest line of the spring model, for the stability check
   double dt_s = 1e-4;
   double table_mass_kg = 20.0;  // the moving table (armature, fixture)
   double servo_hz = 60.0, servo_damping = 0.4;
-  ControllerParams controller;     // mode interlock and host watchdog (default: neither)
+  ControllerParams controller;  // mode interlock and host watchdog (default: neither)
 };
 
 struct ShakerCommands {
@@ -75,7 +75,7 @@ class ShakerSim {
   ShakerState state_;
   double phase_ = 0, carry_ = 0;
   double x_ = 0, v_ = 0, preload_mm_ = 0;  // mass displacement (m, from static equilibrium) and velocity
-  double y_ = 0, yv_ = 0, weight_N_ = 0;    // the table's displacement (m) and velocity; the springs' static force
+  double y_ = 0, yv_ = 0, weight_N_ = 0;   // the table's displacement (m) and velocity; the springs' static force
 };
 
 }  // namespace hystlab::sim

@@ -20,14 +20,15 @@ void apply_controller_commands(const SignalValues& v, Commands& c) {
   if (given(Signal::estop)) c.estop = at(v, Signal::estop) != 0;
   if (given(Signal::fault_reset)) c.fault_reset = at(v, Signal::fault_reset) != 0;
   if (given(Signal::mode)) c.mode = static_cast<std::uint16_t>(std::clamp(at(v, Signal::mode), 0.0, 65535.0));
-  if (given(Signal::host_heartbeat))
-    c.host_heartbeat = static_cast<std::uint32_t>(std::clamp(at(v, Signal::host_heartbeat), 0.0, 4294967295.0));
+  if (given(Signal::host_heartbeat)) c.host_heartbeat = static_cast<std::uint32_t>(std::clamp(at(v, Signal::host_heartbeat), 0.0, 4294967295.0));
 }
 }  // namespace
 
 void SimRig::step(double dt) noexcept {
-  if (frame_) frame_->step(dt);
-  else shaker_->step(dt);
+  if (frame_)
+    frame_->step(dt);
+  else
+    shaker_->step(dt);
 }
 
 void SimRig::apply(const SignalValues& v) noexcept {
@@ -49,13 +50,17 @@ void SimRig::apply(const SignalValues& v) noexcept {
 }
 
 void SimRig::press_estop() noexcept {
-  if (frame_) frame_->press_estop();
-  else shaker_->press_estop();
+  if (frame_)
+    frame_->press_estop();
+  else
+    shaker_->press_estop();
 }
 
 void SimRig::latch_fault(std::uint16_t code) noexcept {
-  if (frame_) frame_->latch_fault(code);
-  else shaker_->latch_fault(code);
+  if (frame_)
+    frame_->latch_fault(code);
+  else
+    shaker_->latch_fault(code);
 }
 
 std::string SimRig::set_deadband(double mm) {

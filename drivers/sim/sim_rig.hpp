@@ -19,9 +19,7 @@ class SimRig {
  public:
   explicit SimRig(std::unique_ptr<LoadFrameSim> frame) : frame_(std::move(frame)) {}
   explicit SimRig(std::unique_ptr<ShakerSim> shaker) : shaker_(std::move(shaker)) {}
-  [[nodiscard]] protocols::RigKind kind() const noexcept {
-    return frame_ ? protocols::RigKind::load_frame : protocols::RigKind::shaker;
-  }
+  [[nodiscard]] protocols::RigKind kind() const noexcept { return frame_ ? protocols::RigKind::load_frame : protocols::RigKind::shaker; }
   void step(double dt) noexcept;
   // Command signals present in values (NaN: not given) are applied.
   void apply(const SignalValues& values) noexcept;
@@ -36,9 +34,7 @@ class SimRig {
   std::string overtravel(double mm);    // the frame pushed toward mm from outside (an error for a shaker)
   // The enable command as the controller holds it: a reset drops it, and a Modbus server shows
   // that in the enable coil, so the host must write enable again.
-  [[nodiscard]] protocols::Signal enable_signal() const noexcept {
-    return frame_ ? protocols::Signal::enable : protocols::Signal::shaker_enable;
-  }
+  [[nodiscard]] protocols::Signal enable_signal() const noexcept { return frame_ ? protocols::Signal::enable : protocols::Signal::shaker_enable; }
   [[nodiscard]] bool enable_command() const noexcept;
   [[nodiscard]] std::string describe_controller() const;
 

@@ -58,8 +58,7 @@ std::unique_ptr<CanChannel> open_socketcan(const std::string& interface) {
     const int err = errno;
     if (err == EAFNOSUPPORT)
       throw std::system_error(err, std::generic_category(),
-                              "cannot open CAN interface '" + interface +
-                                  "': this kernel has no SocketCAN support (socket(PF_CAN, SOCK_RAW, CAN_RAW) failed)");
+                              "cannot open CAN interface '" + interface + "': this kernel has no SocketCAN support (socket(PF_CAN, SOCK_RAW, CAN_RAW) failed)");
     throw std::system_error(err, std::generic_category(), "cannot open CAN interface '" + interface + "'");
   }
   ifreq ifr{};

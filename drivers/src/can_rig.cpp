@@ -7,8 +7,7 @@
 namespace hystlab::drivers {
 namespace can = protocols::can;
 
-CanRig::CanRig(std::unique_ptr<CanChannel> channel, CanRigConfig config)
-    : channel_(std::move(channel)), cfg_(std::move(config)) {}
+CanRig::CanRig(std::unique_ptr<CanChannel> channel, CanRigConfig config) : channel_(std::move(channel)), cfg_(std::move(config)) {}
 
 std::error_code CanRig::send(const can::Message& m) noexcept {
   can_frame f{};
@@ -31,10 +30,14 @@ bool CanRig::absorb(const can_frame& f, bool shaker) noexcept {
     health_.record_error(RigError::protocol_error);
     return false;
   }
-  if (auto* a = std::get_if<can::StatusA>(&m)) pending_a_ = *a, have_a_ = true;
-  else if (auto* b = std::get_if<can::StatusB>(&m)) pending_b_ = *b, have_b_ = true;
-  else if (auto* s = std::get_if<can::ShakerStatus>(&m)) pending_shaker_ = *s, have_a_ = true;
-  else if (auto* h = std::get_if<can::Heartbeat>(&m)) heartbeat_ = h->counter;
+  if (auto* a = std::get_if<can::StatusA>(&m))
+    pending_a_ = *a, have_a_ = true;
+  else if (auto* b = std::get_if<can::StatusB>(&m))
+    pending_b_ = *b, have_b_ = true;
+  else if (auto* s = std::get_if<can::ShakerStatus>(&m))
+    pending_shaker_ = *s, have_a_ = true;
+  else if (auto* h = std::get_if<can::Heartbeat>(&m))
+    heartbeat_ = h->counter;
   else if (auto* c = std::get_if<can::StatusC>(&m)) {
     const bool complete = have_a_ && (have_b_ || shaker);
     have_a_ = have_b_ = false;
@@ -94,8 +97,15 @@ std::error_code CanRig::read_sample(double now_s, RigSample& out) noexcept {
 
 std::error_code CanRig::read_shaker(double now_s, ShakerSample& out) noexcept {
   if (auto ec = next_cycle(true)) return ec;
-  out = ShakerSample{now_s, shaker_.base_accel_m_s2, shaker_.mass_accel_m_s2, shaker_.base_displacement_mm,
-                     shaker_.mass_displacement_mm, b_.status_word, b_.fault_code, heartbeat_, counter_};
+  out = ShakerSample{now_s,
+                     shaker_.base_accel_m_s2,
+                     shaker_.mass_accel_m_s2,
+                     shaker_.base_displacement_mm,
+                     shaker_.mass_displacement_mm,
+                     b_.status_word,
+                     b_.fault_code,
+                     heartbeat_,
+                     counter_};
   return {};
 }
 
@@ -133,8 +143,6 @@ std::error_code CanRig::reset_faults() noexcept {
   if (ec) return ec;
   return send_command();
 }
-std::error_code CanRig::command_shaker(double f, double a, bool enable) noexcept {
-  return send(can::ShakerCommand{f, a, enable});
-}
+std::error_code CanRig::command_shaker(double f, double a, bool enable) noexcept { return send(can::ShakerCommand{f, a, enable}); }
 
 }  // namespace hystlab::drivers

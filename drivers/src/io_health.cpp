@@ -10,16 +10,26 @@ class Category final : public std::error_category {
   const char* name() const noexcept override { return "hystlab.rig"; }
   std::string message(int c) const override {
     switch (static_cast<RigError>(c)) {
-      case RigError::timeout: return "timeout: no answer from the rig";
-      case RigError::exception_response: return "the rig answered with a Modbus exception";
-      case RigError::connection_lost: return "connection to the rig lost";
-      case RigError::crc_error: return "CRC error on the serial line";
-      case RigError::out_of_range: return "value outside the register map's range";
-      case RigError::protocol_error: return "malformed answer from the rig";
-      case RigError::not_connected: return "not connected to the rig";
-      case RigError::stale_data: return "the rig's sample counter stopped advancing";
-      case RigError::unsupported: return "the rig has no such signal";
-      case RigError::count_: break;
+      case RigError::timeout:
+        return "timeout: no answer from the rig";
+      case RigError::exception_response:
+        return "the rig answered with a Modbus exception";
+      case RigError::connection_lost:
+        return "connection to the rig lost";
+      case RigError::crc_error:
+        return "CRC error on the serial line";
+      case RigError::out_of_range:
+        return "value outside the register map's range";
+      case RigError::protocol_error:
+        return "malformed answer from the rig";
+      case RigError::not_connected:
+        return "not connected to the rig";
+      case RigError::stale_data:
+        return "the rig's sample counter stopped advancing";
+      case RigError::unsupported:
+        return "the rig has no such signal";
+      case RigError::count_:
+        break;
     }
     return "unknown rig error";
   }

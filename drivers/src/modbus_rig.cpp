@@ -2,8 +2,8 @@
 
 #include <modbus/modbus.h>
 #include <poll.h>
-#include <unistd.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -21,16 +21,17 @@ RigError classify(int err) {
   if (err == ETIMEDOUT) return RigError::timeout;
   if (err >= EMBXILFUN && err <= EMBXGTAR) return RigError::exception_response;
   if (err == EMBBADCRC) return RigError::crc_error;
-  if (err == EMBBADDATA || err == EMBBADEXC || err == EMBUNKEXC || err == EMBMDATA || err == EMBBADSLAVE)
-    return RigError::protocol_error;
+  if (err == EMBBADDATA || err == EMBBADEXC || err == EMBUNKEXC || err == EMBMDATA || err == EMBBADSLAVE) return RigError::protocol_error;
   return RigError::connection_lost;  // ECONNRESET, EPIPE, ECONNREFUSED, EBADF, EIO, ...
 }
 
 void set_timeout(modbus_t* ctx, double s, bool byte) {
   const auto sec = static_cast<uint32_t>(s);
   const auto usec = static_cast<uint32_t>(std::lround((s - sec) * 1e6));
-  if (byte) modbus_set_byte_timeout(ctx, sec, usec);
-  else modbus_set_response_timeout(ctx, sec, usec);
+  if (byte)
+    modbus_set_byte_timeout(ctx, sec, usec);
+  else
+    modbus_set_response_timeout(ctx, sec, usec);
 }
 
 double micros_since(std::chrono::steady_clock::time_point t0) {
@@ -56,9 +57,8 @@ ModbusRig::ModbusRig(ModbusRigConfig config) : cfg_(std::move(config)) {
 ModbusRig::~ModbusRig() { disconnect(); }
 
 std::string ModbusRig::describe() const {
-  return cfg_.name + (cfg_.transport == ModbusRigConfig::Transport::tcp
-                          ? " (modbus tcp " + cfg_.host + ":" + std::to_string(cfg_.port) + ")"
-                          : " (modbus rtu " + cfg_.device + ")");
+  return cfg_.name + (cfg_.transport == ModbusRigConfig::Transport::tcp ? " (modbus tcp " + cfg_.host + ":" + std::to_string(cfg_.port) + ")"
+                                                                        : " (modbus rtu " + cfg_.device + ")");
 }
 
 void ModbusRig::disconnect() noexcept {
@@ -75,9 +75,8 @@ std::error_code ModbusRig::connect(double now_s) noexcept {
   last_now_ = now_s;
   have_window_counter_ = false;  // block reads start afresh: what came before is not "lost"
   have_poll_anchor_ = false;
-  ctx_ = cfg_.transport == ModbusRigConfig::Transport::tcp
-             ? modbus_new_tcp(cfg_.host.c_str(), cfg_.port)
-             : modbus_new_rtu(cfg_.device.c_str(), cfg_.baud, cfg_.parity, cfg_.data_bits, cfg_.stop_bits);
+  ctx_ = cfg_.transport == ModbusRigConfig::Transport::tcp ? modbus_new_tcp(cfg_.host.c_str(), cfg_.port)
+                                                           : modbus_new_rtu(cfg_.device.c_str(), cfg_.baud, cfg_.parity, cfg_.data_bits, cfg_.stop_bits);
   if (!ctx_) return fail(errno, "create context");
   modbus_set_slave(ctx_, cfg_.slave);
   set_timeout(ctx_, cfg_.response_timeout_s, false);
@@ -113,8 +112,7 @@ std::error_code ModbusRig::fail(int err, const char* op) noexcept {
   }
   ++episode_count_;
   if (episode_ != static_cast<int>(kind)) {  // once per episode, not once per poll
-    spdlog::warn("{}: {} failed: {} ({}); further errors are counted until it recovers", describe(), op,
-                 make_error_code(kind).message(), modbus_strerror(err));
+    spdlog::warn("{}: {} failed: {} ({}); further errors are counted until it recovers", describe(), op, make_error_code(kind).message(), modbus_strerror(err));
     episode_ = static_cast<int>(kind);
   }
   return kind;
@@ -173,12 +171,13 @@ std::error_code ModbusRig::read_blocks(double now_s) noexcept {
     auto& w = block_words_[b];
     const auto t0 = std::chrono::steady_clock::now();
     int rc = -1;
-    if (blk.table == ModbusTable::input_register) rc = modbus_read_input_registers(ctx_, blk.start, blk.count, w.data());
-    else if (blk.table == ModbusTable::holding_register) rc = modbus_read_registers(ctx_, blk.start, blk.count, w.data());
+    if (blk.table == ModbusTable::input_register)
+      rc = modbus_read_input_registers(ctx_, blk.start, blk.count, w.data());
+    else if (blk.table == ModbusTable::holding_register)
+      rc = modbus_read_registers(ctx_, blk.start, blk.count, w.data());
     else {
       std::uint8_t bits[2000];
-      rc = blk.table == ModbusTable::coil ? modbus_read_bits(ctx_, blk.start, blk.count, bits)
-                                          : modbus_read_input_bits(ctx_, blk.start, blk.count, bits);
+      rc = blk.table == ModbusTable::coil ? modbus_read_bits(ctx_, blk.start, blk.count, bits) : modbus_read_input_bits(ctx_, blk.start, blk.count, bits);
       for (int k = 0; k < blk.count && rc > 0; ++k) w[static_cast<std::size_t>(k)] = bits[k];
     }
     if (rc == -1) return fail(errno, "read");
@@ -194,8 +193,7 @@ std::error_code ModbusRig::value_of(Signal s, double& v) const noexcept {
   if (!e) return RigError::unsupported;
   const auto& blocks = cfg_.map.measurement_blocks();
   for (std::size_t b = 0; b < blocks.size(); ++b)
-    if (blocks[b].table == e->table && e->address >= blocks[b].start &&
-        e->address + e->width() <= blocks[b].start + blocks[b].count) {
+    if (blocks[b].table == e->table && e->address >= blocks[b].start && e->address + e->width() <= blocks[b].start + blocks[b].count) {
       const auto& w = block_words_[b];
       const auto ec = protocols::decode(*e, std::span(w).subspan(e->address - blocks[b].start), v);
       if (ec == protocols::ProtocolError::out_of_range || ec == protocols::ProtocolError::not_finite) return RigError::out_of_range;
@@ -221,15 +219,19 @@ std::error_code ModbusRig::read_sample(double now_s, RigSample& out) noexcept {
   if (cfg_.map.kind() != protocols::RigKind::load_frame) return RigError::unsupported;
   if (auto ec = read_blocks(now_s)) return ec;
   double d = 0, f = 0, c = 0, st = 0, fc = 0, hb = 0, n = 0;
-  for (auto [sig, dst] : {std::pair{Signal::displacement_mm, &d}, {Signal::force_N, &f}, {Signal::status_word, &st},
-                          {Signal::fault_code, &fc}, {Signal::heartbeat, &hb}, {Signal::sample_counter, &n}})
+  for (auto [sig, dst] : {std::pair{Signal::displacement_mm, &d},
+                          {Signal::force_N, &f},
+                          {Signal::status_word, &st},
+                          {Signal::fault_code, &fc},
+                          {Signal::heartbeat, &hb},
+                          {Signal::sample_counter, &n}})
     if (auto ec = value_of(sig, *dst)) {
       health_.record_error(static_cast<RigError>(ec.value()));
       return ec;
     }
   if (cfg_.map.find(Signal::command_mm)) (void)value_of(Signal::command_mm, c);
-  out = RigSample{now_s, c, d, f, static_cast<std::uint16_t>(st), static_cast<std::uint16_t>(fc),
-                  static_cast<std::uint32_t>(hb), static_cast<std::uint32_t>(n)};
+  out =
+      RigSample{now_s, c, d, f, static_cast<std::uint16_t>(st), static_cast<std::uint16_t>(fc), static_cast<std::uint32_t>(hb), static_cast<std::uint32_t>(n)};
   return check_stale(now_s, out.sample_counter);
 }
 
@@ -241,8 +243,8 @@ std::error_code ModbusRig::read_window_page(int first, int count) noexcept {
   const auto address = static_cast<int>(w.address) + first * w.record_width;
   std::uint16_t* dst = window_words_.data() + first * w.record_width;
   const auto t0 = std::chrono::steady_clock::now();
-  const int rc = w.table == ModbusTable::input_register ? modbus_read_input_registers(ctx_, address, words, dst)
-                                                        : modbus_read_registers(ctx_, address, words, dst);
+  const int rc =
+      w.table == ModbusTable::input_register ? modbus_read_input_registers(ctx_, address, words, dst) : modbus_read_registers(ctx_, address, words, dst);
   if (rc == -1) return fail(errno, "read");
   if (rc != words) return fail(EMBBADDATA, "read");
   health_.record_transaction(false, micros_since(t0));
@@ -265,8 +267,8 @@ std::error_code ModbusRig::take_window(double now_s, int& fresh, bool& reached) 
       protocols::SignalArray& r = window_records_[static_cast<std::size_t>(k)];
       const auto words = std::span<const std::uint16_t>(window_words_).subspan(static_cast<std::size_t>(k * w.record_width));
       if (const auto ec = protocols::decode_record(cfg_.map, w, words, r)) {
-        const RigError kind = ec == protocols::ProtocolError::out_of_range || ec == protocols::ProtocolError::not_finite
-                                  ? RigError::out_of_range : RigError::protocol_error;
+        const RigError kind =
+            ec == protocols::ProtocolError::out_of_range || ec == protocols::ProtocolError::not_finite ? RigError::out_of_range : RigError::protocol_error;
         health_.record_error(kind);
         return kind;
       }
@@ -308,8 +310,8 @@ void ModbusRig::emit_window(int fresh, std::vector<RigSample>& out) noexcept {
     window_counter64_ += static_cast<std::int32_t>(c - window_counter_);
     window_counter_ = c;
     const double command = cfg_.map.find(Signal::command_mm) && !std::isnan(at(r, Signal::command_mm)) ? at(r, Signal::command_mm) : 0.0;
-    out.push_back(RigSample{anchor_time_s_ + static_cast<double>(window_counter64_ - anchor_counter64_) * w.period_s, command,
-                            at(r, Signal::displacement_mm), at(r, Signal::force_N), static_cast<std::uint16_t>(at(r, Signal::status_word)),
+    out.push_back(RigSample{anchor_time_s_ + static_cast<double>(window_counter64_ - anchor_counter64_) * w.period_s, command, at(r, Signal::displacement_mm),
+                            at(r, Signal::force_N), static_cast<std::uint16_t>(at(r, Signal::status_word)),
                             static_cast<std::uint16_t>(at(r, Signal::fault_code)), c, c});
   }
 }
@@ -336,13 +338,12 @@ std::error_code ModbusRig::read_shaker(double now_s, ShakerSample& out) noexcept
   if (cfg_.map.kind() != protocols::RigKind::shaker) return RigError::unsupported;
   if (auto ec = read_blocks(now_s)) return ec;
   double v[8] = {};
-  const Signal sigs[8] = {Signal::base_accel_m_s2, Signal::mass_accel_m_s2, Signal::base_displacement_mm,
-                          Signal::mass_displacement_mm, Signal::status_word, Signal::fault_code, Signal::heartbeat,
-                          Signal::sample_counter};
+  const Signal sigs[8] = {Signal::base_accel_m_s2, Signal::mass_accel_m_s2, Signal::base_displacement_mm, Signal::mass_displacement_mm, Signal::status_word,
+                          Signal::fault_code,      Signal::heartbeat,       Signal::sample_counter};
   for (int k = 0; k < 8; ++k)
     if (auto ec = value_of(sigs[k], v[k])) return ec;
   const auto counter = static_cast<std::uint32_t>(v[7]);
-  out = ShakerSample{clock_time(now_s, counter), v[0], v[1], v[2], v[3], static_cast<std::uint16_t>(v[4]), static_cast<std::uint16_t>(v[5]),
+  out = ShakerSample{clock_time(now_s, counter),       v[0],   v[1], v[2], v[3], static_cast<std::uint16_t>(v[4]), static_cast<std::uint16_t>(v[5]),
                      static_cast<std::uint32_t>(v[6]), counter};
   return check_stale(now_s, counter);
 }
@@ -378,7 +379,8 @@ std::error_code ModbusRig::write_signals(std::initializer_list<Write> writes) no
     if ((e->min && w.value < *e->min) || (e->max && w.value > *e->max)) return RigError::out_of_range;
     std::uint16_t words[2];
     if (protocols::encode(*e, w.value, words)) return RigError::out_of_range;
-    if (e->table == ModbusTable::coil) coils.emplace_back(e->address, words[0] != 0);
+    if (e->table == ModbusTable::coil)
+      coils.emplace_back(e->address, words[0] != 0);
     else
       for (int k = 0; k < e->width(); ++k) regs[e->address + k] = words[k];
   }

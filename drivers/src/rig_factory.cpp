@@ -71,9 +71,28 @@ protocols::RegisterMap load_map(const Reader& r, protocols::RigKind kind, const 
 
 std::unique_ptr<Rig> make_rig(const json& config, const std::string& where, const std::filesystem::path& base) {
   const Reader r(config, where);
-  r.only({"name", "transport", "rig", "host", "port", "device", "baud", "parity", "data_bits", "stop_bits", "map", "slave",
-          "response_timeout_ms", "byte_timeout_ms", "reconnect_min_ms", "reconnect_max_ms", "stale_after_ms",
-          "can_interface", "can_fd", "can_node", "status_timeout_ms", "block_reads"});
+  r.only({"name",
+          "transport",
+          "rig",
+          "host",
+          "port",
+          "device",
+          "baud",
+          "parity",
+          "data_bits",
+          "stop_bits",
+          "map",
+          "slave",
+          "response_timeout_ms",
+          "byte_timeout_ms",
+          "reconnect_min_ms",
+          "reconnect_max_ms",
+          "stale_after_ms",
+          "can_interface",
+          "can_fd",
+          "can_node",
+          "status_timeout_ms",
+          "block_reads"});
   const std::string transport = r.text("transport", "");
   const std::string name = r.text("name", "rig");
   const std::string rig = r.text("rig", "load_frame");
@@ -117,9 +136,7 @@ std::unique_ptr<Rig> make_rig(const json& config, const std::string& where, cons
     c.status_timeout_ms = static_cast<int>(r.integer("status_timeout_ms", 100, 1, 60000));
     c.stale_after_s = static_cast<double>(r.integer("stale_after_ms", 500, 1, 600000)) / 1e3;
     if (r.has("can_fd") == r.has("can_interface")) r.fail("can_interface", "or can_fd: exactly one is required for can");
-    if (r.has("can_fd"))
-      return std::make_unique<CanRig>(
-          std::make_unique<FdCanChannel>(static_cast<int>(r.integer("can_fd", -1, 0, 65535)), "fd"), c);
+    if (r.has("can_fd")) return std::make_unique<CanRig>(std::make_unique<FdCanChannel>(static_cast<int>(r.integer("can_fd", -1, 0, 65535)), "fd"), c);
     return std::make_unique<CanRig>(open_socketcan(r.text("can_interface", "")), c);
   }
   r.fail("transport", "must be \"modbus-tcp\", \"modbus-rtu\" or \"can\" (got \"" + transport + "\")");

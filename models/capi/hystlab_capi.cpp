@@ -76,8 +76,7 @@ hystlab_status hystlab_model_from_json(const char* text, hystlab_model** out) {
   return guarded([&] { return make(text, out); });
 }
 
-hystlab_status hystlab_model_from_table(int n, double lo, double hi, const double* nodes, const double* values, double offset,
-                                        hystlab_model** out) {
+hystlab_status hystlab_model_from_table(int n, double lo, double hi, const double* nodes, const double* values, double offset, hystlab_model** out) {
   if (!values || !out) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_from_table: null argument");
   *out = nullptr;
   if (n < 1 || n > 100000) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_from_table: n = " + std::to_string(n) + " is not in 1..100000");
@@ -86,8 +85,8 @@ hystlab_status hystlab_model_from_table(int n, double lo, double hi, const doubl
     const std::size_t count = static_cast<std::size_t>(n + 1) * static_cast<std::size_t>(n + 2) / 2;
     const hm::Grid grid = nodes ? hm::Grid::from_nodes(std::vector<double>(nodes, nodes + n + 1)) : hm::Grid::make(lo, hi, n);
     if (nodes && (grid.lo != lo || grid.hi != hi))
-      return fail(HYSTLAB_ERROR_FORMAT, "hystlab_model_from_table: the nodes run from " + std::to_string(grid.lo) + " to " + std::to_string(grid.hi) +
-                                            ", not from lo_mm to hi_mm");
+      return fail(HYSTLAB_ERROR_FORMAT,
+                  "hystlab_model_from_table: the nodes run from " + std::to_string(grid.lo) + " to " + std::to_string(grid.hi) + ", not from lo_mm to hi_mm");
     auto m = std::make_unique<hystlab_model>();
     m->model = std::make_unique<hm::PreisachModel>(hm::EverettTable(grid, std::vector<double>(values, values + count), offset));
     m->kind = 1;

@@ -29,8 +29,7 @@ typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pendi
 typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
 typedef enum { fmi2DoStepStatus, fmi2PendingStatus, fmi2LastSuccessfulTime, fmi2Terminated } fmi2StatusKind;
 
-typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String instanceName, fmi2Status status,
-                                   fmi2String category, fmi2String message, ...);
+typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String instanceName, fmi2Status status, fmi2String category, fmi2String message, ...);
 typedef void* (*fmi2CallbackAllocateMemory)(size_t nobj, size_t size);
 typedef void (*fmi2CallbackFreeMemory)(void* obj);
 typedef void (*fmi2StepFinished)(fmi2ComponentEnvironment, fmi2Status status);
@@ -50,6 +49,8 @@ typedef struct {
 #endif
 
 /* The function names, as an X-macro: the FMU defines them, the importer looks each one up. */
+/* A list of names, kept as written: clang-format 14 lays it out differently on each pass. */
+// clang-format off
 #define HYSTLAB_FMI2_CS_FUNCTIONS(X)                                                                           \
   X(fmi2GetTypesPlatform) X(fmi2GetVersion) X(fmi2SetDebugLogging) X(fmi2Instantiate) X(fmi2FreeInstance)     \
   X(fmi2SetupExperiment) X(fmi2EnterInitializationMode) X(fmi2ExitInitializationMode) X(fmi2Terminate)        \
@@ -59,17 +60,16 @@ typedef struct {
   X(fmi2GetDirectionalDerivative) X(fmi2SetRealInputDerivatives) X(fmi2GetRealOutputDerivatives) X(fmi2DoStep) \
   X(fmi2CancelStep) X(fmi2GetStatus) X(fmi2GetRealStatus) X(fmi2GetIntegerStatus) X(fmi2GetBooleanStatus)     \
   X(fmi2GetStringStatus)
+// clang-format on
 
 HYSTLAB_FMI2_API const char* fmi2GetTypesPlatform(void);
 HYSTLAB_FMI2_API const char* fmi2GetVersion(void);
-HYSTLAB_FMI2_API fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
-                                                const fmi2String categories[]);
-HYSTLAB_FMI2_API fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
-                                               fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
-                                               fmi2Boolean visible, fmi2Boolean loggingOn);
+HYSTLAB_FMI2_API fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]);
+HYSTLAB_FMI2_API fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID, fmi2String fmuResourceLocation,
+                                               const fmi2CallbackFunctions* functions, fmi2Boolean visible, fmi2Boolean loggingOn);
 HYSTLAB_FMI2_API void fmi2FreeInstance(fmi2Component c);
-HYSTLAB_FMI2_API fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
-                                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime);
+HYSTLAB_FMI2_API fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,
+                                                fmi2Boolean stopTimeDefined, fmi2Real stopTime);
 HYSTLAB_FMI2_API fmi2Status fmi2EnterInitializationMode(fmi2Component c);
 HYSTLAB_FMI2_API fmi2Status fmi2ExitInitializationMode(fmi2Component c);
 HYSTLAB_FMI2_API fmi2Status fmi2Terminate(fmi2Component c);
@@ -87,15 +87,13 @@ HYSTLAB_FMI2_API fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUsta
 HYSTLAB_FMI2_API fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate);
 HYSTLAB_FMI2_API fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t* size);
 HYSTLAB_FMI2_API fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size);
-HYSTLAB_FMI2_API fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
-                                                    fmi2FMUstate* FMUstate);
+HYSTLAB_FMI2_API fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size, fmi2FMUstate* FMUstate);
 HYSTLAB_FMI2_API fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
-                                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
-                                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]);
-HYSTLAB_FMI2_API fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
-                                                        const fmi2Integer order[], const fmi2Real value[]);
-HYSTLAB_FMI2_API fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
-                                                         const fmi2Integer order[], fmi2Real value[]);
+                                                         const fmi2ValueReference vKnown_ref[], size_t nKnown, const fmi2Real dvKnown[], fmi2Real dvUnknown[]);
+HYSTLAB_FMI2_API fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],
+                                                        const fmi2Real value[]);
+HYSTLAB_FMI2_API fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],
+                                                         fmi2Real value[]);
 HYSTLAB_FMI2_API fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                                        fmi2Boolean noSetFMUStatePriorToCurrentPoint);
 HYSTLAB_FMI2_API fmi2Status fmi2CancelStep(fmi2Component c);

@@ -28,13 +28,11 @@ struct Accumulator {
 
 double path_work(std::span<const double> input, std::span<const double> force) noexcept {
   double w = 0.0;
-  for (std::size_t k = 1; k < input.size() && k < force.size(); ++k)
-    w += 0.5 * (force[k] + force[k - 1]) * (input[k] - input[k - 1]);
+  for (std::size_t k = 1; k < input.size() && k < force.size(); ++k) w += 0.5 * (force[k] + force[k - 1]) * (input[k] - input[k - 1]);
   return w;
 }
 
-AccuracyReport compare(std::span<const double> input, std::span<const double> reference,
-                       std::span<const double> model) {
+AccuracyReport compare(std::span<const double> input, std::span<const double> reference, std::span<const double> model) {
   if (input.size() != reference.size() || input.size() != model.size())
     throw std::invalid_argument("compare: input, reference and model series differ in length");
   AccuracyReport r;

@@ -33,8 +33,10 @@ std::string json_fault(std::string_view text, const nlohmann::json::exception& e
   const std::size_t at = std::min<std::size_t>(pe->byte > 0 ? pe->byte - 1 : 0, text.size());  // text.size(): its end
   std::size_t line = 1, column = 1;
   for (std::size_t k = 0; k < at; ++k) {
-    if (text[k] == '\n') ++line, column = 1;
-    else if ((static_cast<unsigned char>(text[k]) & 0xC0) != 0x80) ++column;  // characters, not UTF-8 bytes
+    if (text[k] == '\n')
+      ++line, column = 1;
+    else if ((static_cast<unsigned char>(text[k]) & 0xC0) != 0x80)
+      ++column;  // characters, not UTF-8 bytes
   }
   const bool blank = text.find_first_not_of(" \t\r\n") == std::string_view::npos;
   std::string what = at >= text.size() ? (blank ? "the file is empty" : "the file ends too early") : "unexpected " + byte_named(text[at]);
@@ -42,8 +44,8 @@ std::string json_fault(std::string_view text, const nlohmann::json::exception& e
   if (const auto x = msg.rfind("; expected "); x != std::string::npos && !blank) {
     const std::string expected = msg.substr(x + 11);
     what += expected.find("or a literal") != std::string::npos ? ", expected a value"
-            : expected == "end of input"                      ? " after the end of the document"
-                                                              : ", expected " + expected;
+            : expected == "end of input"                       ? " after the end of the document"
+                                                               : ", expected " + expected;
   }
   return "line " + std::to_string(line) + ", column " + std::to_string(column) + ": " + what;
 }

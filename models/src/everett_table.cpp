@@ -6,14 +6,13 @@
 
 namespace hystlab::models {
 
-EverettTable::EverettTable(Grid grid)
-    : grid_(grid), inv_step_(1.0 / grid.step()), values_(grid.node_count(), 0.0) {}
+EverettTable::EverettTable(Grid grid) : grid_(grid), inv_step_(1.0 / grid.step()), values_(grid.node_count(), 0.0) {}
 
 EverettTable::EverettTable(Grid grid, std::vector<double> values, double force_offset)
     : grid_(grid), inv_step_(1.0 / grid.step()), values_(std::move(values)), force_offset_(force_offset) {
   if (values_.size() != grid_.node_count())
-    throw std::invalid_argument("table: expected " + std::to_string(grid_.node_count()) + " values for n = " +
-                                std::to_string(grid_.n) + ", got " + std::to_string(values_.size()));
+    throw std::invalid_argument("table: expected " + std::to_string(grid_.node_count()) + " values for n = " + std::to_string(grid_.n) + ", got " +
+                                std::to_string(values_.size()));
   if (!std::isfinite(force_offset)) throw std::invalid_argument("table: force offset is not a finite number");
   double scale = 0.0;
   for (std::size_t k = 0; k < values_.size(); ++k) {
@@ -24,8 +23,7 @@ EverettTable::EverettTable(Grid grid, std::vector<double> values, double force_o
     double& d = values_[Grid::index(i, i)];
     // F(α,α) = 0 by definition; tolerate rounding from a file, refuse anything else.
     if (std::fabs(d) > 1e-9 * (1.0 + scale))
-      throw std::invalid_argument("table: diagonal value F(" + std::to_string(grid_.node(i)) + ", same) = " +
-                                  std::to_string(d) + " must be 0");
+      throw std::invalid_argument("table: diagonal value F(" + std::to_string(grid_.node(i)) + ", same) = " + std::to_string(d) + " must be 0");
     d = 0.0;
   }
 }

@@ -76,8 +76,7 @@ namespace {
 // direction at once (25 probes) reads each diagonal entry unmixed.
 std::vector<double> node_smoothing_diagonal(const Grid& g) {
   constexpr int kSpacing = 5;
-  std::vector<double> diag(g.node_count(), 0.0), e(g.node_count()), w(g.cell_count()), lw(g.cell_count()),
-      back(g.node_count());
+  std::vector<double> diag(g.node_count(), 0.0), e(g.node_count()), w(g.cell_count()), lw(g.cell_count()), back(g.node_count());
   for (int ci = 0; ci < kSpacing; ++ci)
     for (int cj = 0; cj < kSpacing; ++cj) {
       std::fill(e.begin(), e.end(), 0.0);
@@ -169,8 +168,7 @@ void NormalSystem::set_lambda(double lambda) {
   const Grid& g = op_.grid();
   inv_diag_.assign(data_diag_.size(), 0.0);
   double largest = 0.0;
-  for (std::size_t a = 0; a < inv_diag_.size(); ++a)
-    largest = std::max(largest, data_diag_[a] + lambda_scaled_ * smooth_diag_[a]);
+  for (std::size_t a = 0; a < inv_diag_.size(); ++a) largest = std::max(largest, data_diag_[a] + lambda_scaled_ * smooth_diag_[a]);
   for (int i = 0; i <= g.n; ++i)
     for (int j = 0; j < i; ++j) {
       const std::size_t a = Grid::index(i, j);
@@ -178,8 +176,7 @@ void NormalSystem::set_lambda(double lambda) {
     }
   inv_cell_diag_.assign(cells_, 0.0);
   largest = 0.0;
-  for (std::size_t c = 0; c < cells_; ++c)
-    largest = std::max(largest, cell_data_diag_[c] + lambda_scaled_ * cell_smooth_diag_[c]);
+  for (std::size_t c = 0; c < cells_; ++c) largest = std::max(largest, cell_data_diag_[c] + lambda_scaled_ * cell_smooth_diag_[c]);
   for (std::size_t c = 0; c < cells_; ++c)
     inv_cell_diag_[c] = 1.0 / std::max(cell_data_diag_[c] + lambda_scaled_ * cell_smooth_diag_[c], 1e-12 * largest + 1e-300);
 }
@@ -229,15 +226,14 @@ void NormalSystem::apply(std::span<const double> u, std::span<double> out) const
 }
 
 std::size_t NormalSystem::scratch_bytes() const noexcept {
-  return (mask_.capacity() + samples_.capacity() + nodes_.capacity() + node_grad_.capacity() + cell_tmp_.capacity() +
-          rhs_.capacity() + data_diag_.capacity() + smooth_diag_.capacity() + inv_diag_.capacity() +
-          pre_nodes_.capacity() + cell_data_diag_.capacity() + cell_smooth_diag_.capacity() +
+  return (mask_.capacity() + samples_.capacity() + nodes_.capacity() + node_grad_.capacity() + cell_tmp_.capacity() + rhs_.capacity() + data_diag_.capacity() +
+          smooth_diag_.capacity() + inv_diag_.capacity() + pre_nodes_.capacity() + cell_data_diag_.capacity() + cell_smooth_diag_.capacity() +
           inv_cell_diag_.capacity() + prefix_.capacity()) *
          sizeof(double);
 }
 
-SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::vector<double>& u,
-                         std::span<const std::uint8_t> free, double tol, int max_iterations, bool stop_at_bound) {
+SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, std::span<const std::uint8_t> free, double tol,
+                         int max_iterations, bool stop_at_bound) {
   const std::size_t m = s.size(), cells = s.cells();
   auto on = [&](std::size_t c) { return free.empty() || free[c] != 0; };
   std::vector<double> r(m), z(m), p(m), q(m);
@@ -293,8 +289,7 @@ SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::
   return st;
 }
 
-SolveStats solve_signed(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol,
-                        int max_iterations) {
+SolveStats solve_signed(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol, int max_iterations) {
   return solve_on_face(s, b, u, {}, tol, max_iterations, false);
 }
 
@@ -333,8 +328,8 @@ bool gradient_projection_step(const NormalSystem& s, std::span<const double> b, 
 
 }  // namespace
 
-SolveStats solve_monotone(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol,
-                          int max_iterations, std::vector<std::uint8_t>& free_out) {
+SolveStats solve_monotone(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol, int max_iterations,
+                          std::vector<std::uint8_t>& free_out) {
   const std::size_t m = s.size(), cells = s.cells();
   for (std::size_t c = 0; c < cells; ++c) u[c] = std::max(0.0, u[c]);
   double bnorm = norm_on(b, {});

@@ -35,8 +35,8 @@ class NormalSystem {
   void set_lambda(double lambda);  // relative weight; see the header comment
   [[nodiscard]] double lambda_scaled() const noexcept { return lambda_scaled_; }
 
-  void apply(std::span<const double> u, std::span<double> out) const;        // Q u
-  void predict(std::span<const double> u, std::span<double> out) const;      // A P w + offset, all samples
+  void apply(std::span<const double> u, std::span<double> out) const;          // Q u
+  void predict(std::span<const double> u, std::span<double> out) const;        // A P w + offset, all samples
   void data_gradient(std::span<const double> r, std::span<double> out) const;  // [Pᵀ Aᵀ M r; Σ M r]
   [[nodiscard]] const std::vector<double>& rhs() const noexcept { return rhs_; }
   // z = M⁻¹ r with M = Pᵀ D P, D the diagonal of the system in node space (the data term's,
@@ -53,12 +53,12 @@ class NormalSystem {
   std::vector<double> mask_;
   std::size_t cells_ = 0;
   std::vector<double> rhs_;
-  std::vector<double> data_diag_;    // node space: estimated diagonal of the data term
-  std::vector<double> smooth_diag_;  // node space: exact diagonal of P⁻ᵀ L P⁻¹
-  std::vector<double> inv_diag_;     // node space
+  std::vector<double> data_diag_;                                          // node space: estimated diagonal of the data term
+  std::vector<double> smooth_diag_;                                        // node space: exact diagonal of P⁻ᵀ L P⁻¹
+  std::vector<double> inv_diag_;                                           // node space
   std::vector<double> cell_data_diag_, cell_smooth_diag_, inv_cell_diag_;  // cell space, for faces
   double offset_diag_ = 1.0;
-  double trace_ratio_ = 1.0;         // tr(data) / tr(L)
+  double trace_ratio_ = 1.0;  // tr(data) / tr(L)
   double lambda_scaled_ = 0.0;
   mutable std::vector<double> nodes_, samples_, node_grad_, cell_tmp_, pre_nodes_, prefix_;
 };
@@ -69,16 +69,15 @@ struct SolveStats {
 };
 
 // Preconditioned conjugate gradients on Q u = b from u (a warm start), all unknowns free.
-SolveStats solve_signed(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol,
-                        int max_iterations);
+SolveStats solve_signed(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol, int max_iterations);
 // The same with w >= 0 (the offset free): gradient projection steps, then conjugate gradients on
 // the face of free cells until a bound is hit (Moré and Toraldo's GPCG, without its safeguards on
 // the face's progress). `free_out` gets which unknowns ended off the bound.
-SolveStats solve_monotone(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol,
-                          int max_iterations, std::vector<std::uint8_t>& free_out);
+SolveStats solve_monotone(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, double tol, int max_iterations,
+                          std::vector<std::uint8_t>& free_out);
 // Conjugate gradients restricted to the unknowns with free[c] != 0 (others held at 0): used for
 // the uncertainty of a monotone fit on its free face, and by solve_monotone.
-SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::vector<double>& u,
-                         std::span<const std::uint8_t> free, double tol, int max_iterations, bool stop_at_bound);
+SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, std::span<const std::uint8_t> free, double tol,
+                         int max_iterations, bool stop_at_bound);
 
 }  // namespace hystlab::models::fit

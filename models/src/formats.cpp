@@ -58,9 +58,7 @@ json table_to_json(const EverettTable& t, const TableProvenance& p) {
               {"nodes_mm", std::move(nodes)},
               {"force_offset_N", t.force_offset()},
               {"rows", std::move(rows)},
-              {"provenance",
-               {{"source", p.source}, {"method", p.method}, {"created", p.created}, {"from", p.from}, {"n", g.n},
-                {"details", p.extra}}}};
+              {"provenance", {{"source", p.source}, {"method", p.method}, {"created", p.created}, {"from", p.from}, {"n", g.n}, {"details", p.extra}}}};
 }
 
 TableDocument table_from_json(std::string_view text) {
@@ -75,8 +73,7 @@ TableDocument parse_table(std::string_view text) {
   const std::string what = "table";
   const json j = parse(text, what);
   const json& fmt = field(j, "format", what);
-  if (!fmt.is_string() || fmt.get<std::string>() != kTableFormat)
-    fail(what, "'format' is " + fmt.dump() + ", expected \"" + std::string(kTableFormat) + "\"");
+  if (!fmt.is_string() || fmt.get<std::string>() != kTableFormat) fail(what, "'format' is " + fmt.dump() + ", expected \"" + std::string(kTableFormat) + "\"");
   const json& ver = field(j, "version", what);
   if (!ver.is_number_integer() || (ver.get<int>() != kTableVersion && ver.get<int>() != kTableVersionNodes))
     fail(what, "unknown format version " + ver.dump() + " (this hystlab reads versions " + std::to_string(kTableVersion) + " and " +
@@ -90,8 +87,7 @@ TableDocument parse_table(std::string_view text) {
   if (!range.is_array() || range.size() != 2) fail(what, "'range_mm' must be [start, end]");
   const double lo = number(range[0], "range_mm[0]", what), hi = number(range[1], "range_mm[1]", what);
   const json& sub = field(j, "subdivisions", what);
-  if (!sub.is_number_integer() || sub.get<long long>() < 1 || sub.get<long long>() > 2000)
-    fail(what, "'subdivisions' must be an integer from 1 to 2000");
+  if (!sub.is_number_integer() || sub.get<long long>() < 1 || sub.get<long long>() > 2000) fail(what, "'subdivisions' must be an integer from 1 to 2000");
   Grid g;
   try {
     g = Grid::make(lo, hi, sub.get<int>());
@@ -101,14 +97,11 @@ TableDocument parse_table(std::string_view text) {
   const auto nodes = j.find("nodes_mm");
   if (own_nodes && nodes == j.end()) fail(what, "version 2 needs 'nodes_mm' (the grid's nodes)");
   if (nodes != j.end()) {
-    if (!nodes->is_array() || nodes->size() != static_cast<std::size_t>(g.n) + 1)
-      fail(what, "'nodes_mm' must hold subdivisions + 1 values");
+    if (!nodes->is_array() || nodes->size() != static_cast<std::size_t>(g.n) + 1) fail(what, "'nodes_mm' must hold subdivisions + 1 values");
     std::vector<double> x;
     for (std::size_t i = 0; i < nodes->size(); ++i) {
       const double v = number((*nodes)[i], "nodes_mm[" + std::to_string(i) + "]", what);
-      if (i > 0 && !(v > x.back()))
-        fail(what, "non-monotone grid: nodes_mm[" + std::to_string(i) + "] is not above nodes_mm[" +
-                       std::to_string(i - 1) + "]");
+      if (i > 0 && !(v > x.back())) fail(what, "non-monotone grid: nodes_mm[" + std::to_string(i) + "] is not above nodes_mm[" + std::to_string(i - 1) + "]");
       if (!own_nodes && std::fabs(v - g.node(static_cast<int>(i))) > 1e-9 * (hi - lo) + 1e-12)
         fail(what, "nodes_mm[" + std::to_string(i) + "] is off the uniform grid of range_mm and subdivisions (a grid of its own is version 2)");
       x.push_back(v);
@@ -119,15 +112,12 @@ TableDocument parse_table(std::string_view text) {
     }
   }
   const json& rows = field(j, "rows", what);
-  if (!rows.is_array() || rows.size() != static_cast<std::size_t>(g.n) + 1)
-    fail(what, "'rows' must hold subdivisions + 1 rows");
+  if (!rows.is_array() || rows.size() != static_cast<std::size_t>(g.n) + 1) fail(what, "'rows' must hold subdivisions + 1 rows");
   std::vector<double> values;
   values.reserve(g.node_count());
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (!rows[i].is_array() || rows[i].size() != i + 1)
-      fail(what, "rows[" + std::to_string(i) + "] must hold " + std::to_string(i + 1) + " values");
-    for (std::size_t k = 0; k <= i; ++k)
-      values.push_back(number(rows[i][k], "rows[" + std::to_string(i) + "][" + std::to_string(k) + "]", what));
+    if (!rows[i].is_array() || rows[i].size() != i + 1) fail(what, "rows[" + std::to_string(i) + "] must hold " + std::to_string(i + 1) + " values");
+    for (std::size_t k = 0; k <= i; ++k) values.push_back(number(rows[i][k], "rows[" + std::to_string(i) + "][" + std::to_string(k) + "]", what));
   }
   double offset = 0.0;
   if (const auto o = j.find("force_offset_N"); o != j.end()) offset = number(*o, "force_offset_N", what);
@@ -148,7 +138,7 @@ TableDocument parse_table(std::string_view text) {
 }
 
 json params_to_json(const SmaParameters& p, const std::string& source) {
-  return json{{"model", kParamsModel}, {"source", source},   {"KA_N_per_mm", p.KA}, {"KM_N_per_mm", p.KM},
+  return json{{"model", kParamsModel},   {"source", source},    {"KA_N_per_mm", p.KA}, {"KM_N_per_mm", p.KM},
               {"dtr_max_mm", p.dtr_max}, {"C_N_per_degC", p.C}, {"Mf0_degC", p.Mf0},   {"Ms0_degC", p.Ms0},
               {"As0_degC", p.As0},       {"Af0_degC", p.Af0},   {"T_degC", p.T}};
 }
@@ -167,11 +157,9 @@ SmaParameters parse_params(std::string_view text) {
   if (const auto m = j.find("model"); m != j.end() && (!m->is_string() || m->get<std::string>() != kParamsModel))
     fail(what, "'model' is " + m->dump() + ", expected \"" + std::string(kParamsModel) + "\"");
   SmaParameters p;
-  const std::pair<const char*, double*> fields[] = {{"KA_N_per_mm", &p.KA}, {"KM_N_per_mm", &p.KM},
-                                                    {"dtr_max_mm", &p.dtr_max}, {"C_N_per_degC", &p.C},
-                                                    {"Mf0_degC", &p.Mf0}, {"Ms0_degC", &p.Ms0},
-                                                    {"As0_degC", &p.As0}, {"Af0_degC", &p.Af0},
-                                                    {"T_degC", &p.T}};
+  const std::pair<const char*, double*> fields[] = {{"KA_N_per_mm", &p.KA}, {"KM_N_per_mm", &p.KM}, {"dtr_max_mm", &p.dtr_max},
+                                                    {"C_N_per_degC", &p.C}, {"Mf0_degC", &p.Mf0},   {"Ms0_degC", &p.Ms0},
+                                                    {"As0_degC", &p.As0},   {"Af0_degC", &p.Af0},   {"T_degC", &p.T}};
   for (const auto& [name, dst] : fields) *dst = number(field(j, name, what), name, what);
   try {
     validate(p);

@@ -20,9 +20,7 @@ std::vector<CellWeight> cell_weights(const EverettTable& t) {
   w.reserve(t.grid().cell_count());
   for (int p = 1; p <= n; ++p)
     for (int q = 1; q <= p; ++q) {
-      const double m = q == p ? t.node_value(p, p - 1)
-                              : t.node_value(p, q - 1) - t.node_value(p, q) - t.node_value(p - 1, q - 1) +
-                                    t.node_value(p - 1, q);
+      const double m = q == p ? t.node_value(p, p - 1) : t.node_value(p, q - 1) - t.node_value(p, q) - t.node_value(p - 1, q - 1) + t.node_value(p - 1, q);
       w.push_back(CellWeight{p, q, m});
     }
   return w;
@@ -94,17 +92,14 @@ FotIdentification identify_from_nodes(const std::vector<FotNode>& nodes, double 
   return identify_from_nodes(infer_grid(nodes), nodes, noise_std, force_offset);
 }
 
-FotIdentification identify_from_nodes(const Grid& grid, const std::vector<FotNode>& nodes, double noise_std,
-                                      double force_offset) {
+FotIdentification identify_from_nodes(const Grid& grid, const std::vector<FotNode>& nodes, double noise_std, double force_offset) {
   OnlineTableBuilder builder(grid);
   builder.set_force_offset(force_offset);
   for (const FotNode& n : nodes)
-    if (const std::error_code ec = builder.add(n))
-      throw std::invalid_argument("FOT data: " + describe(n) + ": " + ec.message());
+    if (const std::error_code ec = builder.add(n)) throw std::invalid_argument("FOT data: " + describe(n) + ": " + ec.message());
   for (int i = 1; i <= grid.n; ++i)
     for (int j = 0; j < i; ++j)
-      if (!builder.identified(i, j))
-        throw std::invalid_argument("FOT data: missing " + describe(FotNode{grid.node(i), grid.node(j), 0, 0}));
+      if (!builder.identified(i, j)) throw std::invalid_argument("FOT data: missing " + describe(FotNode{grid.node(i), grid.node(j), 0, 0}));
   FotIdentification r{builder.table(), drift_report(builder), 0.0, {}, nodes.size()};
   double scale = 0.0;
   for (double v : r.table.values()) scale = std::max(scale, std::fabs(v));

@@ -24,8 +24,7 @@ std::vector<double> ramp_through(const std::vector<double>& turning_points, doub
   for (std::size_t k = 1; k < turning_points.size(); ++k) {
     const double a = turning_points[k - 1], b = turning_points[k];
     const auto steps = static_cast<std::size_t>(std::ceil(std::fabs(b - a) / max_step));
-    for (std::size_t s = 1; s <= steps; ++s)
-      out.push_back(s == steps ? b : a + (b - a) * static_cast<double>(s) / static_cast<double>(steps));
+    for (std::size_t s = 1; s <= steps; ++s) out.push_back(s == steps ? b : a + (b - a) * static_cast<double>(s) / static_cast<double>(steps));
   }
   return out;
 }
@@ -38,7 +37,7 @@ VirtualCampaign run_virtual_fot(HysteresisModel& model, const Grid& grid) {
   for (int i = 1; i <= grid.n; ++i) {
     for (int k = 1; k <= i; ++k) model.step(grid.node(k));  // rise through every node to δ_i
     const double f_alpha = model.output();
-    for (int j = i - 1; j >= 0; --j) {                        // descend, passing each δ_j
+    for (int j = i - 1; j >= 0; --j) {  // descend, passing each δ_j
       const double f = model.step(grid.node(j));
       c.nodes.push_back(FotNode{grid.node(i), grid.node(j), f_alpha, f});
     }

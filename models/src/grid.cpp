@@ -9,11 +9,8 @@ namespace hystlab::models {
 Grid Grid::make(double lo, double hi, int n) {
   if (!std::isfinite(lo)) throw std::invalid_argument("grid: range start is not a finite number");
   if (!std::isfinite(hi)) throw std::invalid_argument("grid: range end is not a finite number");
-  if (!(hi > lo))
-    throw std::invalid_argument("grid: range end (" + std::to_string(hi) + ") must be greater than its start (" +
-                                std::to_string(lo) + ")");
-  if (n < 1 || n > 2000)
-    throw std::invalid_argument("grid: subdivisions must be between 1 and 2000, got " + std::to_string(n));
+  if (!(hi > lo)) throw std::invalid_argument("grid: range end (" + std::to_string(hi) + ") must be greater than its start (" + std::to_string(lo) + ")");
+  if (n < 1 || n > 2000) throw std::invalid_argument("grid: subdivisions must be between 1 and 2000, got " + std::to_string(n));
   return Grid{lo, hi, n, nullptr};
 }
 
@@ -22,20 +19,20 @@ Grid Grid::from_nodes(const std::vector<double>& nodes) {
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     if (!std::isfinite(nodes[i])) throw std::invalid_argument("grid: node " + std::to_string(i) + " is not a finite number");
     if (i > 0 && !(nodes[i] > nodes[i - 1]))
-      throw std::invalid_argument("grid: node " + std::to_string(i) + " (" + std::to_string(nodes[i]) + ") is not above node " +
-                                  std::to_string(i - 1) + " (" + std::to_string(nodes[i - 1]) + ")");
+      throw std::invalid_argument("grid: node " + std::to_string(i) + " (" + std::to_string(nodes[i]) + ") is not above node " + std::to_string(i - 1) + " (" +
+                                  std::to_string(nodes[i - 1]) + ")");
   }
   Grid g = make(nodes.front(), nodes.back(), static_cast<int>(nodes.size()) - 1);
   bool uniform = true;
-  for (std::size_t i = 0; i < nodes.size() && uniform; ++i)
-    uniform = std::fabs(nodes[i] - g.node(static_cast<int>(i))) <= 1e-12 * (g.hi - g.lo);
+  for (std::size_t i = 0; i < nodes.size() && uniform; ++i) uniform = std::fabs(nodes[i] - g.node(static_cast<int>(i))) <= 1e-12 * (g.hi - g.lo);
   if (!uniform) g.positions = std::make_shared<const std::vector<double>>(nodes);
   return g;
 }
 
 Grid Grid::refined(double lo, double hi, int n, double center, double width, double share) {
   const Grid u = make(lo, hi, n);
-  if (!std::isfinite(center) || !(width > 0) || !std::isfinite(width)) throw std::invalid_argument("grid: the refined window needs a finite centre and a width > 0");
+  if (!std::isfinite(center) || !(width > 0) || !std::isfinite(width))
+    throw std::invalid_argument("grid: the refined window needs a finite centre and a width > 0");
   if (!(share > 0 && share < 1)) throw std::invalid_argument("grid: the refined share must be between 0 and 1");
   const double a = std::max(lo, center - width / 2), b = std::min(hi, center + width / 2);
   if (!(b > a)) throw std::invalid_argument("grid: the refined window lies outside the range");

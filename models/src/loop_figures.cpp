@@ -27,8 +27,10 @@ std::vector<Reversal> reversals(std::span<const double> x, double band) {
     if (dir == 0) {  // until the input has moved by more than the band: the lowest and highest so far
       if (x[k] < x[lo]) lo = k;
       if (x[k] > x[hi]) hi = k;
-      if (x[k] > x[lo] + band) out.push_back({lo, false}), dir = 1, ext = k;
-      else if (x[k] < x[hi] - band) out.push_back({hi, true}), dir = -1, ext = k;
+      if (x[k] > x[lo] + band)
+        out.push_back({lo, false}), dir = 1, ext = k;
+      else if (x[k] < x[hi] - band)
+        out.push_back({hi, true}), dir = -1, ext = k;
       continue;
     }
     if (dir > 0 ? x[k] > x[ext] : x[k] < x[ext]) {
@@ -80,8 +82,7 @@ std::optional<SmaTransitions> transformation_of(const LoopFigures& L) {
 }
 }  // namespace
 
-LoopFigures loop_figures(std::span<const double> x, std::span<const double> f, std::size_t begin, std::size_t turn, std::size_t end,
-                         const LoopOptions& o) {
+LoopFigures loop_figures(std::span<const double> x, std::span<const double> f, std::size_t begin, std::size_t turn, std::size_t end, const LoopOptions& o) {
   if (x.size() != f.size() || !(begin < turn && turn < end && end < x.size()))
     throw std::invalid_argument("loop_figures: the cycle's samples must satisfy begin < turn < end within the record");
   LoopFigures L;
@@ -190,8 +191,7 @@ void gather(std::span<const double> x, std::span<const double> f, const Cycle& c
 std::vector<LoopFigures> find_loops(std::span<const double> x, std::span<const double> f, const LoopOptions& o) {
   if (x.size() != f.size()) throw std::invalid_argument("loops: displacement and force differ in length");
   for (std::size_t k = 0; k < x.size(); ++k)
-    if (!std::isfinite(x[k]) || !std::isfinite(f[k]))
-      throw std::invalid_argument("loops: sample " + std::to_string(k) + " is not a finite number");
+    if (!std::isfinite(x[k]) || !std::isfinite(f[k])) throw std::invalid_argument("loops: sample " + std::to_string(k) + " is not a finite number");
   if (!(o.reversal_fraction > 0 && o.reversal_fraction < 0.5) || !(o.min_span_fraction >= 0 && o.min_span_fraction < 1))
     throw std::invalid_argument("loops: reversal_fraction must be in (0, 0.5) and min_span_fraction in [0, 1)");
   std::vector<LoopFigures> out;

@@ -5,8 +5,13 @@ namespace {
 using nlohmann::json;
 json point(const TransitionPoint& p) { return json{{"displacement_mm", p.displacement}, {"force_N", p.force}}; }
 json knees(const BranchKnees& b) {
-  return json{{"lower_mm", b.lower_mm}, {"lower_N", b.lower_N}, {"upper_mm", b.upper_mm}, {"upper_N", b.upper_N},
-              {"slopes_N_mm", {b.slope_start, b.slope_middle, b.slope_end}}, {"rms_N", b.rms_N}, {"line_rms_N", b.line_rms_N},
+  return json{{"lower_mm", b.lower_mm},
+              {"lower_N", b.lower_N},
+              {"upper_mm", b.upper_mm},
+              {"upper_N", b.upper_N},
+              {"slopes_N_mm", {b.slope_start, b.slope_middle, b.slope_end}},
+              {"rms_N", b.rms_N},
+              {"line_rms_N", b.line_rms_N},
               {"plateau", b.has_plateau()}};
 }
 }  // namespace
@@ -31,8 +36,8 @@ json loop_json(const LoopFigures& L) {
   if (L.loading) j["loading_knees"] = knees(*L.loading);
   if (L.unloading) j["unloading_knees"] = knees(*L.unloading);
   if (L.transformation)
-    j["transformation"] = {{"Ms", point(L.transformation->Ms)}, {"Mf", point(L.transformation->Mf)},
-                           {"As", point(L.transformation->As)}, {"Af", point(L.transformation->Af)}};
+    j["transformation"] = {
+        {"Ms", point(L.transformation->Ms)}, {"Mf", point(L.transformation->Mf)}, {"As", point(L.transformation->As)}, {"Af", point(L.transformation->Af)}};
   return j;
 }
 

@@ -114,11 +114,9 @@ ActiveSetResult solve_nonnegative(const MatrixXd& Q, const VectorXd& g, const Ve
   return r;
 }
 
-
 }  // namespace
 
-LsqFitResult fit_preisach_lsq(std::span<const double> x, std::span<const double> y, const Grid& grid,
-                              const LsqFitOptions& opt) {
+LsqFitResult fit_preisach_lsq(std::span<const double> x, std::span<const double> y, const Grid& grid, const LsqFitOptions& opt) {
   check_fit_record(x, y, grid, 48);
   const std::size_t nodes = grid.node_count(), cells = grid.cell_count();
   const auto N = static_cast<double>(x.size());

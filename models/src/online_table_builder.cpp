@@ -11,10 +11,14 @@ class FotErrorCategory final : public std::error_category {
   const char* name() const noexcept override { return "hystlab.fot"; }
   std::string message(int c) const override {
     switch (static_cast<FotError>(c)) {
-      case FotError::off_grid_alpha: return "alpha is not on a grid node";
-      case FotError::off_grid_beta: return "beta is not on a grid node";
-      case FotError::beta_above_alpha: return "beta is above alpha";
-      case FotError::not_finite: return "a value is not a finite number";
+      case FotError::off_grid_alpha:
+        return "alpha is not on a grid node";
+      case FotError::off_grid_beta:
+        return "beta is not on a grid node";
+      case FotError::beta_above_alpha:
+        return "beta is above alpha";
+      case FotError::not_finite:
+        return "a value is not a finite number";
     }
     return "unknown FOT error";
   }
@@ -34,8 +38,7 @@ OnlineTableBuilder::OnlineTableBuilder(Grid grid, double tolerance)
       f_alpha_(static_cast<std::size_t>(grid.n) + 1) {}
 
 std::error_code OnlineTableBuilder::add(const FotNode& node) noexcept {
-  if (!std::isfinite(node.alpha) || !std::isfinite(node.beta) || !std::isfinite(node.force_alpha) ||
-      !std::isfinite(node.force_alpha_beta))
+  if (!std::isfinite(node.alpha) || !std::isfinite(node.beta) || !std::isfinite(node.force_alpha) || !std::isfinite(node.force_alpha_beta))
     return FotError::not_finite;
   const int i = grid_.node_near(node.alpha, tolerance_);
   if (i < 0) return FotError::off_grid_alpha;
@@ -52,9 +55,7 @@ std::error_code OnlineTableBuilder::add(const FotNode& node) noexcept {
   return {};
 }
 
-bool OnlineTableBuilder::identified(int i, int j) const noexcept {
-  return i == j || count_[Grid::index(i, j)] > 0;
-}
+bool OnlineTableBuilder::identified(int i, int j) const noexcept { return i == j || count_[Grid::index(i, j)] > 0; }
 
 bool OnlineTableBuilder::cell_identified(int p, int q) const noexcept {
   if (q == p) return identified(p, p - 1);
@@ -73,9 +74,11 @@ EverettTable OnlineTableBuilder::table() const {
   for (int i = 1; i <= grid_.n; ++i) {
     for (int j = i - 1; j >= 0; --j) {
       const std::size_t k = Grid::index(i, j);
-      if (count_[k] > 0) v[k] = sum_[k] / count_[k];
-      else if (j == i - 1) v[k] = 0.0;  // triangle cell with zero weight
-      else  // rectangle cell (i, j+1) with zero weight
+      if (count_[k] > 0)
+        v[k] = sum_[k] / count_[k];
+      else if (j == i - 1)
+        v[k] = 0.0;  // triangle cell with zero weight
+      else           // rectangle cell (i, j+1) with zero weight
         v[k] = v[Grid::index(i, j + 1)] + v[Grid::index(i - 1, j)] - v[Grid::index(i - 1, j + 1)];
     }
   }

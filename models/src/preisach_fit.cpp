@@ -53,8 +53,7 @@ void validate(std::span<const double> x, std::span<const double> y, const Grid& 
   if (std::isnan(o.lambda) || o.lambda > 1e6)
     throw std::invalid_argument("fit: lambda must be a number from 0 to 1e6 (or negative to choose it by cross-validation)");
   if (!(o.tolerance > 0.0 && o.tolerance <= 0.1)) throw std::invalid_argument("fit: tolerance must be in (0, 0.1]");
-  if (o.uncertainty_probes < 0 || o.uncertainty_probes > 1000)
-    throw std::invalid_argument("fit: uncertainty_probes must be from 0 to 1000");
+  if (o.uncertainty_probes < 0 || o.uncertainty_probes > 1000) throw std::invalid_argument("fit: uncertainty_probes must be from 0 to 1000");
   (void)Grid::make(grid.lo, grid.hi, grid.n);  // a grid not built by Grid::make is checked the same way
   check_fit_record(x, y, grid, o.max_subdivisions);
 }
@@ -80,8 +79,8 @@ void solve(const NormalSystem& s, FitPrior prior, double tol, Solved& out) {
 
 // Held-out RMS for every λ of kLambdas: fold f trains on all samples but block f and is scored on
 // block f, whose memory state comes from the whole record before it.
-std::vector<double> cross_validate(const PreisachOperator& op, std::span<const double> y, FitPrior prior, int folds,
-                                   std::span<const double> lambdas, int& iterations) {
+std::vector<double> cross_validate(const PreisachOperator& op, std::span<const double> y, FitPrior prior, int folds, std::span<const double> lambdas,
+                                   int& iterations) {
   const std::size_t N = op.samples();
   std::vector<double> sse(lambdas.size(), 0.0), pred(N);
   for (int f = 0; f < folds; ++f) {
@@ -122,8 +121,7 @@ std::vector<double> cross_validate(const PreisachOperator& op, std::span<const d
 // Per-cell σ and the effective number of parameters from random probes z of the samples:
 // v = Q_F⁻¹ (Jᵀ z)_F has E[v∘v] = diag(Q_F⁻¹ H_F Q_F⁻¹) and E[(Jᵀz)·v] = tr(Q_F⁻¹ H_F) on the
 // free set F, with the exact sandwich covariance σ² Q⁻¹ H Q⁻¹ of the dense fit as its mean.
-void uncertainty(const NormalSystem& s, const Solved& sol, double rss, std::size_t samples, int probes, PriorFit& r,
-                 int& iterations) {
+void uncertainty(const NormalSystem& s, const Solved& sol, double rss, std::size_t samples, int probes, PriorFit& r, int& iterations) {
   const std::size_t m = s.size(), cells = s.cells();
   std::vector<double> var(m, 0.0), z(samples), jz(m);
   double edf = 0.0;
@@ -135,9 +133,7 @@ void uncertainty(const NormalSystem& s, const Solved& sol, double rss, std::size
       if (sol.free[c] == 0) jz[c] = 0.0;
     std::vector<double> v(m, 0.0);
     const bool all_free = std::all_of(sol.free.begin(), sol.free.end(), [](std::uint8_t f) { return f != 0; });
-    iterations +=
-        fit::solve_on_face(s, jz, v, all_free ? std::span<const std::uint8_t>{} : sol.free, 1e-6, kMaxIterations, false)
-            .iterations;
+    iterations += fit::solve_on_face(s, jz, v, all_free ? std::span<const std::uint8_t>{} : sol.free, 1e-6, kMaxIterations, false).iterations;
     for (std::size_t c = 0; c < m; ++c) {
       var[c] += v[c] * v[c] / probes;
       edf += jz[c] * v[c] / probes;
@@ -161,8 +157,8 @@ NormalSystem whole_record(const PreisachOperator& op, std::span<const double> y,
   return s;
 }
 
-FinalFit final_fit(const PreisachOperator& op, std::span<const double> x, std::span<const double> y, FitPrior prior,
-                   double lambda, double tolerance, const std::vector<double>* start = nullptr) {
+FinalFit final_fit(const PreisachOperator& op, std::span<const double> x, std::span<const double> y, FitPrior prior, double lambda, double tolerance,
+                   const std::vector<double>* start = nullptr) {
   const Grid& g = op.grid();
   FinalFit out;
   out.solved.u = start ? *start : std::vector<double>(g.cell_count() + 1, 0.0);
@@ -197,15 +193,12 @@ FinalFit final_fit(const PreisachOperator& op, std::span<const double> x, std::s
 
 // One prior: λ by cross-validation, or the given λ scored on the same held-out blocks (so `auto`
 // still compares the priors on data they were not fitted to); then its fit on the whole record.
-FinalFit fit_prior(const PreisachOperator& op, std::span<const double> x, std::span<const double> y, FitPrior prior,
-                   const PreisachFitOptions& o) {
-  const std::vector<double> lambdas =
-      o.lambda < 0.0 ? std::vector<double>(std::begin(kLambdas), std::end(kLambdas)) : std::vector<double>{o.lambda};
+FinalFit fit_prior(const PreisachOperator& op, std::span<const double> x, std::span<const double> y, FitPrior prior, const PreisachFitOptions& o) {
+  const std::vector<double> lambdas = o.lambda < 0.0 ? std::vector<double>(std::begin(kLambdas), std::end(kLambdas)) : std::vector<double>{o.lambda};
   int cv_iterations = 0;
   std::vector<double> rms = cross_validate(op, y, prior, o.folds, lambdas, cv_iterations);
   const auto best = static_cast<std::size_t>(std::min_element(rms.begin(), rms.end()) - rms.begin());
-  if (!std::isfinite(rms[best]))
-    throw std::invalid_argument("fit: every smoothing weight gave a non-finite error: the record cannot be fitted");
+  if (!std::isfinite(rms[best])) throw std::invalid_argument("fit: every smoothing weight gave a non-finite error: the record cannot be fitted");
   FinalFit f = final_fit(op, x, y, prior, lambdas[best], o.tolerance);
   f.fit.heldout_rms = rms[best];
   f.fit.cv_lambda = lambdas;
@@ -228,9 +221,12 @@ std::string describe(const PriorFit& f) {
 
 std::string_view to_string(FitPrior p) noexcept {
   switch (p) {
-    case FitPrior::signed_masses: return "signed";
-    case FitPrior::monotone: return "monotone";
-    case FitPrior::automatic: return "auto";
+    case FitPrior::signed_masses:
+      return "signed";
+    case FitPrior::monotone:
+      return "monotone";
+    case FitPrior::automatic:
+      return "auto";
   }
   return "?";
 }
@@ -242,8 +238,7 @@ FitPrior fit_prior_from_string(std::string_view s) {
   throw std::invalid_argument("prior: must be signed, monotone or auto, got '" + std::string(s) + "'");
 }
 
-PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double> y, const Grid& grid,
-                               const PreisachFitOptions& o) {
+PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double> y, const Grid& grid, const PreisachFitOptions& o) {
   validate(x, y, grid, o);
   const auto t0 = std::chrono::steady_clock::now();
   // A long record: λ, the prior and σ from the thinned record (sel), the chosen prior's table from
@@ -255,8 +250,10 @@ PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double
   PreisachFitResult result;
   result.selection_samples = sx.size();
   std::vector<FitPrior> priors;
-  if (o.prior == FitPrior::automatic) priors = {FitPrior::signed_masses, FitPrior::monotone};
-  else priors = {o.prior};
+  if (o.prior == FitPrior::automatic)
+    priors = {FitPrior::signed_masses, FitPrior::monotone};
+  else
+    priors = {o.prior};
   std::vector<FinalFit> finals;
   for (const FitPrior prior : priors) finals.push_back(fit_prior(sel, sx, sy, prior, o));
   std::size_t best = 0;
@@ -267,8 +264,7 @@ PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double
   // the whole record's, so the whole record's σ is about √(s/N) of it.
   PriorFit& chosen = finals[best].fit;
   if (o.uncertainty_probes > 0) {
-    uncertainty(whole_record(sel, sy, chosen.lambda), finals[best].solved, finals[best].rss, sx.size(), o.uncertainty_probes, chosen,
-                chosen.iterations);
+    uncertainty(whole_record(sel, sy, chosen.lambda), finals[best].solved, finals[best].rss, sx.size(), o.uncertainty_probes, chosen, chosen.iterations);
     if (thinned)
       for (double& s : chosen.cell_sigma) s *= std::sqrt(static_cast<double>(sx.size()) / static_cast<double>(x.size()));
   }
@@ -289,14 +285,12 @@ PreisachFitResult fit_preisach(std::span<const double> x, std::span<const double
   if (result.candidates.size() > 1) {
     const PriorFit& w = result.candidates[best];
     const PriorFit& l = result.candidates[1 - best];
-    result.reason = describe(w) + " against " + describe(l) + ": " + std::string(to_string(w.prior)) +
-                    " has the lower error on held-out blocks of the record";
+    result.reason = describe(w) + " against " + describe(l) + ": " + std::string(to_string(w.prior)) + " has the lower error on held-out blocks of the record";
   } else {
     result.reason = describe(result.candidates[0]) + " (prior " + std::string(to_string(o.prior)) + " as asked)";
   }
   for (const PriorFit& f : result.candidates)
-    if (!f.converged)
-      result.reason += "; WARNING: the " + std::string(to_string(f.prior)) + " solve stopped at its step limit before converging";
+    if (!f.converged) result.reason += "; WARNING: the " + std::string(to_string(f.prior)) + " solve stopped at its step limit before converging";
   result.chosen = result.candidates[best];
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // The operator, one system's scratch and a few solver vectors of the cells are alive at once.

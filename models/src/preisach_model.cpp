@@ -1,19 +1,18 @@
 #include "hystlab/models/preisach_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
-#include <algorithm>
 #include <stdexcept>
 #include <string>
 
 namespace hystlab::models {
 
-PreisachModel::PreisachModel(std::shared_ptr<const EverettTable> table, PreisachOptions options)
-    : table_(std::move(table)), options_(options) {
+PreisachModel::PreisachModel(std::shared_ptr<const EverettTable> table, PreisachOptions options) : table_(std::move(table)), options_(options) {
   if (!table_) throw std::invalid_argument("preisach: no table");
   if (options_.max_turning_points < 3) throw std::invalid_argument("preisach: max_turning_points must be >= 3");
   if (!(options_.merge_tolerance >= 0.0)) throw std::invalid_argument("preisach: merge_tolerance must be >= 0");
-  turning_.assign(options_.max_turning_points + 1, 0.0);  // + 1 spare slot
+  turning_.assign(options_.max_turning_points + 1, 0.0);     // + 1 spare slot
   closed_.assign(options_.max_turning_points / 2 + 2, 0.0);  // + 1 scratch slot
   reset();
 }
@@ -44,14 +43,14 @@ constexpr std::size_t kPreisachHead = 8;  // kind, len, x, f, base and the three
 // A count stored as a double: a whole number in [lo, hi], or the error names it.
 std::size_t state_count(double v, double lo, double hi, const char* what) {
   if (!(v >= lo && v <= hi) || v != std::floor(v))
-    throw std::invalid_argument(std::string("model state: ") + what + " is not a whole number in [" + std::to_string(static_cast<long long>(lo)) +
-                                ", " + std::to_string(static_cast<long long>(hi)) + "]");
+    throw std::invalid_argument(std::string("model state: ") + what + " is not a whole number in [" + std::to_string(static_cast<long long>(lo)) + ", " +
+                                std::to_string(static_cast<long long>(hi)) + "]");
   return static_cast<std::size_t>(v);
 }
 }  // namespace
 
 std::vector<double> PreisachModel::save_state() const {
-  std::vector<double> s{kPreisachStateKind, static_cast<double>(len_), x_, f_, base_, static_cast<double>(saturations_),
+  std::vector<double> s{kPreisachStateKind,           static_cast<double>(len_),    x_, f_, base_, static_cast<double>(saturations_),
                         static_cast<double>(merges_), static_cast<double>(invalid_)};
   s.insert(s.end(), turning_.begin(), turning_.begin() + static_cast<std::ptrdiff_t>(len_));
   s.insert(s.end(), closed_.begin(), closed_.begin() + static_cast<std::ptrdiff_t>(len_ / 2 + 1));

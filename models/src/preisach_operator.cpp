@@ -84,9 +84,7 @@ PreisachOperator::PreisachOperator(const Grid& grid, std::span<const double> inp
   held_.shrink_to_fit();
 }
 
-std::size_t PreisachOperator::memory_bytes() const noexcept {
-  return held_.capacity() * sizeof(HeldTerm) + live_.capacity() * sizeof(LiveStencil);
-}
+std::size_t PreisachOperator::memory_bytes() const noexcept { return held_.capacity() * sizeof(HeldTerm) + live_.capacity() * sizeof(LiveStencil); }
 
 void PreisachOperator::apply(std::span<const double> v, std::span<double> out) const {
   if (v.size() != nodes() || out.size() != samples()) throw std::invalid_argument("PreisachOperator::apply: sizes");
@@ -102,8 +100,7 @@ void PreisachOperator::apply(std::span<const double> v, std::span<double> out) c
   for (std::size_t k = 0; k < samples(); ++k) {
     held += out[k];
     const LiveStencil& l = live_[k];
-    out[k] = held + l.weight[0] * v[l.node[0]] + l.weight[1] * v[l.node[1]] + l.weight[2] * v[l.node[2]] +
-             l.weight[3] * v[l.node[3]];
+    out[k] = held + l.weight[0] * v[l.node[0]] + l.weight[1] * v[l.node[1]] + l.weight[2] * v[l.node[2]] + l.weight[3] * v[l.node[3]];
   }
 }
 
@@ -112,8 +109,7 @@ void PreisachOperator::apply_transpose(std::span<const double> u, std::span<doub
   apply_transpose(u, g, prefix);
 }
 
-void PreisachOperator::apply_transpose(std::span<const double> u, std::span<double> g,
-                                       std::vector<double>& prefix) const {
+void PreisachOperator::apply_transpose(std::span<const double> u, std::span<double> g, std::vector<double>& prefix) const {
   if (u.size() != samples() || g.size() != nodes()) throw std::invalid_argument("PreisachOperator::apply_transpose: sizes");
   // prefix[k] = Σ_{j<k} u[j], so a held term's share is weight * (prefix[end] - prefix[start]).
   prefix.resize(samples() + 1);

@@ -10,8 +10,7 @@ namespace {
 void add_term(const EverettTable& shape, std::map<std::size_t, double>& row, double a, double b, double sign) {
   const InterpolationStencil st = shape.stencil(a, b);
   for (int k = 0; k < st.size; ++k)
-    if (st.weight[static_cast<std::size_t>(k)] != 0.0)
-      row[st.node[static_cast<std::size_t>(k)]] += sign * st.weight[static_cast<std::size_t>(k)];
+    if (st.weight[static_cast<std::size_t>(k)] != 0.0) row[st.node[static_cast<std::size_t>(k)]] += sign * st.weight[static_cast<std::size_t>(k)];
 }
 
 }  // namespace

@@ -22,8 +22,10 @@ double RelayGrid::step(double x) noexcept {
   for (std::size_t k = 0; k < n; ++k) {
     const Relay& r = relays_[k];
     std::uint8_t s = on_[k];
-    if (x >= r.alpha) s = 1;
-    else if (x <= r.beta) s = 0;
+    if (x >= r.alpha)
+      s = 1;
+    else if (x <= r.beta)
+      s = 0;
     on_[k] = s;
     f += s ? r.weight : 0.0;
   }

@@ -32,8 +32,7 @@ double force_at(std::span<const double> x, std::span<const double> f, std::size_
   return f[to];
 }
 
-std::vector<double> branch_shape(std::span<const double> x, std::span<const double> f, std::size_t from,
-                                 std::size_t to, double lo, double hi, int points) {
+std::vector<double> branch_shape(std::span<const double> x, std::span<const double> f, std::size_t from, std::size_t to, double lo, double hi, int points) {
   std::vector<double> s(static_cast<std::size_t>(points) + 1);
   const bool up = x[to] >= x[from];
   const double f0 = force_at(x, f, from, to, up ? lo : hi);
@@ -72,12 +71,10 @@ std::vector<std::size_t> find_reversals(std::span<const double> x, double dead_b
   return out;
 }
 
-RepresentationReport check_representation(std::span<const double> x, std::span<const double> f,
-                                          const RepresentationOptions& opt) {
+RepresentationReport check_representation(std::span<const double> x, std::span<const double> f, const RepresentationOptions& opt) {
   if (x.size() != f.size()) throw std::invalid_argument("check: displacement and force differ in length");
   for (std::size_t k = 0; k < x.size(); ++k)
-    if (!std::isfinite(x[k]) || !std::isfinite(f[k]))
-      throw std::invalid_argument("check: sample " + std::to_string(k) + " is not a finite number");
+    if (!std::isfinite(x[k]) || !std::isfinite(f[k])) throw std::invalid_argument("check: sample " + std::to_string(k) + " is not a finite number");
   RepresentationReport r;
   if (x.size() < 3) return r;
   const auto [xmin, xmax] = std::minmax_element(x.begin(), x.end());

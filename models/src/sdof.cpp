@@ -43,8 +43,7 @@ SdofSystem::SdofSystem(std::vector<SdofSpring> springs, const SdofOptions& o) : 
   omega_max_ = std::sqrt(kMmPerS2PerNPerKg * k_sum / o.mass_kg);
   if (o.dt_s * omega_max_ >= 1.0)
     fail("dt_s", "a step of " + short_num(o.dt_s) + " s is unstable for this system: dt·ω_max = " + short_num(o.dt_s * omega_max_) +
-                     " (ω_max = sqrt(1000·Σk_max/m) = " + short_num(omega_max_) + " rad/s) must stay below 1; use dt ≤ " +
-                     short_num(0.5 / omega_max_) + " s");
+                     " (ω_max = sqrt(1000·Σk_max/m) = " + short_num(omega_max_) + " rad/s) must stay below 1; use dt ≤ " + short_num(0.5 / omega_max_) + " s");
   // Load the springs monotonically from rest to the preload: the weight is what they then carry.
   for (auto& s : springs_) s.model->reset();
   constexpr int kLoadSteps = 200;
@@ -104,7 +103,8 @@ SteadyResponse steady_response(SdofSystem& sys, double amplitude_mm, double freq
   if (!(amplitude_mm > 0) || !std::isfinite(amplitude_mm)) fail("amplitude_mm", "must be a positive amplitude");
   if (settle_cycles < 0 || measured_cycles < 1) fail("cycles", "settle ≥ 0 and measured ≥ 1 cycles");
   const double period = 1.0 / frequency_hz;
-  if (period < 8 * sys.dt()) fail("frequency_hz", "needs at least 8 steps per cycle: " + short_num(frequency_hz) + " Hz is too fast for dt = " + short_num(sys.dt()) + " s");
+  if (period < 8 * sys.dt())
+    fail("frequency_hz", "needs at least 8 steps per cycle: " + short_num(frequency_hz) + " Hz is too fast for dt = " + short_num(sys.dt()) + " s");
   sys.set_base(amplitude_mm, frequency_hz);
   sys.run_for(settle_cycles * period);
   const auto n = static_cast<std::size_t>(std::llround(measured_cycles * period / sys.dt()));

@@ -28,9 +28,9 @@ SmaTransitions transitions(const SmaParameters& p) noexcept {
 }
 
 void validate(const SmaParameters& p) {
-  const std::pair<const char*, double> fields[] = {{"KA_N_per_mm", p.KA},   {"KM_N_per_mm", p.KM}, {"dtr_max_mm", p.dtr_max},
-                                                   {"C_N_per_degC", p.C},   {"Mf0_degC", p.Mf0},   {"Ms0_degC", p.Ms0},
-                                                   {"As0_degC", p.As0},     {"Af0_degC", p.Af0},   {"T_degC", p.T}};
+  const std::pair<const char*, double> fields[] = {{"KA_N_per_mm", p.KA}, {"KM_N_per_mm", p.KM}, {"dtr_max_mm", p.dtr_max},
+                                                   {"C_N_per_degC", p.C}, {"Mf0_degC", p.Mf0},   {"Ms0_degC", p.Ms0},
+                                                   {"As0_degC", p.As0},   {"Af0_degC", p.Af0},   {"T_degC", p.T}};
   for (const auto& [name, v] : fields) require(std::isfinite(v), name, "is not a finite number");
   require(p.KA > 0, "KA_N_per_mm", "must be > 0");
   require(p.KM > 0, "KM_N_per_mm", "must be > 0");
@@ -40,15 +40,12 @@ void validate(const SmaParameters& p) {
   require(p.As0 < p.Af0, "Af0_degC", "must be above As0_degC");
   require(p.T > p.Af0, "T_degC", "must be above Af0_degC (the model is superelastic: austenite at rest)");
   const SmaTransitions t = transitions(p);
-  require(t.Mf.displacement > t.Ms.displacement, "dtr_max_mm",
-          "is too small: the forward transformation would end (δMf) before it starts (δMs)");
-  require(t.As.displacement > t.Af.displacement, "dtr_max_mm",
-          "is too small: the reverse transformation would end (δAf) after it starts (δAs)");
+  require(t.Mf.displacement > t.Ms.displacement, "dtr_max_mm", "is too small: the forward transformation would end (δMf) before it starts (δMs)");
+  require(t.As.displacement > t.Af.displacement, "dtr_max_mm", "is too small: the reverse transformation would end (δAf) after it starts (δAs)");
   const double kmin = std::min(p.KA, p.KM);
   require(t.forward_slope() < kmin, "Mf0_degC", "gives a forward transformation line steeper than the elastic lines");
   require(t.reverse_slope() < kmin, "As0_degC", "gives a reverse transformation line steeper than the elastic lines");
-  require(t.As.force <= t.Mf.force && t.Af.force < t.Ms.force, "As0_degC",
-          "puts the reverse transformation above the forward one");
+  require(t.As.force <= t.Mf.force && t.Af.force < t.Ms.force, "As0_degC", "puts the reverse transformation above the forward one");
 }
 
 SimplifiedSmaModel::SimplifiedSmaModel(const SmaParameters& p) : p_(p), tr_(transitions(p)) {
@@ -148,9 +145,15 @@ double SimplifiedSmaModel::step(double x) noexcept {
   for (int pass = 0; pass < 16 && x != d_; ++pass) {
     bool reached = false;
     switch (phase_) {
-      case Phase::Elastic: reached = advance_elastic(x); break;
-      case Phase::Forward: reached = advance_forward(x); break;
-      case Phase::Reverse: reached = advance_reverse(x); break;
+      case Phase::Elastic:
+        reached = advance_elastic(x);
+        break;
+      case Phase::Forward:
+        reached = advance_forward(x);
+        break;
+      case Phase::Reverse:
+        reached = advance_reverse(x);
+        break;
     }
     if (reached) break;
   }

@@ -29,8 +29,7 @@ SmaParameters to_parameters(const Vec7& v, const SmaCalibrationOptions& o) {
   return p;
 }
 
-bool residuals(const Vec7& v, const SmaCalibrationOptions& o, std::span<const double> x, std::span<const double> y,
-               VectorXd& r) {
+bool residuals(const Vec7& v, const SmaCalibrationOptions& o, std::span<const double> x, std::span<const double> y, VectorXd& r) {
   const SmaParameters p = to_parameters(v, o);
   try {
     validate(p);
@@ -47,30 +46,27 @@ bool residuals(const Vec7& v, const SmaCalibrationOptions& o, std::span<const do
 // figures' transformation points): loading gives KA, KM, Ms, Mf and so δtr_max; unloading Af, As.
 Vec7 initial_guess(std::span<const double> x, std::span<const double> y) {
   const std::size_t top = static_cast<std::size_t>(std::max_element(x.begin(), x.end()) - x.begin());
-  if (top + 1 < 10 || x.size() - top < 10)
-    throw std::invalid_argument("calibrate: the loop needs at least 10 samples on loading and on unloading");
+  if (top + 1 < 10 || x.size() - top < 10) throw std::invalid_argument("calibrate: the loop needs at least 10 samples on loading and on unloading");
   const auto up = fit_branch_knees(x.subspan(0, top + 1), y.subspan(0, top + 1));
   const auto down = fit_branch_knees(x.subspan(top), y.subspan(top));
   if (!up || !down) throw std::invalid_argument("calibrate: the loop's branches do not span a displacement range");
   Vec7 v{};
-  v[0] = up->slope_start;                 // KA: first slope of loading
-  v[1] = up->slope_end;                   // KM: last slope of loading
-  v[3] = up->lower_N;                     // fMs
-  v[4] = up->upper_N;                     // fMf
-  v[2] = up->upper_mm - v[4] / v[1];      // δtr_max from δMf = fMf/KM + δtr_max
-  v[6] = down->lower_N;                   // fAf (lower corner of unloading)
-  v[5] = down->upper_N;                   // fAs (upper corner)
+  v[0] = up->slope_start;             // KA: first slope of loading
+  v[1] = up->slope_end;               // KM: last slope of loading
+  v[3] = up->lower_N;                 // fMs
+  v[4] = up->upper_N;                 // fMf
+  v[2] = up->upper_mm - v[4] / v[1];  // δtr_max from δMf = fMf/KM + δtr_max
+  v[6] = down->lower_N;               // fAf (lower corner of unloading)
+  v[5] = down->upper_N;               // fAs (upper corner)
   return v;
 }
 
 }  // namespace
 
-SmaCalibration calibrate_simplified_sma(std::span<const double> x, std::span<const double> y,
-                                        const SmaCalibrationOptions& o) {
+SmaCalibration calibrate_simplified_sma(std::span<const double> x, std::span<const double> y, const SmaCalibrationOptions& o) {
   if (x.size() != y.size()) throw std::invalid_argument("calibrate: displacement and force differ in length");
   for (std::size_t k = 0; k < x.size(); ++k)
-    if (!std::isfinite(x[k]) || !std::isfinite(y[k]))
-      throw std::invalid_argument("calibrate: sample " + std::to_string(k) + " is not a finite number");
+    if (!std::isfinite(x[k]) || !std::isfinite(y[k])) throw std::invalid_argument("calibrate: sample " + std::to_string(k) + " is not a finite number");
   if (!(o.C > 0) || !std::isfinite(o.T)) throw std::invalid_argument("calibrate: C must be > 0 and T finite");
   Vec7 v = initial_guess(x, y);
   SmaCalibration out;

@@ -5,9 +5,9 @@
 #include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <sstream>
 #include <tuple>
 #include <vector>
-#include <sstream>
 
 namespace hystlab::models {
 namespace {
@@ -101,9 +101,8 @@ std::string upper(std::string s) {
 
 // The parameters in the order of docs/FORMATS.md, with their units.
 std::vector<std::tuple<const char*, double, const char*>> params_of(const SmaParameters& p) {
-  return {{"KA", p.KA, "N/mm"},     {"KM", p.KM, "N/mm"},     {"dtr_max", p.dtr_max, "mm"}, {"C", p.C, "N/degC"},
-          {"Mf0", p.Mf0, "degC"},   {"Ms0", p.Ms0, "degC"},   {"As0", p.As0, "degC"},      {"Af0", p.Af0, "degC"},
-          {"T", p.T, "degC"}};
+  return {{"KA", p.KA, "N/mm"},   {"KM", p.KM, "N/mm"},   {"dtr_max", p.dtr_max, "mm"}, {"C", p.C, "N/degC"}, {"Mf0", p.Mf0, "degC"},
+          {"Ms0", p.Ms0, "degC"}, {"As0", p.As0, "degC"}, {"Af0", p.Af0, "degC"},       {"T", p.T, "degC"}};
 }
 }  // namespace
 
@@ -112,8 +111,8 @@ std::string table_to_c_header(const EverettTable& table, const TableProvenance& 
   const std::string N = upper(name);
   const Grid& g = table.grid();
   std::ostringstream o;
-  o << "/* hystlab Everett table (" << kTableFormat << " v" << version_of(g) << "), " << one_line(p.method) << ", "
-    << one_line(p.source) << ", created " << one_line(p.created) << ".\n"
+  o << "/* hystlab Everett table (" << kTableFormat << " v" << version_of(g) << "), " << one_line(p.method) << ", " << one_line(p.source) << ", created "
+    << one_line(p.created) << ".\n"
     << " * F(delta_i, delta_j) in N for 0 <= j <= i <= n at " << N << "_VALUES_N[i*(i+1)/2 + j];\n"
     << (g.uniform() ? " * delta_i = lo + (hi - lo) * i / n in mm." : " * delta_i = " + N + "_NODES_MM[i] in mm (a grid of its own).")
     << " Evaluate with the memory-stack rule of hystlab's docs. */\n"
@@ -128,8 +127,7 @@ std::string table_to_c_header(const EverettTable& table, const TableProvenance& 
     for (int i = 0; i <= g.n; ++i) o << (i ? ", " : "") << num(g.node(i));
     o << "};\n";
   }
-  o
-    << "static const double " << N << "_VALUES_N[" << N << "_NODE_COUNT] = {\n";
+  o << "static const double " << N << "_VALUES_N[" << N << "_NODE_COUNT] = {\n";
   for (int i = 0; i <= g.n; ++i) {
     o << "   ";
     for (int j = 0; j <= i; ++j) o << " " << num(table.node_value(i, j)) << ",";
@@ -178,11 +176,10 @@ std::string table_to_csv(const EverettTable& table, const TableProvenance& p) {
 std::string table_to_matlab(const EverettTable& table, const TableProvenance& p) {
   const Grid& g = table.grid();
   std::ostringstream o;
-  o << "% hystlab Everett table (" << kTableFormat << " v" << version_of(g) << "), " << one_line(p.method) << ", "
-    << one_line(p.source) << ", created " << one_line(p.created) << ".\n"
+  o << "% hystlab Everett table (" << kTableFormat << " v" << version_of(g) << "), " << one_line(p.method) << ", " << one_line(p.source) << ", created "
+    << one_line(p.created) << ".\n"
     << "% Run this script, then: f = hystlab_eval(T, x) for displacements x in mm (force in N).\n"
-    << "T = struct();\nT.lo = " << num(g.lo) << ";\nT.hi = " << num(g.hi) << ";\nT.n = " << g.n
-    << ";\nT.force_offset = " << num(table.force_offset()) << ";\n";
+    << "T = struct();\nT.lo = " << num(g.lo) << ";\nT.hi = " << num(g.hi) << ";\nT.n = " << g.n << ";\nT.force_offset = " << num(table.force_offset()) << ";\n";
   if (!g.uniform()) {
     o << "T.nodes = [";
     for (int i = 0; i <= g.n; ++i) o << (i ? " " : "") << num(g.node(i));

@@ -18,8 +18,7 @@ nlohmann::json accuracy_json(const AccuracyReport& r) {
   auto branch = [](const ErrorStats& s) {
     return json{{"samples", s.count}, {"rms_N", s.rms}, {"max_N", s.max_abs}, {"rms_norm", s.rms_norm}, {"max_norm", s.max_norm}};
   };
-  json j{{"overall", branch(r.overall)}, {"ascending", branch(r.ascending)}, {"descending", branch(r.descending)},
-         {"reference_range_N", r.reference_range}};
+  json j{{"overall", branch(r.overall)}, {"ascending", branch(r.ascending)}, {"descending", branch(r.descending)}, {"reference_range_N", r.reference_range}};
   if (r.energy_rel_error) j["loop_energy_rel_error"] = *r.energy_rel_error;
   return j;
 }

@@ -47,8 +47,10 @@ std::vector<std::size_t> reversals_of(std::span<const float> x, double threshold
     if (dir == 0) {  // the first move decides the direction
       if (v > x[hi]) hi = k;
       if (v < x[lo]) lo = k;
-      if (v - x[lo] > threshold) dir = 1, ext = k;
-      else if (x[hi] - v > threshold) dir = -1, ext = k;
+      if (v - x[lo] > threshold)
+        dir = 1, ext = k;
+      else if (x[hi] - v > threshold)
+        dir = -1, ext = k;
       continue;
     }
     if (dir > 0 ? v >= x[ext] : v <= x[ext]) {

@@ -80,8 +80,8 @@ std::error_code encode(const Message& m, int node, can_frame& f) noexcept {
     f.data[4] = sc->enable ? 1 : 0;
   } else if (const auto* ss = std::get_if<ShakerStatus>(&m)) {
     std::int16_t ba = 0, ma = 0, bd = 0, md = 0;
-    ok = scaled(ss->base_accel_m_s2, 1e-2, ba) && scaled(ss->mass_accel_m_s2, 1e-2, ma) &&
-         scaled(ss->base_displacement_mm, 1e-3, bd) && scaled(ss->mass_displacement_mm, 1e-3, md);
+    ok = scaled(ss->base_accel_m_s2, 1e-2, ba) && scaled(ss->mass_accel_m_s2, 1e-2, ma) && scaled(ss->base_displacement_mm, 1e-3, bd) &&
+         scaled(ss->mass_displacement_mm, 1e-3, md);
     start(f, kShakerStatus, node, 8);
     put(f, 0, ba);
     put(f, 2, ma);
@@ -102,8 +102,13 @@ std::error_code decode(const can_frame& f, int node, Message& out) noexcept {
       if (!need(8)) return ProtocolError::wrong_length;
       if (f.data[6] & ~0x0FU) return ProtocolError::reserved_bits;
       if (f.data[7] > kMaxMode) return ProtocolError::out_of_range;
-      out = Command{get<std::int32_t>(f, 0) * 1e-3, get<std::uint16_t>(f, 4) * 1e-2, (f.data[6] & 1) != 0,
-                    (f.data[6] & 2) != 0, (f.data[6] & 4) != 0, f.data[7], (f.data[6] & 8) != 0};
+      out = Command{get<std::int32_t>(f, 0) * 1e-3,
+                    get<std::uint16_t>(f, 4) * 1e-2,
+                    (f.data[6] & 1) != 0,
+                    (f.data[6] & 2) != 0,
+                    (f.data[6] & 4) != 0,
+                    f.data[7],
+                    (f.data[6] & 8) != 0};
       return {};
     }
     case kStatusA:
@@ -129,10 +134,10 @@ std::error_code decode(const can_frame& f, int node, Message& out) noexcept {
       return {};
     case kShakerStatus:
       if (!need(8)) return ProtocolError::wrong_length;
-      out = ShakerStatus{get<std::int16_t>(f, 0) * 1e-2, get<std::int16_t>(f, 2) * 1e-2, get<std::int16_t>(f, 4) * 1e-3,
-                         get<std::int16_t>(f, 6) * 1e-3};
+      out = ShakerStatus{get<std::int16_t>(f, 0) * 1e-2, get<std::int16_t>(f, 2) * 1e-2, get<std::int16_t>(f, 4) * 1e-3, get<std::int16_t>(f, 6) * 1e-3};
       return {};
-    default: return ProtocolError::unknown_id;
+    default:
+      return ProtocolError::unknown_id;
   }
 }
 

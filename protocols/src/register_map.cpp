@@ -17,10 +17,14 @@ bool is_bit_table(ModbusTable t) { return t == ModbusTable::coil || t == ModbusT
 
 const char* table_name(ModbusTable t) {
   switch (t) {
-    case ModbusTable::coil: return "coil";
-    case ModbusTable::discrete_input: return "discrete_input";
-    case ModbusTable::holding_register: return "holding_register";
-    case ModbusTable::input_register: return "input_register";
+    case ModbusTable::coil:
+      return "coil";
+    case ModbusTable::discrete_input:
+      return "discrete_input";
+    case ModbusTable::holding_register:
+      return "holding_register";
+    case ModbusTable::input_register:
+      return "input_register";
   }
   return "?";
 }
@@ -41,8 +45,7 @@ double finite_number(const json& v, const std::string& where) {
 }
 
 std::uint16_t parse_address(const json& j, const std::string& where) {
-  if (!j.is_number_integer() || j.get<long long>() < 0 || j.get<long long>() > 65535)
-    fail(where + " must be an integer from 0 to 65535");
+  if (!j.is_number_integer() || j.get<long long>() < 0 || j.get<long long>() > 65535) fail(where + " must be an integer from 0 to 65535");
   return static_cast<std::uint16_t>(j.get<long long>());
 }
 
@@ -50,8 +53,8 @@ MapEntry parse_entry(Signal s, const json& j) {
   const std::string where = "signals." + std::string(signal_name(s));
   if (!j.is_object()) fail(where + " must be an object");
   for (const auto& [key, _] : j.items())
-    if (key != "table" && key != "address" && key != "type" && key != "word_order" && key != "scale" &&
-        key != "offset" && key != "unit" && key != "min" && key != "max")
+    if (key != "table" && key != "address" && key != "type" && key != "word_order" && key != "scale" && key != "offset" && key != "unit" && key != "min" &&
+        key != "max")
       fail(where + " has an unknown field '" + key + "'");
   MapEntry e;
   e.signal = s;
@@ -65,14 +68,16 @@ MapEntry parse_entry(Signal s, const json& j) {
   e.address = parse_address(j["address"], where + ".address");
   const json type = j.value("type", json(is_bit_table(e.table) ? "bool" : "uint16"));
   e.type = pick<ValueType>(type, where + ".type",
-                           {{"bool", ValueType::boolean}, {"int16", ValueType::int16}, {"uint16", ValueType::uint16},
-                            {"int32", ValueType::int32}, {"uint32", ValueType::uint32}, {"float32", ValueType::float32}});
+                           {{"bool", ValueType::boolean},
+                            {"int16", ValueType::int16},
+                            {"uint16", ValueType::uint16},
+                            {"int32", ValueType::int32},
+                            {"uint32", ValueType::uint32},
+                            {"float32", ValueType::float32}});
   if (is_bit_table(e.table) != (e.type == ValueType::boolean))
-    fail(where + ".type " + type.dump() + " does not fit table '" + table_name(e.table) +
-         "' (coils and discrete inputs are bool, registers are numbers)");
+    fail(where + ".type " + type.dump() + " does not fit table '" + table_name(e.table) + "' (coils and discrete inputs are bool, registers are numbers)");
   if (j.contains("word_order"))
-    e.word_order = pick<WordOrder>(j["word_order"], where + ".word_order",
-                                   {{"big", WordOrder::big}, {"swapped", WordOrder::swapped}});
+    e.word_order = pick<WordOrder>(j["word_order"], where + ".word_order", {{"big", WordOrder::big}, {"swapped", WordOrder::swapped}});
   if (j.contains("scale")) e.scale = finite_number(j["scale"], where + ".scale");
   if (e.scale == 0.0) fail(where + ".scale must not be 0");
   if (j.contains("offset")) e.offset = finite_number(j["offset"], where + ".offset");
@@ -109,15 +114,13 @@ SampleWindow parse_window(const json& j, const RegisterMap& m) {
   const std::string where = "sample_window";
   if (!j.is_object()) fail(where + " must be an object");
   for (const auto& [key, _] : j.items())
-    if (key != "table" && key != "address" && key != "records" && key != "period_s" && key != "fields")
-      fail(where + " has an unknown field '" + key + "'");
+    if (key != "table" && key != "address" && key != "records" && key != "period_s" && key != "fields") fail(where + " has an unknown field '" + key + "'");
   SampleWindow w;
   w.table = pick<ModbusTable>(j.value("table", json("input_register")), where + ".table",
                               {{"holding_register", ModbusTable::holding_register}, {"input_register", ModbusTable::input_register}});
   if (!j.contains("address")) fail(where + ".address is missing");
   w.address = parse_address(j["address"], where + ".address");
-  if (!j.contains("records") || !j["records"].is_number_integer() || j["records"].get<long long>() < 1 ||
-      j["records"].get<long long>() > 10000)
+  if (!j.contains("records") || !j["records"].is_number_integer() || j["records"].get<long long>() < 1 || j["records"].get<long long>() > 10000)
     fail(where + ".records must be an integer from 1 to 10000");
   w.records = j["records"].get<int>();
   if (!j.contains("period_s")) fail(where + ".period_s is missing");
@@ -162,8 +165,7 @@ namespace {
 double parse_sample_period(const json& p, const std::optional<SampleWindow>& window) {
   if (!p.is_number() || !(p.get<double>() > 0) || p.get<double>() > 1) fail("sample_period_s must be a number of seconds > 0 and <= 1");
   const double s = p.get<double>();
-  if (window && std::fabs(window->period_s - s) > 1e-12 * s)
-    fail("sample_period_s differs from sample_window.period_s: the controller has one sample clock");
+  if (window && std::fabs(window->period_s - s) > 1e-12 * s) fail("sample_period_s differs from sample_window.period_s: the controller has one sample clock");
   return s;
 }
 }  // namespace
@@ -180,8 +182,7 @@ RegisterMap RegisterMap::parse_map(std::string_view text) {
   if (!j.contains("version") || j["version"] != 1) fail("unknown version " + j.value("version", json()).dump() + " (this hystlab reads version 1)");
   RegisterMap m;
   m.name_ = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : "unnamed";
-  if (j.contains("rig"))
-    m.kind_ = pick<RigKind>(j["rig"], "rig", {{"load_frame", RigKind::load_frame}, {"shaker", RigKind::shaker}});
+  if (j.contains("rig")) m.kind_ = pick<RigKind>(j["rig"], "rig", {{"load_frame", RigKind::load_frame}, {"shaker", RigKind::shaker}});
   if (j.contains("slave_id")) {
     if (!j["slave_id"].is_number_integer() || j["slave_id"] < 1 || j["slave_id"] > 247) fail("slave_id must be from 1 to 247");
     m.slave_id_ = j["slave_id"].get<int>();
@@ -203,12 +204,11 @@ RegisterMap RegisterMap::parse_map(std::string_view text) {
     for (int w = 0; w < e.width(); ++w) {
       const auto key = std::make_pair(static_cast<int>(e.table), e.address + w);
       if (const auto it = used.find(key); it != used.end())
-        fail("signals." + std::string(signal_name(e.signal)) + " overlaps signals." +
-             std::string(signal_name(it->second)) + " at " + table_name(e.table) + " " + std::to_string(e.address + w));
+        fail("signals." + std::string(signal_name(e.signal)) + " overlaps signals." + std::string(signal_name(it->second)) + " at " + table_name(e.table) +
+             " " + std::to_string(e.address + w));
       used[key] = e.signal;
     }
-  for (const ModbusTable t : {ModbusTable::input_register, ModbusTable::holding_register, ModbusTable::discrete_input,
-                              ModbusTable::coil}) {
+  for (const ModbusTable t : {ModbusTable::input_register, ModbusTable::holding_register, ModbusTable::discrete_input, ModbusTable::coil}) {
     int lo = 65536, hi = -1;
     for (const MapEntry& e : m.entries_)
       if (e.table == t && !is_command(e.signal)) {
@@ -242,7 +242,9 @@ std::error_code encode(const MapEntry& e, double value, std::span<std::uint16_t>
   std::uint32_t bits = 0;
   auto in = [&](double lo, double hi) { return raw >= lo && raw <= hi; };
   switch (e.type) {
-    case ValueType::boolean: words[0] = raw != 0.0 ? 1 : 0; return {};
+    case ValueType::boolean:
+      words[0] = raw != 0.0 ? 1 : 0;
+      return {};
     case ValueType::int16:
       if (!in(-32768.5, 32767.49)) return ProtocolError::out_of_range;
       words[0] = static_cast<std::uint16_t>(static_cast<std::int16_t>(std::lround(raw)));
@@ -275,16 +277,26 @@ std::error_code decode(const MapEntry& e, std::span<const std::uint16_t> words, 
   if (words.size() < static_cast<std::size_t>(e.width())) return ProtocolError::wrong_length;
   double raw = 0.0;
   const std::uint32_t bits =
-      e.width() == 2 ? (e.word_order == WordOrder::big ? (std::uint32_t{words[0]} << 16) | words[1]
-                                                       : (std::uint32_t{words[1]} << 16) | words[0])
-                     : words[0];
+      e.width() == 2 ? (e.word_order == WordOrder::big ? (std::uint32_t{words[0]} << 16) | words[1] : (std::uint32_t{words[1]} << 16) | words[0]) : words[0];
   switch (e.type) {
-    case ValueType::boolean: raw = words[0] != 0 ? 1.0 : 0.0; break;
-    case ValueType::int16: raw = static_cast<std::int16_t>(words[0]); break;
-    case ValueType::uint16: raw = words[0]; break;
-    case ValueType::int32: raw = static_cast<std::int32_t>(bits); break;
-    case ValueType::uint32: raw = bits; break;
-    case ValueType::float32: raw = static_cast<double>(std::bit_cast<float>(bits)); break;
+    case ValueType::boolean:
+      raw = words[0] != 0 ? 1.0 : 0.0;
+      break;
+    case ValueType::int16:
+      raw = static_cast<std::int16_t>(words[0]);
+      break;
+    case ValueType::uint16:
+      raw = words[0];
+      break;
+    case ValueType::int32:
+      raw = static_cast<std::int32_t>(bits);
+      break;
+    case ValueType::uint32:
+      raw = bits;
+      break;
+    case ValueType::float32:
+      raw = static_cast<double>(std::bit_cast<float>(bits));
+      break;
   }
   if (!std::isfinite(raw)) return ProtocolError::not_finite;
   const double v = raw * e.scale + e.offset;

@@ -2,8 +2,7 @@
 
 namespace hystlab::protocols {
 
-std::error_code encode_record(const RegisterMap& m, const SampleWindow& w, const SignalArray& values,
-                              std::span<std::uint16_t> words) noexcept {
+std::error_code encode_record(const RegisterMap& m, const SampleWindow& w, const SignalArray& values, std::span<std::uint16_t> words) noexcept {
   if (words.size() < static_cast<std::size_t>(w.record_width)) return ProtocolError::wrong_length;
   std::size_t at = 0;
   for (const Signal s : w.fields) {
@@ -15,8 +14,7 @@ std::error_code encode_record(const RegisterMap& m, const SampleWindow& w, const
   return {};
 }
 
-std::error_code decode_record(const RegisterMap& m, const SampleWindow& w, std::span<const std::uint16_t> words,
-                              SignalArray& values) noexcept {
+std::error_code decode_record(const RegisterMap& m, const SampleWindow& w, std::span<const std::uint16_t> words, SignalArray& values) noexcept {
   if (words.size() < static_cast<std::size_t>(w.record_width)) return ProtocolError::wrong_length;
   std::size_t at = 0;
   for (const Signal s : w.fields) {

@@ -55,9 +55,10 @@ int main(int argc, char** argv) {
     hystlab::test_support::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1, "noise_N": 0}}]})");
     httplib::Client c("127.0.0.1", daemon.port());
     c.set_read_timeout(10, 0);
-    const json plan{{"kind", "fot"}, {"range_mm", {0, 1}}, {"subdivisions", 2}, {"ramp_rate_mm_s", 2.0}, {"dwell_s", 0.15},
-                    {"sample_rate_hz", 1000}, {"validation", false},
-                    {"limits", {{"displacement_mm", {-0.5, 1.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
+    const json plan{{"kind", "fot"},       {"range_mm", {0, 1}},
+                    {"subdivisions", 2},   {"ramp_rate_mm_s", 2.0},
+                    {"dwell_s", 0.15},     {"sample_rate_hz", 1000},
+                    {"validation", false}, {"limits", {{"displacement_mm", {-0.5, 1.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
     const std::vector<std::string> phases{"just submitted", "preamble", "ramping", "dwelling", "paused", "safing"};
     const std::string rig = "/api/rigs/sim%20frame";
     auto phase_is = [&](const std::string& p, double min_x) {
@@ -118,10 +119,10 @@ int main(int argc, char** argv) {
       ++done;
     }
     const double period_ms = 1.0;
-    std::printf("e-stop over %d presses at 1 kHz (hystlabd, hystlab-sim over Modbus TCP, time scale 1), %d not answered latched and confirmed\n",
-                done, failures);
-    std::printf("request -> answer (written, and seen in the status word), HTTP round trip: p50 %.2f ms, p99 %.2f ms, max %.2f ms\n",
-                quantile(http_ms, 0.5), quantile(http_ms, 0.99), quantile(http_ms, 1.0));
+    std::printf("e-stop over %d presses at 1 kHz (hystlabd, hystlab-sim over Modbus TCP, time scale 1), %d not answered latched and confirmed\n", done,
+                failures);
+    std::printf("request -> answer (written, and seen in the status word), HTTP round trip: p50 %.2f ms, p99 %.2f ms, max %.2f ms\n", quantile(http_ms, 0.5),
+                quantile(http_ms, 0.99), quantile(http_ms, 1.0));
     std::printf("the daemon's own time, request taken -> status word confirmed: p50 %.2f ms (%.1f periods), p99 %.2f ms (%.1f periods), max %.2f ms\n",
                 quantile(daemon_ms, 0.5), quantile(daemon_ms, 0.5) / period_ms, quantile(daemon_ms, 0.99), quantile(daemon_ms, 0.99) / period_ms,
                 quantile(daemon_ms, 1.0));
@@ -132,8 +133,8 @@ int main(int argc, char** argv) {
     for (std::size_t p = 0; p < phases.size(); ++p)
       std::printf("  %-15s %3zu presses: p50 %.2f ms, p99 %.2f ms, max %.2f ms\n", phases[p].c_str(), by_phase[p].size(), quantile(by_phase[p], 0.5),
                   quantile(by_phase[p], 0.99), quantile(by_phase[p], 1.0));
-    std::printf("distance moved after the e-stop (the sample read before the request -> rest), ramps at 2 mm/s: p99 %.4f mm, max %.4f mm\n", quantile(moved_mm, 0.99),
-                quantile(moved_mm, 1.0));
+    std::printf("distance moved after the e-stop (the sample read before the request -> rest), ramps at 2 mm/s: p99 %.4f mm, max %.4f mm\n",
+                quantile(moved_mm, 0.99), quantile(moved_mm, 1.0));
     return failures == 0 && done == presses ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_estop: %s\n", e.what());

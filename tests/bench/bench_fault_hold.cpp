@@ -33,9 +33,7 @@ double wall() { return std::chrono::duration<double>(std::chrono::steady_clock::
 // and of the first hold(true) after the fault.
 class TimedRig final : public drivers::Rig {
  public:
-  explicit TimedRig(double fault_at_rig_s) : fault_at_(fault_at_rig_s) {
-    rig_.plan.push_back({test::FaultEvent::latch_fault, fault_at_rig_s, 1e9, 7});
-  }
+  explicit TimedRig(double fault_at_rig_s) : fault_at_(fault_at_rig_s) { rig_.plan.push_back({test::FaultEvent::latch_fault, fault_at_rig_s, 1e9, 7}); }
   std::error_code connect(double t) noexcept override { return rig_.connect(t); }
   void disconnect() noexcept override { rig_.disconnect(); }
   std::error_code arm(bool on) noexcept override { return rig_.arm(on); }

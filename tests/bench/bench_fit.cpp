@@ -107,26 +107,23 @@ int main(int argc, char** argv) {
     const Measured fresh = in_child([&] {
       const auto t0 = std::chrono::steady_clock::now();
       const PreisachFitResult r = fit_preisach(rec.x, rec.y, g);
-      return Measured{std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                      r.chosen.rms_residual, r.chosen.heldout_rms, 0, false};
+      return Measured{std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), r.chosen.rms_residual, r.chosen.heldout_rms, 0, false};
     });
     Measured dense;
     if (n <= 48)
       dense = in_child([&] {
         const auto t0 = std::chrono::steady_clock::now();
         const LsqFitResult r = fit_preisach_lsq(rec.x, rec.y, g);
-        return Measured{std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), r.rms_residual,
-                        0.0, 0, false};
+        return Measured{std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), r.rms_residual, 0.0, 0, false};
       });
     const double mib = static_cast<double>(fresh.peak_kib - idle.peak_kib) / 1024.0;
     char dense_text[64] = "not run (n > 48)", ratio[32] = "";
     if (dense.ok) {
-      std::snprintf(dense_text, sizeof dense_text, "%.2f s / %.0f MiB", dense.seconds,
-                    static_cast<double>(dense.peak_kib - idle.peak_kib) / 1024.0);
+      std::snprintf(dense_text, sizeof dense_text, "%.2f s / %.0f MiB", dense.seconds, static_cast<double>(dense.peak_kib - idle.peak_kib) / 1024.0);
       std::snprintf(ratio, sizeof ratio, "%.2fx", dense.seconds / fresh.seconds);
     }
-    std::printf("%5d %19.2f s / %4.0f MiB %28s %10s   rms %.3f N (held-out %.3f N)%s\n", n, fresh.seconds, mib,
-                dense_text, ratio, fresh.rms, fresh.heldout, dense.ok ? "" : "");
+    std::printf("%5d %19.2f s / %4.0f MiB %28s %10s   rms %.3f N (held-out %.3f N)%s\n", n, fresh.seconds, mib, dense_text, ratio, fresh.rms, fresh.heldout,
+                dense.ok ? "" : "");
     // Agreement: the fit ran, and it is at least as close to the data as the monotone dense fit.
     if (!fresh.ok || !std::isfinite(fresh.rms)) ++failures;
     if (dense.ok && !(fresh.rms <= dense.rms * 1.001)) {

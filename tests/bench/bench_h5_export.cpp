@@ -164,8 +164,8 @@ int main(int argc, char** argv) {
     double last_t = 0, last_f = 0;
     const std::int64_t rows = csv_rows(csv), nt = h5_length(h5, "time_s", last_t), nf = h5_length(h5, "force_N", last_f);
     if (rows != n || nt != n || nf != n || last_t != want.t || last_f != want.force) {
-      std::printf("FAIL: %lld samples stored; the CSV has %lld rows, the HDF5 time_s %lld and force_N %lld (last %.17g, %.17g)\n",
-                  static_cast<long long>(n), static_cast<long long>(rows), static_cast<long long>(nt), static_cast<long long>(nf), last_t, last_f);
+      std::printf("FAIL: %lld samples stored; the CSV has %lld rows, the HDF5 time_s %lld and force_N %lld (last %.17g, %.17g)\n", static_cast<long long>(n),
+                  static_cast<long long>(rows), static_cast<long long>(nt), static_cast<long long>(nf), last_t, last_f);
       failures = 1;
     }
     std::printf("%-6s %10s %14s %12s\n", "export", "time (s)", "peak RSS (MB)", "file (MB)");

@@ -5,8 +5,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -102,8 +102,10 @@ void overview_of_ten_million(const fs::path& dir) {
   }
   std::sort(fast.begin(), fast.end());
   std::sort(scan.begin(), scan.end());
-  std::printf("overview of a 10^7-sample run in 1000 min/max buckets: %.1f ms from the block summaries, %.0f ms by scanning "
-              "the samples (median of 3; %.0fx; target: well under a second)\n", fast[1], scan[1], scan[1] / fast[1]);
+  std::printf(
+      "overview of a 10^7-sample run in 1000 min/max buckets: %.1f ms from the block summaries, %.0f ms by scanning "
+      "the samples (median of 3; %.0fx; target: well under a second)\n",
+      fast[1], scan[1], scan[1] / fast[1]);
 }
 }  // namespace
 
@@ -117,8 +119,10 @@ int main() {
     double max_ms = 0;
     std::uint64_t full = 0;
     const double w = writer(fresh(dir, "writer.db"), max_ms, full);
-    std::printf("bare batched insert (1000/tx): %8.0f k rows/s | SampleWriter: %8.0f k rows/s (max commit %.1f ms, ring-full "
-                "retries %llu)\n", b / 1e3, w / 1e3, max_ms, static_cast<unsigned long long>(full));
+    std::printf(
+        "bare batched insert (1000/tx): %8.0f k rows/s | SampleWriter: %8.0f k rows/s (max commit %.1f ms, ring-full "
+        "retries %llu)\n",
+        b / 1e3, w / 1e3, max_ms, static_cast<unsigned long long>(full));
     ratios.push_back(w / b);
   }
   std::sort(ratios.begin(), ratios.end());

@@ -28,7 +28,8 @@ void fill(const std::string& path, std::int64_t n) {
   hystlab::db::Store store(path, false);
   const std::string now = "2026-01-01T00:00:00Z";
   const auto rig = store.upsert_rig("sim frame", "{}", now);
-  const auto campaign = store.create_campaign(rig, hystlab::db::CampaignKind::fot, R"({"kind":"fot","range_mm":[0,14],"subdivisions":12,"ramp_rate_mm_s":0.5})", now);
+  const auto campaign =
+      store.create_campaign(rig, hystlab::db::CampaignKind::fot, R"({"kind":"fot","range_mm":[0,14],"subdivisions":12,"ramp_rate_mm_s":0.5})", now);
   const auto run = store.add_run(campaign, now, 0, 0);
   hystlab::models::SimplifiedSmaModel m(hystlab::models::table1_parameters());
   double total = 0;

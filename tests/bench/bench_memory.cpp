@@ -69,8 +69,8 @@ int main(int argc, char** argv) {
     const std::size_t legs = static_cast<std::size_t>(million * 1000) + 1;
     nlohmann::json points = nlohmann::json::array();
     for (std::size_t k = 0; k <= legs; ++k) points.push_back(k % 2 ? 2.0 : 0.0);
-    const nlohmann::json plan_json{{"kind", "waveform"}, {"points_mm", points}, {"ramp_rate_mm_s", 2.0}, {"sample_rate_hz", 1000},
-                                   {"limits", {{"displacement_mm", {-0.5, 2.5}}}}};
+    const nlohmann::json plan_json{
+        {"kind", "waveform"}, {"points_mm", points}, {"ramp_rate_mm_s", 2.0}, {"sample_rate_hz", 1000}, {"limits", {{"displacement_mm", {-0.5, 2.5}}}}};
     daemon::CampaignJob job;
     job.plan = daemon::parse_plan(plan_json);
     job.plan.limits = daemon::check_plan_against(job.plan, daemon::RigEnvelope{}, settings, false);
@@ -95,8 +95,7 @@ int main(int argc, char** argv) {
     writer.flush();
     std::printf("campaign: %s, %llu samples stored, %llu dropped; resident %.1f MB before, %.1f MB after\n", daemon::to_string(r.end),
                 static_cast<unsigned long long>(store.sample_count(r.run_id)), static_cast<unsigned long long>(r.dropped), before, rss_mb());
-    std::printf("resident memory against samples: %+.0f bytes per 10^6 samples over the second half (target: flat, 0)\n",
-                slope(at, mb) * 1e6);
+    std::printf("resident memory against samples: %+.0f bytes per 10^6 samples over the second half (target: flat, 0)\n", slope(at, mb) * 1e6);
     if (r.end != daemon::CampaignEnd::completed) rc = 1;
 
     // Exports of a stored run of 10^5 samples (the first 10^5 of the campaign's copied into a run of its own).

@@ -3,16 +3,16 @@
 // 1 kHz poll loop on absolute deadlines, reporting the period jitter.
 #include <modbus/modbus.h>
 #include <netinet/in.h>
-#include <sys/socket.h>
 #include <sched.h>
 #include <sys/mman.h>
+#include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -56,8 +56,10 @@ class BareServer {
       std::uint8_t q[MODBUS_TCP_MAX_ADU_LENGTH];
       for (;;) {
         const int rc = modbus_receive(ctx_, q);
-        if (rc > 0) modbus_reply(ctx_, q, rc, mapping_);
-        else if (rc == -1) break;
+        if (rc > 0)
+          modbus_reply(ctx_, q, rc, mapping_);
+        else if (rc == -1)
+          break;
       }
     });
   }
@@ -142,19 +144,18 @@ void jitter_loop(hystlab::drivers::ModbusRig* rig, double seconds, const std::st
     clock_gettime(CLOCK_MONOTONIC, &now);
     const double late_us = static_cast<double>((now.tv_sec - next.tv_sec) * 1'000'000'000L + (now.tv_nsec - next.tv_nsec)) / 1e3;
     if (late_us > 1000) ++missed;  // a whole period late
-    if (k > 0)
-      periods_us.push_back(static_cast<double>((now.tv_sec - prev.tv_sec) * 1'000'000'000L + (now.tv_nsec - prev.tv_nsec)) / 1e3);
+    if (k > 0) periods_us.push_back(static_cast<double>((now.tv_sec - prev.tv_sec) * 1'000'000'000L + (now.tv_nsec - prev.tv_nsec)) / 1e3);
     prev = now;
     if (rig && rig->read_sample(hystlab::test::steady_now(), s)) ++errors;
   }
   std::vector<double> jitter;
   for (double p : periods_us) jitter.push_back(std::fabs(p - 1000.0));
   std::sort(jitter.begin(), jitter.end());
-  std::printf("%s for %.0f s: period jitter p50 %.1f us, p99 %.1f us, p99.9 %.1f us, max %.1f us; "
-              "deadlines missed by a whole period: %ld; read errors: %ld; %s\n",
-              rig ? "1 kHz poll loop (ModbusRig -> hystlab-sim)" : "baseline: 1 kHz sleep loop, no I/O", seconds,
-              jitter[jitter.size() / 2], jitter[jitter.size() * 99 / 100], jitter[jitter.size() * 999 / 1000], jitter.back(),
-              missed, errors, policy.c_str());
+  std::printf(
+      "%s for %.0f s: period jitter p50 %.1f us, p99 %.1f us, p99.9 %.1f us, max %.1f us; "
+      "deadlines missed by a whole period: %ld; read errors: %ld; %s\n",
+      rig ? "1 kHz poll loop (ModbusRig -> hystlab-sim)" : "baseline: 1 kHz sleep loop, no I/O", seconds, jitter[jitter.size() / 2],
+      jitter[jitter.size() * 99 / 100], jitter[jitter.size() * 999 / 1000], jitter.back(), missed, errors, policy.c_str());
 }
 }  // namespace
 
@@ -189,8 +190,8 @@ int main(int argc, char** argv) {
     ratios.push_back(h.per_s / b.per_s);
   }
   std::sort(ratios.begin(), ratios.end());
-  std::printf("rig/bare polls per second, median of %d interleaved pairs: %.0f %% (target >= 80 %%); read errors: %d\n", reps,
-              100 * ratios[ratios.size() / 2], errors);
+  std::printf("rig/bare polls per second, median of %d interleaved pairs: %.0f %% (target >= 80 %%); read errors: %d\n", reps, 100 * ratios[ratios.size() / 2],
+              errors);
   if (jitter_seconds > 0) {
     const std::string policy = realtime_policy(sim.pid());
     jitter_loop(nullptr, jitter_seconds / 3, policy);

@@ -135,10 +135,10 @@ int main(int argc, char** argv) {
     std::vector<double> ratios;
     for (std::size_t k = 0; k < std::min(e.size(), r.size()); ++k) ratios.push_back(e[k] / r[k]);
     const double best = e.empty() ? 0.0 : *std::max_element(e.begin(), e.end());
-    std::printf("%5d %16.2f M %16.3f M %13.1fx %12s\n", n, median(e) / 1e6, median(r) / 1e6, median(ratios),
-                best >= 40e6 ? "met" : "NOT met");
+    std::printf("%5d %16.2f M %16.3f M %13.1fx %12s\n", n, median(e) / 1e6, median(r) / 1e6, median(ratios), best >= 40e6 ? "met" : "NOT met");
   }
-  std::printf("(ratio: median over repetitions of everett/relays, each pair from the same repetition; "
-              "target at n = 200: >= 500x)\n");
+  std::printf(
+      "(ratio: median over repetitions of everett/relays, each pair from the same repetition; "
+      "target at n = 200: >= 500x)\n");
   return 0;
 }

@@ -62,7 +62,7 @@ int main() {
   }
   std::printf("SDOF isolator, 2 springs, 10 kHz step (dt = 0.1 ms), 20 simulated s per run, median of %d interleaved runs:\n", kRounds);
   for (std::size_t k = 0; k < cases.size(); ++k)
-    std::printf("  %-28s %10.0f simulated s per wall s (%.2f M steps/s), %.2f of the linear baseline\n", cases[k].name, median[k],
-                median[k] / 1e-4 * 1e-6, median[k] / median[0]);
+    std::printf("  %-28s %10.0f simulated s per wall s (%.2f M steps/s), %.2f of the linear baseline\n", cases[k].name, median[k], median[k] / 1e-4 * 1e-6,
+                median[k] / median[0]);
   return 0;
 }

@@ -13,13 +13,13 @@
 #include <cstring>
 #include <filesystem>
 
-#include "realtime_bench.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
+#include "realtime_bench.hpp"
 
 using namespace hystlab;
 
@@ -51,9 +51,10 @@ int report_points(db::Store& store, std::int64_t id, const daemon::SinePlan& sin
     pts.push_back({t.demand_mm, t.direction == "up", {t.frequency_hz, t.ratio, t.phase_rad}});
   }
   const auto unreached = store.event_details(id, "control_unreached").size();
-  std::printf("points: %zu of %zu; worst step's control error %.2f %% (tolerance %.0f %%); %d points beyond it, %zu steps where control "
-              "gave up after its windows\n",
-              pts.size(), daemon::step_count(sine), worst, sine.control.tolerance_pct, beyond, unreached);
+  std::printf(
+      "points: %zu of %zu; worst step's control error %.2f %% (tolerance %.0f %%); %d points beyond it, %zu steps where control "
+      "gave up after its windows\n",
+      pts.size(), daemon::step_count(sine), worst, sine.control.tolerance_pct, beyond, unreached);
   const models::SweepReport r = models::analyse_sweep(pts, sine.jump_threshold_pct / 100);
   for (const models::SweepCurve& c : r.curves)
     if (c.resonance)
@@ -79,8 +80,13 @@ int main(int argc, char** argv) {
   db::Store& store = bench.store;
   db::SampleWriter& writer = *bench.writer;
 
-  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"sweep", {{"from_hz", 5}, {"to_hz", 100}, {"steps", steps}}}, {"direction", "up-down"},
-                                        {"amplitudes_mm", {0.005, 0.05}}, {"settle_cycles", 10}, {"measured_cycles", 10}, {"sample_rate_hz", 1000}});
+  const auto plan = daemon::parse_plan({{"kind", "sine"},
+                                        {"sweep", {{"from_hz", 5}, {"to_hz", 100}, {"steps", steps}}},
+                                        {"direction", "up-down"},
+                                        {"amplitudes_mm", {0.005, 0.05}},
+                                        {"settle_cycles", 10},
+                                        {"measured_cycles", 10},
+                                        {"sample_rate_hz", 1000}});
   auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", bench.sim.modbus_port}, {"rig", "shaker"}});
   const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), db::CampaignKind::sine, plan.source.dump(), "t");
   daemon::SteadyClock clock;
@@ -99,13 +105,14 @@ int main(int argc, char** argv) {
   // The baseline: a bare 1 kHz loop for a quarter of the sweep's time (its rate of missed periods is what compares).
   const double base_s = std::max(10.0, wall / 4);
   const long base_missed = bare_loop_missed(base_s);
-  std::printf("sweep 5-100 Hz up-down at 0.005 and 0.05 mm, %d steps a pass: campaign %s%s%s\n", steps, daemon::to_string(r.end),
-              r.reason.empty() ? "" : ": ", r.reason.c_str());
-  std::printf("acquisition loop: %llu samples, missed deadlines %llu (%.2f a minute), late wake-ups %llu, gaps %llu (longest %.0f ms); "
-              "bare 1 kHz loop: %ld missed in %.0f s (%.2f a minute) (target: 0 missed)\n",
-              static_cast<unsigned long long>(r.samples), static_cast<unsigned long long>(r.missed_deadlines), 60.0 * static_cast<double>(r.missed_deadlines) / wall,
-              static_cast<unsigned long long>(r.late_wakeups), static_cast<unsigned long long>(r.gaps), r.longest_gap_s * 1e3, base_missed, base_s,
-              60.0 * static_cast<double>(base_missed) / base_s);
+  std::printf("sweep 5-100 Hz up-down at 0.005 and 0.05 mm, %d steps a pass: campaign %s%s%s\n", steps, daemon::to_string(r.end), r.reason.empty() ? "" : ": ",
+              r.reason.c_str());
+  std::printf(
+      "acquisition loop: %llu samples, missed deadlines %llu (%.2f a minute), late wake-ups %llu, gaps %llu (longest %.0f ms); "
+      "bare 1 kHz loop: %ld missed in %.0f s (%.2f a minute) (target: 0 missed)\n",
+      static_cast<unsigned long long>(r.samples), static_cast<unsigned long long>(r.missed_deadlines), 60.0 * static_cast<double>(r.missed_deadlines) / wall,
+      static_cast<unsigned long long>(r.late_wakeups), static_cast<unsigned long long>(r.gaps), r.longest_gap_s * 1e3, base_missed, base_s,
+      60.0 * static_cast<double>(base_missed) / base_s);
   std::printf("wall time %.1f s against the plan's nominal %.1f s: ratio %.2f\n", wall, nominal, wall / nominal);
   return report_points(store, id, plan.sine, r.end == daemon::CampaignEnd::completed);
 }

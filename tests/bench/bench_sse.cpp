@@ -90,8 +90,9 @@ int main(int argc, char** argv) {
   try {
     hystlab::test_support::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1}}]})");
     httplib::Client c("127.0.0.1", daemon.port());
-    const nlohmann::json plan{{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 12}, {"ramp_rate_mm_s", 0.5}, {"sample_rate_hz", 1000},
-                              {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
+    const nlohmann::json plan{{"kind", "fot"},          {"range_mm", {0, 4}},
+                              {"subdivisions", 12},     {"ramp_rate_mm_s", 0.5},
+                              {"sample_rate_hz", 1000}, {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
     auto r = c.Post("/api/campaigns", nlohmann::json{{"plan", plan}}.dump(), "application/json");
     if (!r || r->status != 201) throw std::runtime_error("cannot submit the campaign");
     const auto id = nlohmann::json::parse(r->body)["id"].get<long>();
@@ -136,12 +137,11 @@ int main(int argc, char** argv) {
     std::printf("with %d SSE clients (%s): %.0f samples in %.0f s, %.0f missed deadlines\n", clients,
                 at == std::string::npos ? "?" : sse.substr(at + 1, sse.find('\n', at + 1) - at - 1).c_str(), with.acquired, total, with.missed);
     std::sort(added.begin(), added.end());
-    std::printf("late wake-ups of the acquisition loop (no sample lost by them with block reads): %.0f without clients, %.0f with\n",
-                without.late, with.late);
-    std::printf("missed deadlines added by the clients: %.0f in all, median per round %.1f (target 0)\n",
-                std::max(0.0, with.missed - without.missed), added[added.size() / 2] / 2 + added[(added.size() - 1) / 2] / 2);
-    std::printf("sample-to-client latency over %zu frames: p50 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 < 200 ms)\n", lat.ms.size(), q(0.5),
-                q(0.99), lat.ms.back());
+    std::printf("late wake-ups of the acquisition loop (no sample lost by them with block reads): %.0f without clients, %.0f with\n", without.late, with.late);
+    std::printf("missed deadlines added by the clients: %.0f in all, median per round %.1f (target 0)\n", std::max(0.0, with.missed - without.missed),
+                added[added.size() / 2] / 2 + added[(added.size() - 1) / 2] / 2);
+    std::printf("sample-to-client latency over %zu frames: p50 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 < 200 ms)\n", lat.ms.size(), q(0.5), q(0.99),
+                lat.ms.back());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_sse: %s\n", e.what());

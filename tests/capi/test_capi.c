@@ -6,12 +6,12 @@
 #include "hystlab/hystlab.h"
 
 static int failures = 0;
-#define CHECK(cond)                                              \
-  do {                                                           \
-    if (!(cond)) {                                               \
-      fprintf(stderr, "FAIL line %d: %s\n", __LINE__, #cond);    \
-      ++failures;                                                \
-    }                                                            \
+#define CHECK(cond)                                           \
+  do {                                                        \
+    if (!(cond)) {                                            \
+      fprintf(stderr, "FAIL line %d: %s\n", __LINE__, #cond); \
+      ++failures;                                             \
+    }                                                         \
   } while (0)
 
 static const char* kParams =

@@ -49,7 +49,6 @@ class Workdir {
   fs::path dir_ = tmp_.path();
 };
 
-
 // One error line naming the problem, exit code 2, nothing on stdout.
 inline void check_error(const Result& r, const std::string& needle) {
   CAPTURE(r.err);

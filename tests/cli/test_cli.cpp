@@ -1,12 +1,12 @@
 // The hystlab CLI as a user runs it: the real binary, real files, exit codes and messages.
 #include <doctest/doctest.h>
 
-#include <nlohmann/json.hpp>
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -25,12 +25,12 @@
 #include "cli_workdir.hpp"
 #include "hystlab/db/store.hpp"
 
-#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/loop_figures.hpp"
-#include "hystlab/models/table_score.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/simplified_sma.hpp"
+#include "hystlab/models/table_score.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystlab::models;
@@ -62,7 +62,6 @@ std::vector<double> column(const std::string& csv, int col) {
   }
   return v;
 }
-
 
 const std::vector<double> kPath = ramp_through({0.0, 3.5, 1.0, 3.0, 1.5, 4.0, 0.0}, 0.01);
 
@@ -147,8 +146,7 @@ TEST_CASE("cli: fit, calibrate, invert, check and compare on generated data") {
   CHECK(fitted.provenance.method == "lsq");
   CHECK(fitted.provenance.extra.at("prior") == "signed");
   CHECK(fitted.provenance.extra.at("candidates").size() == 2);
-  CHECK(fitted.provenance.extra.at("heldout_rms_N").get<double>() <
-        fitted.provenance.extra.at("candidates").at(1).at("heldout_rms_N").get<double>());
+  CHECK(fitted.provenance.extra.at("heldout_rms_N").get<double>() < fitted.provenance.extra.at("candidates").at(1).at("heldout_rms_N").get<double>());
   bool negative = false;
   for (const CellWeight& c : cell_weights(fitted.table)) negative = negative || c.weight < 0.0;
   CHECK(negative);
@@ -310,8 +308,7 @@ TEST_CASE("cli: the daemon's records, read from its file with no daemon running"
   {
     hystlab::db::Store daemons((w / "d.db").string());
     const auto rig = daemons.upsert_rig("sim frame", "{}", "2026-01-01T00:00:00Z");
-    (void)daemons.create_campaign(rig, hystlab::db::CampaignKind::waveform, R"({"kind": "waveform", "points_mm": [0, 2.5, 1, 3, 0]})",
-                                  "2026-01-01T00:00:01Z");
+    (void)daemons.create_campaign(rig, hystlab::db::CampaignKind::waveform, R"({"kind": "waveform", "points_mm": [0, 2.5, 1, 3, 0]})", "2026-01-01T00:00:01Z");
   }
   const Result list = w.run("campaign list --db d.db");
   CHECK(list.out.find("queued") != std::string::npos);
@@ -365,7 +362,7 @@ TEST_CASE("cli: a validation run re-scored against a stored table, as the campai
   CHECK(cmp.out.find("data: run 2 (validation)") != std::string::npos);
   char line[64];
   std::snprintf(line, sizeof line, "%12.6g", acc["held_out"]["overall"]["rms_N"].get<double>());
-  CHECK(cmp.out.find(std::string("overall") ) != std::string::npos);
+  CHECK(cmp.out.find(std::string("overall")) != std::string::npos);
   CHECK(cmp.out.find(line) != std::string::npos);  // the same figure as stored, to its printed digits
   check_error(w.run("compare --table-id 1 --run 9 --db d.db"), "--run: no run 9");
   check_error(w.run("compare --table-id 7 --run 2 --db d.db"), "--table-id: no table 7");
@@ -426,7 +423,8 @@ TEST_CASE("cli: submit, preview and the commands go to the running hystlabd over
   REQUIRE(preview.code == 0);
   CHECK(preview.out.find("waveform on 'sim frame'") != std::string::npos);
   CHECK(preview.out.find("peak speed 0.05 mm/s") != std::string::npos);
-  const Result none = run_until(w, "campaign list --db " + d.db_path(), [](const Result& r) { return r.code == 0; }, 10);
+  const Result none = run_until(
+      w, "campaign list --db " + d.db_path(), [](const Result& r) { return r.code == 0; }, 10);
   CHECK(none.code == 0);
   CHECK(none.out.find("waveform") == std::string::npos);  // a preview queues nothing
 
@@ -441,12 +439,14 @@ TEST_CASE("cli: submit, preview and the commands go to the running hystlabd over
 
   // Commands: abort ends it (the daemon drives the rig to its safe position); a second abort no
   // longer applies, in the API's words.
-  const Result running = run_until(w, "campaign show 1 --db " + d.db_path(), [](const Result& r) { return r.out.find(", running") != std::string::npos; }, 60);
+  const Result running = run_until(
+      w, "campaign show 1 --db " + d.db_path(), [](const Result& r) { return r.out.find(", running") != std::string::npos; }, 60);
   CAPTURE(running.out);
   REQUIRE(running.out.find(", running") != std::string::npos);
   CHECK(w.run("campaign pause 1" + auth).out.find("pause sent: campaign 1 (running: taken by the running campaign)") != std::string::npos);
   CHECK(w.run("campaign abort 1" + auth).out.find("abort sent: campaign 1") != std::string::npos);
-  const Result aborted = run_until(w, "campaign show 1 --db " + d.db_path(), [](const Result& r) { return r.out.find(", aborted") != std::string::npos; }, 60);
+  const Result aborted = run_until(
+      w, "campaign show 1 --db " + d.db_path(), [](const Result& r) { return r.out.find(", aborted") != std::string::npos; }, 60);
   CAPTURE(aborted.out);
   REQUIRE(aborted.out.find(", aborted") != std::string::npos);
   check_error(w.run("campaign abort 1" + auth), "campaign 1 is aborted: 'abort' does not apply");
@@ -456,9 +456,10 @@ TEST_CASE("cli: submit, preview and the commands go to the running hystlabd over
   const Result estop = w.run("rig estop 'sim frame'" + auth);
   CAPTURE(estop.err);
   CHECK(estop.out.find("estop done: rig 'sim frame' is estopped (latched: the rig reports its e-stop)") != std::string::npos);  // confirmed before the answer
-  check_error(w.run("campaign submit --plan plan.json" + auth), "reset it first");  // at once, never a moment later
+  check_error(w.run("campaign submit --plan plan.json" + auth), "reset it first");                                              // at once, never a moment later
   CHECK(w.run("rig reset 'sim frame'" + auth).code == 0);
-  const Result again = run_until(w, "campaign submit --plan plan.json" + auth, [](const Result& r) { return r.code == 0; }, 30);
+  const Result again = run_until(
+      w, "campaign submit --plan plan.json" + auth, [](const Result& r) { return r.code == 0; }, 30);
   CAPTURE(again.err);
   CHECK(again.out.find("campaign 2 queued") != std::string::npos);
   check_error(w.run("rig estop 'frame B'" + auth), "frame B");
@@ -466,14 +467,16 @@ TEST_CASE("cli: submit, preview and the commands go to the running hystlabd over
 
 TEST_CASE("cli: simulate sdof: time history, sweep up and down with the linear comparison, and its refusals") {
   Workdir w;
-  const Result h = w.run("simulate sdof --mass 1 --springs 2 --linear 5 --damping 0.02 --preload-mm 2 --amplitude-mm 0.05 "
-                         "--frequency-hz 10 --duration-s 0.5 --every 10 -o H.csv");
+  const Result h = w.run(
+      "simulate sdof --mass 1 --springs 2 --linear 5 --damping 0.02 --preload-mm 2 --amplitude-mm 0.05 "
+      "--frequency-hz 10 --duration-s 0.5 --every 10 -o H.csv");
   REQUIRE(h.code == 0);
   const std::string hist = slurp(w / "H.csv");
   CHECK(hist.rfind("t_s,base_mm,mass_mm,compression_mm,force_N,input_work_Nmm", 0) == 0);
   CHECK(column(hist, 0).size() == 501);
-  const Result s = w.run("simulate sdof --mass 1 --springs 2 --linear 5 --preload-mm 2 --amplitude-mm 0.05 --sweep "
-                         "--frequencies 8,16,30 --settle-cycles 30 --zetas 0.1 -o S.csv --svg S.svg");
+  const Result s = w.run(
+      "simulate sdof --mass 1 --springs 2 --linear 5 --preload-mm 2 --amplitude-mm 0.05 --sweep "
+      "--frequencies 8,16,30 --settle-cycles 30 --zetas 0.1 -o S.csv --svg S.svg");
   REQUIRE(s.code == 0);
   const std::string sweep = slurp(w / "S.csv");
   CHECK(sweep.rfind("frequency_hz,up,down,up_p2p,down_p2p,linear_zeta_0.1", 0) == 0);
@@ -485,8 +488,9 @@ TEST_CASE("cli: simulate sdof: time history, sweep up and down with the linear c
     CHECK(zeta01[k] == doctest::Approx(std::sqrt((1 + a * a) / ((1 - r * r) * (1 - r * r) + a * a))).epsilon(0.02));
   }
   CHECK(slurp(w / "S.svg").find("<svg") != std::string::npos);
-  const Result sma = w.run("simulate sdof --mass 2 --springs 2 --model simplified --preload-mm 3 --amplitude-mm 0.5 --sweep "
-                           "--from-hz 20 --to-hz 40 --steps 5 --settle-cycles 30 -o M.csv");
+  const Result sma = w.run(
+      "simulate sdof --mass 2 --springs 2 --model simplified --preload-mm 3 --amplitude-mm 0.5 --sweep "
+      "--from-hz 20 --to-hz 40 --steps 5 --settle-cycles 30 -o M.csv");
   REQUIRE(sma.code == 0);
   CHECK(column(slurp(w / "M.csv"), 1).size() == 5);
   check_error(w.run("simulate sdof --mass 1 --linear 5 --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1 --dt 0.05"), "unstable");
@@ -496,8 +500,9 @@ TEST_CASE("cli: simulate sdof: time history, sweep up and down with the linear c
   // One calibrated table per spring.
   REQUIRE(w.run("identify --model simplified --range 0,5 --subdivisions 6 -o A.json").code == 0);
   REQUIRE(w.run("identify --model simplified --range 0,5 --subdivisions 10 -o B.json").code == 0);
-  const Result two = w.run("simulate sdof --mass 2 --tables A.json,B.json --preload-mm 3 --amplitude-mm 0.3 --frequency-hz 20 "
-                           "--duration-s 0.2 -o two.csv");
+  const Result two = w.run(
+      "simulate sdof --mass 2 --tables A.json,B.json --preload-mm 3 --amplitude-mm 0.3 --frequency-hz 20 "
+      "--duration-s 0.2 -o two.csv");
   CAPTURE(two.err);
   REQUIRE(two.code == 0);
   CHECK(column(slurp(w / "two.csv"), 4).front() > 0);  // the two tables carry the weight
@@ -506,4 +511,3 @@ TEST_CASE("cli: simulate sdof: time history, sweep up and down with the linear c
   w.write("bad.json", R"({"format": "hystlab-everett-table", "version": 9})");
   check_error(w.run("simulate sdof --mass 1 --table bad.json --amplitude-mm 0.1 --frequency-hz 5 --duration-s 1"), "version");
 }
-

@@ -32,16 +32,19 @@ void check_header_forces(const Workdir& w, const std::string& table, const std::
   xcsv << "displacement_mm\n";
   for (const double x : xs) xcsv << x << "\n";
   w.write("X.csv", xcsv.str());
-  w.write(name + "_main.c", "#include <stdio.h>\n#include <hystlab/hystlab.h>\n#include \"" + name + ".h\"\nint main(void) {\n"
-          "  hystlab_model* m = NULL; double x, f;\n"
-          "  if (hystlab_model_from_table(" + upper + "_N, " + upper + "_LO_MM, " + upper + "_HI_MM, " + (refined ? upper + "_NODES_MM" : "NULL") +
-          ", " + upper + "_VALUES_N, " + upper + "_FORCE_OFFSET_N, &m) != HYSTLAB_OK) { fprintf(stderr, \"%s\\n\", hystlab_last_error()); return 1; }\n"
-          "  FILE* in = fopen(\"X.csv\", \"r\"); char head[64]; if (!in || !fgets(head, sizeof head, in)) return 1;\n"
-          "  while (fscanf(in, \"%lf\", &x) == 1) { hystlab_model_step(m, x, &f); printf(\"%.17g\\n\", f); }\n"
-          "  hystlab_model_free(m); return 0;\n}\n");
+  w.write(name + "_main.c", "#include <stdio.h>\n#include <hystlab/hystlab.h>\n#include \"" + name +
+                                ".h\"\nint main(void) {\n"
+                                "  hystlab_model* m = NULL; double x, f;\n"
+                                "  if (hystlab_model_from_table(" +
+                                upper + "_N, " + upper + "_LO_MM, " + upper + "_HI_MM, " + (refined ? upper + "_NODES_MM" : "NULL") + ", " + upper +
+                                "_VALUES_N, " + upper +
+                                "_FORCE_OFFSET_N, &m) != HYSTLAB_OK) { fprintf(stderr, \"%s\\n\", hystlab_last_error()); return 1; }\n"
+                                "  FILE* in = fopen(\"X.csv\", \"r\"); char head[64]; if (!in || !fgets(head, sizeof head, in)) return 1;\n"
+                                "  while (fscanf(in, \"%lf\", &x) == 1) { hystlab_model_step(m, x, &f); printf(\"%.17g\\n\", f); }\n"
+                                "  hystlab_model_free(m); return 0;\n}\n");
   const std::string cc = "cd '" + (w / "").string() + "' && cc -std=c99 -Wall -Werror " HYSTLAB_C_FLAGS " -I'" HYSTLAB_CAPI_INCLUDE "' " + name +
-                         "_main.c '" HYSTLAB_CAPI_LIB "' -Wl,-rpath,'" + std::filesystem::path(HYSTLAB_CAPI_LIB).parent_path().string() +
-                         "' -o " + name + "_main && ./" + name + "_main > " + name + "_forces.txt";
+                         "_main.c '" HYSTLAB_CAPI_LIB "' -Wl,-rpath,'" + std::filesystem::path(HYSTLAB_CAPI_LIB).parent_path().string() + "' -o " + name +
+                         "_main && ./" + name + "_main > " + name + "_forces.txt";
   REQUIRE(std::system(cc.c_str()) == 0);
   const Result eval = w.run("eval --table " + table + " --input X.csv");
   REQUIRE(eval.code == 0);
@@ -67,9 +70,10 @@ TEST_CASE("cli: export a table and parameters as JSON, CSV, MATLAB and a C heade
   CHECK(slurp(w / "T.m").find("function f = hystlab_eval(T, x)") != std::string::npos);
   CHECK(slurp(w / "T2.json").find("\"hystlab-everett-table\"") != std::string::npos);
   // The header, compiled by the C compiler, holds the CSV's node values exactly.
-  w.write("main.c", "#include <stdio.h>\n#include \"isolator.h\"\nint main(void) {\n"
-                    "  for (int k = 0; k < ISOLATOR_NODE_COUNT; ++k) printf(\"%.17g\\n\", ISOLATOR_VALUES_N[k]);\n"
-                    "  printf(\"%d %.17g %.17g\\n\", ISOLATOR_N, ISOLATOR_LO_MM, ISOLATOR_HI_MM);\n  return 0;\n}\n");
+  w.write("main.c",
+          "#include <stdio.h>\n#include \"isolator.h\"\nint main(void) {\n"
+          "  for (int k = 0; k < ISOLATOR_NODE_COUNT; ++k) printf(\"%.17g\\n\", ISOLATOR_VALUES_N[k]);\n"
+          "  printf(\"%d %.17g %.17g\\n\", ISOLATOR_N, ISOLATOR_LO_MM, ISOLATOR_HI_MM);\n  return 0;\n}\n");
   const std::string cc = "cd '" + (w / "").string() + "' && cc -std=c99 -Wall -Werror main.c -o main && ./main > values.txt";
   REQUIRE(std::system(cc.c_str()) == 0);
   std::istringstream csv(slurp(w / "T.csv")), values(slurp(w / "values.txt"));

@@ -63,10 +63,22 @@ TEST_CASE("cli: --help lists every verb, each sub-command and every export forma
   CHECK(choices(top.out, "  runs export --format ") == std::vector<std::string>{"csv", "h5"});
   // Every verb has a line of the top-level help and its own help; each sub-command is named on
   // its verb's line(s) and in the verb's own help.
-  const std::pair<const char*, std::vector<const char*>> verbs[] = {
-      {"eval", {}}, {"identify", {}}, {"fit", {}}, {"calibrate", {}}, {"invert", {}}, {"check", {}}, {"compare", {}}, {"loops", {}}, {"demo", {}},
-      {"simulate", {"sdof"}}, {"export", {}}, {"campaign", {"submit", "preview", "pause", "resume", "abort", "estop", "list", "show"}},
-      {"rig", {"estop", "reset", "recover"}}, {"tables", {"list", "export"}}, {"runs", {"export"}}, {"report", {}}};
+  const std::pair<const char*, std::vector<const char*>> verbs[] = {{"eval", {}},
+                                                                    {"identify", {}},
+                                                                    {"fit", {}},
+                                                                    {"calibrate", {}},
+                                                                    {"invert", {}},
+                                                                    {"check", {}},
+                                                                    {"compare", {}},
+                                                                    {"loops", {}},
+                                                                    {"demo", {}},
+                                                                    {"simulate", {"sdof"}},
+                                                                    {"export", {}},
+                                                                    {"campaign", {"submit", "preview", "pause", "resume", "abort", "estop", "list", "show"}},
+                                                                    {"rig", {"estop", "reset", "recover"}},
+                                                                    {"tables", {"list", "export"}},
+                                                                    {"runs", {"export"}},
+                                                                    {"report", {}}};
   for (const auto& [v, subs] : verbs) {
     const std::string verb = v;
     CAPTURE(verb);

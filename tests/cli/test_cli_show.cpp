@@ -61,7 +61,8 @@ const std::pair<const char*, const char*> kEvents[] = {
     {"retake", R"({"frequency_hz":12.5,"why":"a gap in the window","attempt":2})"},
     {"gaps", R"({"count":3,"total_ms":120,"longest_ms":80})"},
     {"gap", R"({"from_s":1,"to_s":1.2,"length_ms":200})"},
-    {"quality", R"({"run":1,"samples":12345,"rig_seconds":12.3,"rate_hz":999.1,"expected_rate_hz":1000,"gaps":3,"gap_total_s":0.12,"longest_gap_s":0.08,"lost_samples":1,"io_errors":2})"},
+    {"quality",
+     R"({"run":1,"samples":12345,"rig_seconds":12.3,"rate_hz":999.1,"expected_rate_hz":1000,"gaps":3,"gap_total_s":0.12,"longest_gap_s":0.08,"lost_samples":1,"io_errors":2})"},
     {"safe", R"({"position_mm":0.001,"target_mm":0,"seconds":2.3})"},
     {"frobnicate", R"({"a":1,"b":{"c":"x"},"list":[1,2]})"},
     {"remark", "plain words"},
@@ -113,10 +114,10 @@ TEST_CASE("cli: tables list: every column at one offset in every row, numbers ri
     const auto rig = s.upsert_rig("sim frame", "{}", "2026-01-01T00:00:00Z");
     const auto c = s.create_campaign(rig, hystlab::db::CampaignKind::fot, R"({"kind": "fot"})", "2026-01-01T00:00:01Z");
     const std::string doc = R"({"format": "hystlab-everett-table"})";  // listed, never read here
-    for (int k = 0; k < 11; ++k) {  // ids 1..11 (one and two digits), every width of figure
+    for (int k = 0; k < 11; ++k) {                                     // ids 1..11 (one and two digits), every width of figure
       const bool own = k != 4, held = k % 3 == 0, campaign = k != 7;
-      (void)s.add_table(campaign ? std::optional<std::int64_t>(c) : std::nullopt, std::nullopt, k % 2 ? "lsq" : "fot", k < 5 ? 4 : 24, 0,
-                        k < 9 ? 2 : 12.5, "2026-01-0" + std::to_string(1 + k % 9) + "T10:57:27.123Z",
+      (void)s.add_table(campaign ? std::optional<std::int64_t>(c) : std::nullopt, std::nullopt, k % 2 ? "lsq" : "fot", k < 5 ? 4 : 24, 0, k < 9 ? 2 : 12.5,
+                        "2026-01-0" + std::to_string(1 + k % 9) + "T10:57:27.123Z",
                         own ? accuracy(0.59 * (k + 1) * (k + 1) * (k + 1), 1.6 * (k + 1), held ? 1.2 + k : 0, k == 3) : "", doc);
     }
   }
@@ -125,9 +126,9 @@ TEST_CASE("cli: tables list: every column at one offset in every row, numbers ri
   CAPTURE(r.out);
   const auto lines = lines_of(r.out);
   REQUIRE(lines.size() == 13);  // the header, 11 rows, the legend
-  const Col cols[] = {{"id", true},       {"campaign", true},         {"method", false},          {"n", true},
-                      {"range (mm)", false}, {"RMS (N)", true},      {"% range", true},          {"max (N)", true},
-                      {"held-out RMS (N)", true}, {"held-out max (N)", true}, {"created", false}};
+  const Col cols[] = {
+      {"id", true},      {"campaign", true},         {"method", false},          {"n", true},       {"range (mm)", false}, {"RMS (N)", true}, {"% range", true},
+      {"max (N)", true}, {"held-out RMS (N)", true}, {"held-out max (N)", true}, {"created", false}};
   std::vector<std::size_t> at;  // each title's offset in the header
   for (const Col& c : cols) {
     const std::size_t p = lines[0].find(c.title, at.empty() ? 0 : at.back() + 1);

@@ -12,11 +12,11 @@
 #include <mutex>
 #include <optional>
 
+#include "../support/temp_dir.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
-#include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
 namespace fs = std::filesystem;
@@ -61,19 +61,20 @@ struct Controls {  // what the HTTP threads will do: queue commands for the acqu
 };
 
 nlohmann::json fot_plan(int n, double rate = 0.1) {
-  return {{"kind", "fot"}, {"range_mm", {0.0, 4.0}}, {"subdivisions", n}, {"ramp_rate_mm_s", rate}, {"sample_rate_hz", 1000},
-          {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 50}}}};
+  return {{"kind", "fot"},          {"range_mm", {0.0, 4.0}}, {"subdivisions", n},
+          {"ramp_rate_mm_s", rate}, {"sample_rate_hz", 1000}, {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 50}}}};
 }
 
 std::unique_ptr<drivers::Rig> tcp_rig(int port) {
-  return drivers::make_rig({{"transport", "modbus-tcp"}, {"port", port}, {"response_timeout_ms", 50}, {"reconnect_min_ms", 10},
-                            {"reconnect_max_ms", 20}, {"stale_after_ms", 5000}});
+  return drivers::make_rig(
+      {{"transport", "modbus-tcp"}, {"port", port}, {"response_timeout_ms", 50}, {"reconnect_min_ms", 10}, {"reconnect_max_ms", 20}, {"stale_after_ms", 5000}});
 }
 
 daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale, bool shaker = false) {
   b.sup = std::make_unique<daemon::Supervisor>(rig, daemon::SupervisionSettings{}, shaker, [](const daemon::RigTransition& t) {
     if (std::getenv("HYSTLAB_TRACE"))
-      std::fprintf(stderr, "%.3f %s -> %s: %s\n", t.t, std::string(daemon::to_string(t.from)).c_str(), std::string(daemon::to_string(t.to)).c_str(), t.reason.c_str());
+      std::fprintf(stderr, "%.3f %s -> %s: %s\n", t.t, std::string(daemon::to_string(t.from)).c_str(), std::string(daemon::to_string(t.to)).c_str(),
+                   t.reason.c_str());
   });
   daemon::RunnerContext ctx{rig, *b.sup, *b.writer, b.clock};
   ctx.time_scale = scale;

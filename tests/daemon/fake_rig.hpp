@@ -36,10 +36,10 @@ class FakeRig final : public drivers::Rig {
     std::vector<double> setpoints;
   } log;
   double deadband_mm = 0, rate_cap_mm_s = 500, dt = 0.001;
-  double t_base = 0;                // added to the time a read passes in (campaigns count from their start)
-  double enable_delay_s = 0;        // enabled reported this long after enable (the handshake's wait)
-  double heartbeat_timeout_s = 0;   // > 0: the controller's host watchdog (fault 4), timed while enabled
-  double stroke_mm = 1e9;           // beyond ±stroke_mm: fault 1; a reset there enters limit recovery (1 mm/s, inward only)
+  double t_base = 0;               // added to the time a read passes in (campaigns count from their start)
+  double enable_delay_s = 0;       // enabled reported this long after enable (the handshake's wait)
+  double heartbeat_timeout_s = 0;  // > 0: the controller's host watchdog (fault 4), timed while enabled
+  double stroke_mm = 1e9;          // beyond ±stroke_mm: fault 1; a reset there enters limit recovery (1 mm/s, inward only)
   bool shaker = false;
   std::uint16_t required_mode = 1;
   std::vector<FaultEvent> plan;
@@ -84,8 +84,10 @@ class FakeRig final : public drivers::Rig {
     if (auto ec = link()) return ec;
     ++log.resets;
     estop_cmd_ = false;
-    if (!cause_ && limit_ && beyond()) fault_ = 0, estop_ = false, enable_ = false, recovering_ = true;
-    else if (!cause_) fault_ = 0, estop_ = false, enable_ = false, limit_ = false;
+    if (!cause_ && limit_ && beyond())
+      fault_ = 0, estop_ = false, enable_ = false, recovering_ = true;
+    else if (!cause_)
+      fault_ = 0, estop_ = false, enable_ = false, limit_ = false;
     return {};
   }
   std::error_code write_host_heartbeat(std::uint32_t) noexcept override {
@@ -194,8 +196,10 @@ class FakeRig final : public drivers::Rig {
       const double before = x_;
       const double rate = std::min({rate_, rate_cap_mm_s, recovering_ ? 1.0 : 1e9});
       const double target = recovering_ ? std::clamp(setpoint_, -stroke_mm, stroke_mm) : setpoint_;
-      if (driving) cmd_ += std::clamp(target - cmd_, -rate * dt, rate * dt);
-      else cmd_ = x_;
+      if (driving)
+        cmd_ += std::clamp(target - cmd_, -rate * dt, rate * dt);
+      else
+        cmd_ = x_;
       if (std::fabs(cmd_ - x_) > deadband_mm) x_ += (cmd_ - x_) * 0.2;
       moving_ = std::fabs(x_ - before) > 1e-9;
       if (recovering_ && !beyond()) recovering_ = false, limit_ = false;
@@ -205,9 +209,8 @@ class FakeRig final : public drivers::Rig {
   std::uint16_t status() const {
     const bool ready = !estop_ && !fault_ && !in(FaultEvent::not_ready);
     const bool on = enabled() && now_ - enabled_at_ >= enable_delay_s;
-    return static_cast<std::uint16_t>((ready ? st::ready : 0U) | (on ? st::enabled : 0U) | (hold_ ? st::holding : 0U) |
-                                      (estop_ ? st::estop : 0U) | (fault_ && !estop_ ? st::fault : 0U) | (moving_ ? st::moving : 0U) |
-                                      (limit_ ? st::limit_tripped : 0U));
+    return static_cast<std::uint16_t>((ready ? st::ready : 0U) | (on ? st::enabled : 0U) | (hold_ ? st::holding : 0U) | (estop_ ? st::estop : 0U) |
+                                      (fault_ && !estop_ ? st::fault : 0U) | (moving_ ? st::moving : 0U) | (limit_ ? st::limit_tripped : 0U));
   }
 
   double now_ = 0, x_ = 0, cmd_ = 0, setpoint_ = 0, rate_ = 1;

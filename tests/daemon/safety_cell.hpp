@@ -26,19 +26,29 @@ using daemon::RigState;
 using nlohmann::json;
 
 json fot_plan() {  // preamble, one training cycle, two rows, a short validation run: about 6 s of rig time
-  return {{"kind", "fot"}, {"range_mm", {0, 1}}, {"subdivisions", 2}, {"ramp_rate_mm_s", 2}, {"dwell_s", 0.1}, {"sample_rate_hz", 500},
-          {"training_cycles", 1}, {"validation", {{"reversals", 4}}}};
+  return {{"kind", "fot"},  {"range_mm", {0, 1}},    {"subdivisions", 2},    {"ramp_rate_mm_s", 2},
+          {"dwell_s", 0.1}, {"sample_rate_hz", 500}, {"training_cycles", 1}, {"validation", {{"reversals", 4}}}};
 }
 json sine_plan() {
-  return {{"kind", "sine"}, {"frequencies_hz", {20, 30}}, {"amplitude_mm", 0.05}, {"sample_rate_hz", 1000}, {"measured_cycles", 4},
-          {"settle", {{"change", "5 %"}, {"consecutive", 1}, {"min_cycles", 2}}}, {"control", {{"tolerance", "5 %"}, {"window_cycles", 2}}}};
+  return {{"kind", "sine"},
+          {"frequencies_hz", {20, 30}},
+          {"amplitude_mm", 0.05},
+          {"sample_rate_hz", 1000},
+          {"measured_cycles", 4},
+          {"settle", {{"change", "5 %"}, {"consecutive", 1}, {"min_cycles", 2}}},
+          {"control", {{"tolerance", "5 %"}, {"window_cycles", 2}}}};
 }
 json next_plan(bool shaker) {  // after a reset: the next campaign must run
-  if (shaker) return {{"kind", "sine"}, {"frequencies_hz", {25}}, {"amplitude_mm", 0.05}, {"sample_rate_hz", 1000}, {"measured_cycles", 2},
-                      {"settle", {{"change", "5 %"}, {"consecutive", 1}, {"min_cycles", 1}}}, {"control", {{"tolerance", "5 %"}, {"window_cycles", 2}}}};
+  if (shaker)
+    return {{"kind", "sine"},
+            {"frequencies_hz", {25}},
+            {"amplitude_mm", 0.05},
+            {"sample_rate_hz", 1000},
+            {"measured_cycles", 2},
+            {"settle", {{"change", "5 %"}, {"consecutive", 1}, {"min_cycles", 1}}},
+            {"control", {{"tolerance", "5 %"}, {"window_cycles", 2}}}};
   // From wherever the event left the frame (the limits take in the whole range it may be at).
-  return {{"kind", "waveform"}, {"points_mm", {0, 0.2, 0}}, {"ramp_rate_mm_s", 2}, {"sample_rate_hz", 500},
-          {"limits", {{"displacement_mm", {-0.5, 1.5}}}}};
+  return {{"kind", "waveform"}, {"points_mm", {0, 0.2, 0}}, {"ramp_rate_mm_s", 2}, {"sample_rate_hz", 500}, {"limits", {{"displacement_mm", {-0.5, 1.5}}}}};
 }
 
 bool shaker_state(State s) { return s == State::shaker_control || s == State::shaker_measure; }
@@ -48,8 +58,8 @@ bool campaign_event(Event e) {
 }
 // Events whose first act is a write to the rig within two periods (the stops).
 bool stop_event(Event e) {
-  return e == Event::rig_estop || e == Event::campaign_estop || e == Event::abort || e == Event::pause || e == Event::ctl_estop ||
-         e == Event::ctl_fault || e == Event::limit_trip || e == Event::not_ready || e == Event::enable_dropped || e == Event::strategy_exception;
+  return e == Event::rig_estop || e == Event::campaign_estop || e == Event::abort || e == Event::pause || e == Event::ctl_estop || e == Event::ctl_fault ||
+         e == Event::limit_trip || e == Event::not_ready || e == Event::enable_dropped || e == Event::strategy_exception;
 }
 
 // What the host has written so far, to see the first safe write after an event.
@@ -60,7 +70,7 @@ struct Writes {
       : estops(r.log.estop_writes), holds(r.log.hold_writes), disables(r.log.disables), zero_drives(r.log.zero_drives), setpoints(r.log.setpoints.size()) {}
   bool safe_write_since(const Writes& b, const FakeRig& r) const {
     if (estops > b.estops || holds > b.holds || disables > b.disables) return true;
-    if (r.shaker) return zero_drives > b.zero_drives;  // the shaker's hold: zero amplitude (a new drive level is no stop)
+    if (r.shaker) return zero_drives > b.zero_drives;                            // the shaker's hold: zero amplitude (a new drive level is no stop)
     return setpoints > b.setpoints && std::fabs(r.log.setpoints.back()) < 1e-9;  // the safe ramp (to 0 mm)
   }
 };
@@ -116,26 +126,64 @@ struct Cell {
     const double T = rig().now();
     if (record) at_event.emplace(rig()), event_tick = ticks;
     switch (e) {
-      case Event::rig_estop: answer = world.w.push_rig_command(RigCommand::estop); break;
-      case Event::reset: answer = world.w.push_rig_command(RigCommand::reset); break;
-      case Event::campaign_estop: world.controls.push_back(Control::estop); break;
-      case Event::abort: world.controls.push_back(Control::abort); break;
-      case Event::pause: world.controls.push_back(Control::pause); break;
-      case Event::resume: world.controls.push_back(Control::resume); break;
-      case Event::ctl_estop: rig().plan.push_back({FaultEvent::estop, T, T}); break;
-      case Event::ctl_fault: rig().plan.push_back({FaultEvent::latch_fault, T, T, 7}); break;
-      case Event::limit_trip: rig().plan.push_back({FaultEvent::limit_trip, T, T}); break;
-      case Event::not_ready: rig().plan.push_back({FaultEvent::not_ready, T, T + 0.2}); break;
-      case Event::enable_dropped: rig().plan.push_back({FaultEvent::drop_enable, T, T}); break;
-      case Event::link_lost: rig().plan.push_back({FaultEvent::drop, T, T + 1.5}); break;  // beyond the watchdog's 500 periods
-      case Event::stale_counter: rig().plan.push_back({FaultEvent::freeze, T, T + 0.1}); break;
-      case Event::heartbeat_lost: rig().plan.push_back({FaultEvent::heartbeat_loss, T, T + 1e9}); break;
-      case Event::dead_band: rig().deadband_mm = 0.05; break;  // beyond the 0.01 mm in-position tolerance
-      case Event::strategy_exception: throw std::runtime_error("injected: a strategy threw");
-      case Event::db_busy: lock.start(world.path, 1.0); break;    // within SQLite's 5 s busy timeout: writes wait
-      case Event::db_failing: lock.start(world.path, 6.0); break;  // beyond it: commits fail and are retried
-      case Event::ring_full: lock.start(world.path, 2.0); break;   // 256 slots fill in 0.5 s of rig time
-      case Event::finisher_failing: break;                          // at the end: the finisher's work throws
+      case Event::rig_estop:
+        answer = world.w.push_rig_command(RigCommand::estop);
+        break;
+      case Event::reset:
+        answer = world.w.push_rig_command(RigCommand::reset);
+        break;
+      case Event::campaign_estop:
+        world.controls.push_back(Control::estop);
+        break;
+      case Event::abort:
+        world.controls.push_back(Control::abort);
+        break;
+      case Event::pause:
+        world.controls.push_back(Control::pause);
+        break;
+      case Event::resume:
+        world.controls.push_back(Control::resume);
+        break;
+      case Event::ctl_estop:
+        rig().plan.push_back({FaultEvent::estop, T, T});
+        break;
+      case Event::ctl_fault:
+        rig().plan.push_back({FaultEvent::latch_fault, T, T, 7});
+        break;
+      case Event::limit_trip:
+        rig().plan.push_back({FaultEvent::limit_trip, T, T});
+        break;
+      case Event::not_ready:
+        rig().plan.push_back({FaultEvent::not_ready, T, T + 0.2});
+        break;
+      case Event::enable_dropped:
+        rig().plan.push_back({FaultEvent::drop_enable, T, T});
+        break;
+      case Event::link_lost:
+        rig().plan.push_back({FaultEvent::drop, T, T + 1.5});
+        break;  // beyond the watchdog's 500 periods
+      case Event::stale_counter:
+        rig().plan.push_back({FaultEvent::freeze, T, T + 0.1});
+        break;
+      case Event::heartbeat_lost:
+        rig().plan.push_back({FaultEvent::heartbeat_loss, T, T + 1e9});
+        break;
+      case Event::dead_band:
+        rig().deadband_mm = 0.05;
+        break;  // beyond the 0.01 mm in-position tolerance
+      case Event::strategy_exception:
+        throw std::runtime_error("injected: a strategy threw");
+      case Event::db_busy:
+        lock.start(world.path, 1.0);
+        break;  // within SQLite's 5 s busy timeout: writes wait
+      case Event::db_failing:
+        lock.start(world.path, 6.0);
+        break;  // beyond it: commits fail and are retried
+      case Event::ring_full:
+        lock.start(world.path, 2.0);
+        break;  // 256 slots fill in 0.5 s of rig time
+      case Event::finisher_failing:
+        break;  // at the end: the finisher's work throws
     }
   }
 
@@ -184,13 +232,20 @@ struct Cell {
     const CampaignPhase p = phase();
     const double x = rig().position();
     switch (state) {
-      case State::arming_ready: return p == CampaignPhase::arming && sup().state() != RigState::arming;
-      case State::arming_enable: return p == CampaignPhase::arming && sup().state() == RigState::arming && rig().enabled();
-      case State::preamble: return p == CampaignPhase::preamble;
-      case State::training: return p == CampaignPhase::training && x > 0.3;
-      case State::ramping: return p == CampaignPhase::ramping && x > 0.2 && x > last_x;
-      case State::dwelling: return p == CampaignPhase::dwelling && x > 0.2;
-      case State::validation: return p == CampaignPhase::validation && x > 0.1;
+      case State::arming_ready:
+        return p == CampaignPhase::arming && sup().state() != RigState::arming;
+      case State::arming_enable:
+        return p == CampaignPhase::arming && sup().state() == RigState::arming && rig().enabled();
+      case State::preamble:
+        return p == CampaignPhase::preamble;
+      case State::training:
+        return p == CampaignPhase::training && x > 0.3;
+      case State::ramping:
+        return p == CampaignPhase::ramping && x > 0.2 && x > last_x;
+      case State::dwelling:
+        return p == CampaignPhase::dwelling && x > 0.2;
+      case State::validation:
+        return p == CampaignPhase::validation && x > 0.1;
       case State::retake:
         if (p == CampaignPhase::ramping && x > 0.95) top_seen = 1;
         // A hole across β = 0.5 in row 2's descent: the link drops for 0.2 s (the rig, not hearing
@@ -201,14 +256,18 @@ struct Cell {
         }
         return p == CampaignPhase::retake;
       case State::paused:
-        if (p == CampaignPhase::ramping && x > 0.3 && !saw_paused && world.controls.empty() && !pause_sent) pause_sent = true, world.controls.push_back(Control::pause);
+        if (p == CampaignPhase::ramping && x > 0.3 && !saw_paused && world.controls.empty() && !pause_sent)
+          pause_sent = true, world.controls.push_back(Control::pause);
         return p == CampaignPhase::paused && ticks > pause_tick();
       case State::safing:
         if (p == CampaignPhase::ramping && x > 0.6 && !abort_sent) abort_sent = true, world.controls.push_back(Control::abort);
         return p == CampaignPhase::safing && x < 0.5;
-      case State::shaker_control: return p == CampaignPhase::shaker_control && ticks > 30;
-      case State::shaker_measure: return p == CampaignPhase::shaker_measure;
-      default: return false;
+      case State::shaker_control:
+        return p == CampaignPhase::shaker_control && ticks > 30;
+      case State::shaker_measure:
+        return p == CampaignPhase::shaker_measure;
+      default:
+        return false;
     }
   }
   bool pause_sent = false, abort_sent = false;

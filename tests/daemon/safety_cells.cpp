@@ -12,18 +12,46 @@
 namespace hystlab::test {
 
 const char* to_string(State s) noexcept {
-  constexpr const char* names[] = {"idle",       "queued", "arming: checking ready", "arming: enable written", "preamble", "training",
-                                   "ramping",    "dwelling", "retake",               "validation",             "paused",   "safing",
-                                   "shaker control window", "shaker measuring window", "finishing", "held after restart",
+  constexpr const char* names[] = {"idle",
+                                   "queued",
+                                   "arming: checking ready",
+                                   "arming: enable written",
+                                   "preamble",
+                                   "training",
+                                   "ramping",
+                                   "dwelling",
+                                   "retake",
+                                   "validation",
+                                   "paused",
+                                   "safing",
+                                   "shaker control window",
+                                   "shaker measuring window",
+                                   "finishing",
+                                   "held after restart",
                                    "limit recovery (latched, on the way back)"};
   return names[static_cast<int>(s)];
 }
 
 const char* to_string(Event e) noexcept {
-  constexpr const char* names[] = {"operator e-stop (rig)", "operator e-stop (campaign)", "abort", "pause", "resume", "reset",
-                                   "controller e-stop bit", "controller fault", "limit trip", "not ready", "enable dropped",
-                                   "link lost (1.5 s)", "stale counter (0.1 s)", "host heartbeat lost", "dead band",
-                                   "exception in a strategy", "database busy (1 s)", "database failing (6 s)", "writer's ring full",
+  constexpr const char* names[] = {"operator e-stop (rig)",
+                                   "operator e-stop (campaign)",
+                                   "abort",
+                                   "pause",
+                                   "resume",
+                                   "reset",
+                                   "controller e-stop bit",
+                                   "controller fault",
+                                   "limit trip",
+                                   "not ready",
+                                   "enable dropped",
+                                   "link lost (1.5 s)",
+                                   "stale counter (0.1 s)",
+                                   "host heartbeat lost",
+                                   "dead band",
+                                   "exception in a strategy",
+                                   "database busy (1 s)",
+                                   "database failing (6 s)",
+                                   "writer's ring full",
                                    "finisher failing"};
   return names[static_cast<int>(e)];
 }
@@ -133,9 +161,12 @@ void Cell::run_recovery_state() {
   }
   if (sup().recovering()) fail("the recovery never ended");
   if (event == Event::reset) {  // refused while the frame comes back: only a stop interrupts a recovery
-    if (!answer || answer->wait_for(std::chrono::seconds(0)) != std::future_status::ready) fail("the reset was never answered");
-    else if (const CommandOutcome o = answer->get(); o.result != CommandOutcome::Result::conflict) fail("a reset during the recovery was answered " + o.reason);
-    else reset_refused = true;
+    if (!answer || answer->wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+      fail("the reset was never answered");
+    else if (const CommandOutcome o = answer->get(); o.result != CommandOutcome::Result::conflict)
+      fail("a reset during the recovery was answered " + o.reason);
+    else
+      reset_refused = true;
   }
   if (event != Event::reset && event != Event::stale_counter && recovering.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
     const CommandOutcome o = recovering.get();
@@ -190,11 +221,13 @@ void Cell::check_after(const daemon::RunnerResult& r, bool ran, std::int64_t id)
     if (loop_state(state) && r.end != CampaignEnd::aborted && r.end != CampaignEnd::failed) fail("the campaign was not ended by the e-stop");
   }
   if (event == Event::rig_estop && answer) {
-    if (answer->wait_for(std::chrono::seconds(0)) != std::future_status::ready) fail("the e-stop was never answered");
+    if (answer->wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+      fail("the e-stop was never answered");
     else if (const CommandOutcome o = answer->get(); o.result != CommandOutcome::Result::done || !o.confirmed || !o.latched)
       fail("the e-stop was answered " + std::string(control::to_string(o.result)) + ": " + o.reason);
   }
-  if ((event == Event::ctl_estop || event == Event::ctl_fault || event == Event::limit_trip) && !sup().latched()) fail("the controller's latch was not latched");
+  if ((event == Event::ctl_estop || event == Event::ctl_fault || event == Event::limit_trip) && !sup().latched())
+    fail("the controller's latch was not latched");
   if (event == Event::pause && loop_state(state) && moved_while_paused) fail("the rig moved while paused");
   if (event == Event::pause && (state == State::arming_ready || state == State::arming_enable) && !saw_paused)
     fail("a pause while arming was not applied once armed");
@@ -204,8 +237,7 @@ void Cell::check_after(const daemon::RunnerResult& r, bool ran, std::int64_t id)
   if (event == Event::ring_full && ran && loop_state(state) && r.dropped == 0) fail("the writer's ring never filled (the cell tested nothing)");
   // The bound is shown for the events whose first act is a write: the stops, and the watchdogs'
   // holds (a stale counter, a dead band's missed target, the controller's own heartbeat stop).
-  const bool shown = stop || (event == Event::stale_counter && state != State::limit_recovery) || event == Event::dead_band ||
-                     event == Event::heartbeat_lost;
+  const bool shown = stop || (event == Event::stale_counter && state != State::limit_recovery) || event == Event::dead_band || event == Event::heartbeat_lost;
   describe(r, ran, shown ? bound : -1);
   recover_and_run_next();
 }
@@ -213,7 +245,8 @@ void Cell::check_after(const daemon::RunnerResult& r, bool ran, std::int64_t id)
 void Cell::describe(const daemon::RunnerResult& r, bool ran, int bound) {
   std::string o = ran ? std::string(daemon::to_string(r.end)) : "no campaign";
   if (ran && !r.reason.empty()) o += ": " + short_reason(r.reason);
-  if (state == State::limit_recovery) o = std::string(reset_refused ? "the reset refused (409), " : "") + "recovery: " + recovery_words(sup().recovery_result());
+  if (state == State::limit_recovery)
+    o = std::string(reset_refused ? "the reset refused (409), " : "") + "recovery: " + recovery_words(sup().recovery_result());
   if (closed_tick >= 0) o += " (went on; ended by an abort " + std::to_string(closing_ticks()) + " periods later)";
   // (where the loop runs when the event comes, the ring is asserted to have filled; elsewhere how
   // much of the run meets the lock is the host's timing, and the text must not depend on it)
@@ -222,9 +255,12 @@ void Cell::describe(const daemon::RunnerResult& r, bool ran, int bound) {
   out.outcome = o;
   if (std::getenv("HYSTLAB_SAFETY_ONLY")) out.outcome += " [" + r.reason + "]";  // the whole reason when looking at a few cells
   const bool loop = loop_state(state);
-  if (bound >= 0) out.bound = std::to_string(bound) + (loop ? " period" + std::string(bound == 1 ? "" : "s") : " idle tick" + std::string(bound == 1 ? "" : "s"));
-  else if (event == Event::link_lost) out.bound = "the hold re-asserted at the link's first answer";
-  else out.bound = "-";
+  if (bound >= 0)
+    out.bound = std::to_string(bound) + (loop ? " period" + std::string(bound == 1 ? "" : "s") : " idle tick" + std::string(bound == 1 ? "" : "s"));
+  else if (event == Event::link_lost)
+    out.bound = "the hold re-asserted at the link's first answer";
+  else
+    out.bound = "-";
 }
 
 // After a reset, the next campaign must run: the event's causes cleared, the latch reset, the run completed.
@@ -301,8 +337,10 @@ std::string matrix_markdown(const std::vector<CellResult>& cells) {
       state = c.state;
       o << "\n#### " << state << "\n\n| event | outcome | first safe write |\n|---|---|---|\n";
     }
-    if (!c.applies) o << "| " << c.event << " | does not apply: " << c.why_not << " | - |\n";
-    else o << "| " << c.event << " | " << c.outcome << " | " << c.bound << " |\n";
+    if (!c.applies)
+      o << "| " << c.event << " | does not apply: " << c.why_not << " | - |\n";
+    else
+      o << "| " << c.event << " | " << c.outcome << " | " << c.bound << " |\n";
   }
   return o.str();
 }

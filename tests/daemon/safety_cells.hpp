@@ -9,23 +9,54 @@
 namespace hystlab::test {
 
 enum class State {
-  idle, queued, arming_ready, arming_enable, preamble, training, ramping, dwelling, retake, validation, paused, safing,
-  shaker_control, shaker_measure, finishing, held_after_restart, limit_recovery
+  idle,
+  queued,
+  arming_ready,
+  arming_enable,
+  preamble,
+  training,
+  ramping,
+  dwelling,
+  retake,
+  validation,
+  paused,
+  safing,
+  shaker_control,
+  shaker_measure,
+  finishing,
+  held_after_restart,
+  limit_recovery
 };
 enum class Event {
-  rig_estop, campaign_estop, abort, pause, resume, reset, ctl_estop, ctl_fault, limit_trip, not_ready, enable_dropped, link_lost,
-  stale_counter, heartbeat_lost, dead_band, strategy_exception, db_busy, db_failing, ring_full, finisher_failing
+  rig_estop,
+  campaign_estop,
+  abort,
+  pause,
+  resume,
+  reset,
+  ctl_estop,
+  ctl_fault,
+  limit_trip,
+  not_ready,
+  enable_dropped,
+  link_lost,
+  stale_counter,
+  heartbeat_lost,
+  dead_band,
+  strategy_exception,
+  db_busy,
+  db_failing,
+  ring_full,
+  finisher_failing
 };
-inline constexpr std::array kStates{State::idle,        State::queued,         State::arming_ready,   State::arming_enable,
-                                    State::preamble,    State::training,       State::ramping,        State::dwelling,
-                                    State::retake,      State::validation,     State::paused,         State::safing,
-                                    State::shaker_control, State::shaker_measure, State::finishing, State::held_after_restart,
-                                    State::limit_recovery};
-inline constexpr std::array kEvents{Event::rig_estop,     Event::campaign_estop, Event::abort,          Event::pause,
-                                    Event::resume,        Event::reset,          Event::ctl_estop,      Event::ctl_fault,
-                                    Event::limit_trip,    Event::not_ready,      Event::enable_dropped, Event::link_lost,
-                                    Event::stale_counter, Event::heartbeat_lost, Event::dead_band,      Event::strategy_exception,
-                                    Event::db_busy,       Event::db_failing,     Event::ring_full,      Event::finisher_failing};
+inline constexpr std::array kStates{
+    State::idle,           State::queued,         State::arming_ready, State::arming_enable,      State::preamble,      State::training,
+    State::ramping,        State::dwelling,       State::retake,       State::validation,         State::paused,        State::safing,
+    State::shaker_control, State::shaker_measure, State::finishing,    State::held_after_restart, State::limit_recovery};
+inline constexpr std::array kEvents{
+    Event::rig_estop, Event::campaign_estop,     Event::abort,     Event::pause,          Event::resume,    Event::reset,           Event::ctl_estop,
+    Event::ctl_fault, Event::limit_trip,         Event::not_ready, Event::enable_dropped, Event::link_lost, Event::stale_counter,   Event::heartbeat_lost,
+    Event::dead_band, Event::strategy_exception, Event::db_busy,   Event::db_failing,     Event::ring_full, Event::finisher_failing};
 [[nodiscard]] const char* to_string(State s) noexcept;
 [[nodiscard]] const char* to_string(Event e) noexcept;
 

@@ -13,12 +13,12 @@
 #include <optional>
 #include <string>
 
+#include "../support/temp_dir.hpp"
 #include "fake_rig.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "rig_worker.hpp"
-#include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
 

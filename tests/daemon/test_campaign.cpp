@@ -8,26 +8,26 @@
 #include <atomic>
 #include <cmath>
 #include <deque>
-#include <future>
 #include <filesystem>
+#include <future>
 #include <mutex>
 #include <thread>
 
+#include <random>
+#include <set>
 #include "../drivers/sim_process.hpp"
 #include "campaign_bench.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
-#include "hystlab/daemon/envelope.hpp"
-#include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/daemon/daemon.hpp"
-#include "hystlab/daemon/realtime.hpp"
+#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/online_fot.hpp"
+#include "hystlab/daemon/realtime.hpp"
 #include "hystlab/daemon/safety.hpp"
-#include <random>
-#include <set>
+#include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/drivers/can_rig.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
-#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/online_table_builder.hpp"
 #include "hystlab/models/simplified_sma.hpp"
 #include "hystlab/protocols/signals.hpp"
@@ -346,8 +346,8 @@ TEST_CASE("plans: an error names the field and the reason") {
 
 TEST_CASE("daemon config: acquisition settings and the simulator's priority, with errors that name the field") {
   using daemon::AcquisitionSettings;
-  const auto c = daemon::parse_daemon_config(nlohmann::json::parse(
-      R"({"acquisition": {"priority": 0, "cpu": "any"}, "rigs": [{"simulate": {"time_scale": 1, "realtime_priority": 5}}]})"));
+  const auto c = daemon::parse_daemon_config(
+      nlohmann::json::parse(R"({"acquisition": {"priority": 0, "cpu": "any"}, "rigs": [{"simulate": {"time_scale": 1, "realtime_priority": 5}}]})"));
   CHECK(c.acquisition.priority == 0);
   CHECK(c.acquisition.cpu == AcquisitionSettings::kAnyCpu);
   CHECK(c.rigs.at(0).sim.realtime_priority == 5);
@@ -421,8 +421,8 @@ TEST_CASE("training until stable on an untrained specimen: the plateau settles, 
   CAPTURE(training[0]);
   CHECK(t["stable"] == true);
   CHECK(t["cycles"].get<std::size_t>() == cycles.size());
-  CHECK(cycles.size() >= 5);   // the drift is seen (10 N on a 30 N plateau)
-  CHECK(cycles.size() < 25);   // and training ended before its maximum
+  CHECK(cycles.size() >= 5);  // the drift is seen (10 N on a 30 N plateau)
+  CHECK(cycles.size() < 25);  // and training ended before its maximum
   // The loop narrows while it settles, and the rule replayed on the stored figures stops where it stopped.
   CHECK(cycles[0]["energy_Nmm"].get<double>() > cycles.back()["energy_Nmm"].get<double>() * 1.1);
   int run_below = 0;
@@ -516,4 +516,3 @@ TEST_CASE("training until stable: at its maximum the campaign says the loop did 
   CHECK(b.store->runs_of_campaign(id).size() == 1);
   CHECK(b.store->event_details(id, "recommendation").empty());  // nothing held out: nothing recommended
 }
-

@@ -14,8 +14,7 @@ using namespace hystlab;
 
 namespace {
 nlohmann::json small_plan() {
-  return {{"kind", "fot"}, {"range_mm", {0, 1}}, {"subdivisions", 2}, {"ramp_rate_mm_s", 2}, {"dwell_s", 0.05}, {"sample_rate_hz", 500},
-          {"validation", false}};
+  return {{"kind", "fot"}, {"range_mm", {0, 1}}, {"subdivisions", 2}, {"ramp_rate_mm_s", 2}, {"dwell_s", 0.05}, {"sample_rate_hz", 500}, {"validation", false}};
 }
 }  // namespace
 
@@ -45,8 +44,7 @@ TEST_CASE("contain: an exception on the acquisition thread holds the rig, fails 
     const auto row = world.store->campaign(first.id);
     REQUIRE(row);
     CHECK(row->state == db::CampaignState::failed);
-    CHECK(world.store->state_reason(first.id, db::CampaignState::failed) ==
-          "error on the acquisition thread: injected: a strategy's bug; the rig is held");
+    CHECK(world.store->state_reason(first.id, db::CampaignState::failed) == "error on the acquisition thread: injected: a strategy's bug; the rig is held");
     // The worker goes on: idle ticks, then a campaign to its end.
     world.idle(5);
     const int setpoints_before = static_cast<int>(world.rig->log.setpoints.size());

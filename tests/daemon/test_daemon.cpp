@@ -12,12 +12,12 @@
 #include <string>
 #include <thread>
 
-#include "hystlab/db/store.hpp"
-#include "hystlab/models/fot_identification.hpp"
-#include "hystlab/models/formats.hpp"
-#include "hystlab/models/simplified_sma.hpp"
 #include "../support/daemon_process.hpp"
 #include "../support/temp_dir.hpp"
+#include "hystlab/db/store.hpp"
+#include "hystlab/models/formats.hpp"
+#include "hystlab/models/fot_identification.hpp"
+#include "hystlab/models/simplified_sma.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystlab;
@@ -30,9 +30,7 @@ struct Dir {
   void write(const std::string& name, const std::string& text) const { std::ofstream(path / name) << text; }
 };
 
-pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
-  return test_support::spawn_logged(args, log.string());
-}
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) { return test_support::spawn_logged(args, log.string()); }
 
 // A daemon a failed REQUIRE left running is killed when the test case ends.
 struct Reaper {
@@ -152,8 +150,8 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
     db::Store s(d.db());
     CHECK(s.integrity_check() == "ok");
     CHECK(s.max_seq(1) >= committed);
-    CHECK(s.sample_count(1) == s.max_seq(1) + 1);  // no holes
-    CHECK(s.campaign(1)->state == db::CampaignState::running);      // as the crash left it
+    CHECK(s.sample_count(1) == s.max_seq(1) + 1);               // no holes
+    CHECK(s.campaign(1)->state == db::CampaignState::running);  // as the crash left it
   }
   pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log2");
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "interrupted"; }));

@@ -42,8 +42,9 @@ TEST_CASE("operator e-stop over CAN in every phase: written within two periods, 
     }
   };
   idle(5);
-  const nlohmann::json plan_json{{"kind", "fot"}, {"range_mm", {0, 2}}, {"subdivisions", 2}, {"ramp_rate_mm_s", 1.0}, {"dwell_s", 0.5},
-                                 {"sample_rate_hz", 500}, {"validation", false}, {"limits", {{"displacement_mm", {-0.5, 2.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
+  const nlohmann::json plan_json{
+      {"kind", "fot"},  {"range_mm", {0, 2}},    {"subdivisions", 2},   {"ramp_rate_mm_s", 1.0},
+      {"dwell_s", 0.5}, {"sample_rate_hz", 500}, {"validation", false}, {"limits", {{"displacement_mm", {-0.5, 2.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
   using P = daemon::CampaignPhase;
   for (const std::string phase : {"just submitted", "ramping", "dwelling", "paused", "safing"}) {
     CAPTURE(phase);

@@ -49,8 +49,10 @@ TEST_CASE("safety matrix: every state x every event, each stop within its bound,
   std::vector<std::size_t> fast;
   for (std::size_t k = 0; k < cells.size(); ++k) {
     const auto [s, e] = cells[k];
-    if (e == Event::db_busy || e == Event::db_failing) slow.emplace_back([&all, k, s = s, e = e] { all[k] = run_cell(s, e); });
-    else fast.push_back(k);
+    if (e == Event::db_busy || e == Event::db_failing)
+      slow.emplace_back([&all, k, s = s, e = e] { all[k] = run_cell(s, e); });
+    else
+      fast.push_back(k);
   }
   // The others on every core (each cell's time is its fake clock's: the outcome is the same).
   std::atomic<std::size_t> next{0};
@@ -67,8 +69,10 @@ TEST_CASE("safety matrix: every state x every event, each stop within its bound,
     CAPTURE(c.event);
     CAPTURE(c.outcome);
     for (const std::string& v : c.violations) FAIL_CHECK(v);
-    if (c.applies) ++applied;
-    else CHECK_FALSE(c.why_not.empty());  // a cell that does not apply says why
+    if (c.applies)
+      ++applied;
+    else
+      CHECK_FALSE(c.why_not.empty());  // a cell that does not apply says why
   }
   MESSAGE(applied << " of " << all.size() << " cells apply");
   if (only) {
@@ -90,15 +94,16 @@ TEST_CASE("safety matrix: every state x every event, each stop within its bound,
                 "docs/SAFETY.md's matrix differs from what the code does: run HYSTLAB_SAFETY_UPDATE=1 tests/test_safety_matrix and review the diff");
 }
 
-TEST_CASE("seeded random stop schedules over whole campaigns (load frame and shaker): every stop acted on, never moving while latched, "
-          "always a terminal state with a reason") {
+TEST_CASE(
+    "seeded random stop schedules over whole campaigns (load frame and shaker): every stop acted on, never moving while latched, "
+    "always a terminal state with a reason") {
   for (std::uint64_t seed = 1; seed <= 24; ++seed) {
     CAPTURE(seed);
     std::mt19937_64 rng(seed);
     const bool shaker = seed % 3 == 0;
-    const std::vector<Event> pool{Event::rig_estop, Event::campaign_estop, Event::abort,     Event::pause,        Event::resume,
-                                  Event::reset,     Event::ctl_estop,      Event::ctl_fault, Event::limit_trip,   Event::not_ready,
-                                  Event::enable_dropped, Event::link_lost, Event::stale_counter, Event::heartbeat_lost, Event::dead_band};
+    const std::vector<Event> pool{Event::rig_estop,      Event::campaign_estop, Event::abort,         Event::pause,          Event::resume,
+                                  Event::reset,          Event::ctl_estop,      Event::ctl_fault,     Event::limit_trip,     Event::not_ready,
+                                  Event::enable_dropped, Event::link_lost,      Event::stale_counter, Event::heartbeat_lost, Event::dead_band};
     std::vector<std::pair<double, Event>> schedule;
     std::string said;
     const int n = 1 + static_cast<int>(rng() % 4);

@@ -55,8 +55,12 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   // The isolator rings at 17.7 Hz for 1/(ζω_n) = 0.45 s after each change: the settle criterion
   // waits until the mass amplitude stops changing (a fixed 10 cycles at 60 Hz measured a 16 %
   // high ratio with 9 % "distortion": the free vibration beating with the response).
-  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {12, 30, 60}}, {"amplitude_mm", 0.005},
-                                        {"settle", {{"change", "1 %"}, {"consecutive", 3}}}, {"measured_cycles", 8}, {"sample_rate_hz", 1000},
+  const auto plan = daemon::parse_plan({{"kind", "sine"},
+                                        {"frequencies_hz", {12, 30, 60}},
+                                        {"amplitude_mm", 0.005},
+                                        {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
+                                        {"measured_cycles", 8},
+                                        {"sample_rate_hz", 1000},
                                         {"control", {{"tolerance", "3 %"}, {"window_cycles", 3}}}});
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 0.25, true);
@@ -89,7 +93,8 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   CHECK(rows_in(*b.store, "shaker_samples", r.run_id) > 1000);
   CHECK(rows_in(*b.store, "samples", r.run_id) == 0);
   double drive_min = 1;  // the drive column: what the loop commanded (below the demand: the table gains above 1 here)
-  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30, [&](const db::ShakerRow& row) { drive_min = std::min(drive_min, row.v[db::shaker_signal::drive_amplitude]); });
+  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30,
+                                  [&](const db::ShakerRow& row) { drive_min = std::min(drive_min, row.v[db::shaker_signal::drive_amplitude]); });
   CHECK(drive_min < 0.005 * 0.95);
 }
 
@@ -100,8 +105,12 @@ TEST_CASE("sine campaign with linear springs: the transmissibility of the analyt
   SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25", "--linear", "40"});
   Bench b;
   auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {12, 16, 30}}, {"amplitude_mm", 0.05},
-                                        {"settle", {{"change", "1 %"}, {"consecutive", 3}}}, {"measured_cycles", 8}, {"sample_rate_hz", 1000}});
+  const auto plan = daemon::parse_plan({{"kind", "sine"},
+                                        {"frequencies_hz", {12, 16, 30}},
+                                        {"amplitude_mm", 0.05},
+                                        {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
+                                        {"measured_cycles", 8},
+                                        {"sample_rate_hz", 1000}});
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 0.25, true);
   const auto r = run(id, plan, ctx);
@@ -128,7 +137,10 @@ TEST_CASE("sine campaign: beyond the abort band the shaker is stopped, at zero d
   auto rig = shaker_rig(sim.modbus_port);
   // 110 Hz is beyond the table's servo (60 Hz): the base follows a third of the drive, and the
   // plan allows the drive only 1.5 times the demand, so the base stays about 45 % short.
-  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"frequencies_hz", {110}}, {"amplitude_mm", 0.005}, {"sample_rate_hz", 1000},
+  const auto plan = daemon::parse_plan({{"kind", "sine"},
+                                        {"frequencies_hz", {110}},
+                                        {"amplitude_mm", 0.005},
+                                        {"sample_rate_hz", 1000},
                                         {"control", {{"abort", "30 %"}, {"max_drive_ratio", 1.5}}}});
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 0.25, true);
@@ -154,8 +166,12 @@ TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rat
   SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5"});
   Bench b;
   auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan({{"kind", "sine"}, {"sweep", {{"from_hz", 8}, {"to_hz", 11}, {"rate_hz_s", 1.5}}}, {"amplitude_mm", 0.005},
-                                        {"settle_cycles", 20}, {"measured_cycles", 4}, {"sample_rate_hz", 1000}});
+  const auto plan = daemon::parse_plan({{"kind", "sine"},
+                                        {"sweep", {{"from_hz", 8}, {"to_hz", 11}, {"rate_hz_s", 1.5}}},
+                                        {"amplitude_mm", 0.005},
+                                        {"settle_cycles", 20},
+                                        {"measured_cycles", 4},
+                                        {"sample_rate_hz", 1000}});
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 0.5, true);
   const auto r = run(id, plan, ctx);
@@ -192,7 +208,8 @@ TEST_CASE("sine plans: sweeps, directions, amplitudes, settle and control, with 
   CHECK(daemon::step_count(p.sine) == 48);
   CHECK(p.sine.settle.until);
   CHECK(p.sine.control.tolerance_pct == 4);
-  const auto c = daemon::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "rate_oct_min": 2}, "amplitude_mm": 0.01})"));
+  const auto c =
+      daemon::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "rate_oct_min": 2}, "amplitude_mm": 0.01})"));
   CHECK(c.sine.continuous);
   CHECK(daemon::nominal_duration_s(c.sine) > 120);  // 4 octaves at 2 oct/min
   auto bad = [](const char* text, const char* what) {

@@ -9,13 +9,13 @@
 #include <filesystem>
 #include <random>
 
+#include "../support/temp_dir.hpp"
 #include "fake_rig.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/sequencer.hpp"
 #include "hystlab/daemon/supervisor.hpp"
-#include "../support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystlab;
@@ -272,8 +272,7 @@ TEST_CASE("randomized fault schedules: never moving while latched, never armed w
     bool armed_without_enabled = false, moved_while_latched = false;
     double latched_x = NAN;
     const auto r = h.run(j, [&](double) {
-      if (h.sup->state() == RigState::armed && !h.rig.enabled() && !h.rig.latched() && !h.rig.held() && h.rig.moving())
-        armed_without_enabled = true;
+      if (h.sup->state() == RigState::armed && !h.rig.enabled() && !h.rig.latched() && !h.rig.held() && h.rig.moving()) armed_without_enabled = true;
       if (h.sup->latched()) {
         if (std::isnan(latched_x)) latched_x = h.rig.position();
         if (std::fabs(h.rig.position() - latched_x) > 0.05) moved_while_latched = true;
@@ -290,8 +289,7 @@ TEST_CASE("randomized fault schedules: never moving while latched, never armed w
     for (const auto& t : h.transitions)
       if (t.to == RigState::armed) armed_seen = true;
     if (armed_seen) CHECK(h.rig.log.mode_writes >= 1);
-    CHECK((h.sup->state() == RigState::idle || h.sup->latched() || h.sup->state() == RigState::disconnected ||
-           h.sup->state() == RigState::holding));
+    CHECK((h.sup->state() == RigState::idle || h.sup->latched() || h.sup->state() == RigState::disconnected || h.sup->state() == RigState::holding));
   }
 }
 
@@ -317,7 +315,7 @@ std::vector<double> fot_row_with_jump(double spacing, double from, double to, do
 TEST_CASE("online FOT: a node inside a hole in the data is left missing, not interpolated; coarse regular sampling is no hole") {
   bool pending = false;
   CHECK(fot_row_with_jump(0.01, 0.0, 0.0, 0.01, &pending) == std::vector<double>{2, 1, 0});  // no jump
-  CHECK(pending);  // δ1 passed, the bottom (δ0) waits for the next reversal
+  CHECK(pending);                                                                            // δ1 passed, the bottom (δ0) waits for the next reversal
   // 2.3 -> 1.6 mm in 0.5 s: node δ2 = 2 mm is inside the hole.
   CHECK(fot_row_with_jump(0.01, 2.3, 1.6, 0.5) == std::vector<double>{1, 0});
   // The same jump at the regular spacing (coarse sampling, not late): interpolated.

@@ -12,10 +12,10 @@
 #include <string>
 #include <thread>
 
+#include "../support/temp_dir.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/db/schema.hpp"
 #include "hystlab/db/store.hpp"
-#include "../support/temp_dir.hpp"
 
 extern char** environ;
 namespace fs = std::filesystem;

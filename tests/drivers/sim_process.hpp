@@ -77,7 +77,7 @@ class SimProcess {
   int modbus_port = 0, control_port = 0;
   std::string rtu_path;
 
- [[nodiscard]] pid_t pid() const noexcept { return pid_; }
+  [[nodiscard]] pid_t pid() const noexcept { return pid_; }
 
  private:
   std::string read_line(int timeout_ms) {
@@ -91,8 +91,6 @@ class SimProcess {
   int out_ = -1, control_fd_ = -1;
 };
 
-inline double steady_now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+inline double steady_now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 }  // namespace hystlab::test

@@ -12,9 +12,8 @@
 namespace {
 // Runs mbpoll once and returns register -> value.
 std::map<int, long> mbpoll(int port, int slave, int table, int start, int count) {
-  const std::string cmd = "mbpoll -m tcp -0 -1 -q -p " + std::to_string(port) + " -a " + std::to_string(slave) + " -t " +
-                          std::to_string(table) + " -r " + std::to_string(start) + " -c " + std::to_string(count) +
-                          " 127.0.0.1 2>&1";
+  const std::string cmd = "mbpoll -m tcp -0 -1 -q -p " + std::to_string(port) + " -a " + std::to_string(slave) + " -t " + std::to_string(table) + " -r " +
+                          std::to_string(start) + " -c " + std::to_string(count) + " 127.0.0.1 2>&1";
   std::map<int, long> out;
   FILE* p = popen(cmd.c_str(), "r");
   REQUIRE(p != nullptr);
@@ -69,5 +68,5 @@ TEST_CASE("mbpoll reads the vendor B map: other addresses, swapped words, scaled
   auto hold = mbpoll(sim.modbus_port, 17, 4, 4100, 3);
   CHECK(hold[4100] == 0xFA24);  // -1500 µm as int32: low word 0xFA24 first (swapped)
   CHECK(hold[4101] == 0xFFFF);
-  CHECK(hold[4102] == 250);     // 2.5 mm/s in 0.01 mm/s
+  CHECK(hold[4102] == 250);  // 2.5 mm/s in 0.01 mm/s
 }

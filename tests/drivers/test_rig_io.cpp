@@ -171,7 +171,7 @@ TEST_CASE("modbus tcp: the second vendor map (scaled integers, swapped words) en
   SimProcess sim({"--port", "0", "--time-scale", "10", "--noise", "0", "--map", HYSTLAB_MAPS "/vendor_b_load_frame.json"});
   ModbusRig rig(tcp_config(sim.modbus_port, map));
   REQUIRE_FALSE(rig.connect(steady_now()));
-  REQUIRE_FALSE(rig.set_mode(1));  // vendor B's map has a mode register too
+  REQUIRE_FALSE(rig.set_mode(1));                               // vendor B's map has a mode register too
   CHECK(rig.write_host_heartbeat(1) == RigError::unsupported);  // ... but no host heartbeat
   REQUIRE_FALSE(rig.arm(true));
   const RigSample s = move_to(rig, 1.25);
@@ -230,7 +230,7 @@ TEST_CASE("modbus tcp, block reads: every sample once, on the controller's clock
   }
   CAPTURE(longest_interval);
   CHECK(rig.health().lost_samples == gaps);
-  CHECK(longest_block > 12);  // more than one page in one read
+  CHECK(longest_block > 12);                                   // more than one page in one read
   CHECK(taken + gaps == last.sample_counter - first_counter);  // every record since the first: taken, or counted lost
   CHECK(taken >= 30);
   CHECK(last.command_mm > 0.1);  // the commands still go through: the controller is ramping
@@ -262,7 +262,7 @@ TEST_CASE("modbus tcp, block reads: every sample once, on the controller's clock
   CHECK(rig.health().lost_samples == gaps + gap);
 
   REQUIRE(sim.control("fault freeze").rfind("ok", 0) == 0);  // the controller stops sampling: stale, as when polling
-  std::error_code ec;  // a read may time out on a starved host: only stale data ends the wait
+  std::error_code ec;                                        // a read may time out on a starved host: only stale data ends the wait
   for (int k = 0; k < 100 && ec != RigError::stale_data; ++k, sleep_ms(10)) ec = rig.read_samples(steady_now(), block);
   CHECK(ec == RigError::stale_data);
   CHECK(block.empty());
@@ -399,8 +399,8 @@ TEST_CASE("shaker over modbus: base excitation moves the mass") {
 
 TEST_CASE("rigs from configuration: a simulated rig is only a different address") {
   SimProcess sim({"--port", "0", "--noise", "0"});
-  const nlohmann::json cfg = {{"name", "frame A"}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"},
-                              {"port", sim.modbus_port}, {"map", "default"}, {"response_timeout_ms", 1500}};
+  const nlohmann::json cfg = {{"name", "frame A"},       {"transport", "modbus-tcp"}, {"host", "127.0.0.1"},
+                              {"port", sim.modbus_port}, {"map", "default"},          {"response_timeout_ms", 1500}};
   const auto rig = make_rig(cfg, "rigs[0]");
   REQUIRE_FALSE(rig->connect(steady_now()));
   RigSample s;
@@ -415,8 +415,7 @@ TEST_CASE("rigs from configuration: a simulated rig is only a different address"
   bad({{"transport", "modbus-rtu"}}, "rigs[1].device is required");
   bad({{"transport", "modbus-tcp"}, {"map", "no/such/map.json"}}, "rigs[1].map names a file that cannot be opened");
   bad({{"transport", "modbus-tcp"}, {"map", {{"format", "x"}}}}, "rigs[1].map is not usable");
-  bad({{"transport", "modbus-tcp"}, {"rig", "shaker"}, {"map", nlohmann::json::parse(protocols::kDefaultLoadFrameMap)}},
-      "is for another kind of rig");
+  bad({{"transport", "modbus-tcp"}, {"rig", "shaker"}, {"map", nlohmann::json::parse(protocols::kDefaultLoadFrameMap)}}, "is for another kind of rig");
   bad({{"transport", "can"}}, "exactly one is required");
   bad({{"transport", "modbus-tcp"}, {"baudrate", 9600}}, "rigs[1].baudrate is not a known field");
   bad({{"transport", "modbus-tcp"}, {"block_reads", "yes"}}, "rigs[1].block_reads must be true or false");
@@ -427,8 +426,8 @@ TEST_CASE("rigs from configuration: a simulated rig is only a different address"
   no_force["sample_window"]["fields"] = {"sample_counter", "displacement_mm", "status_word"};
   bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"map", no_force}}, "block reads need force_N in the map's sample_window.fields");
   CHECK_THROWS_WITH_AS(SimProcess({"--port", "0", "--sample-rate", "500"}), doctest::Contains("did not start"), std::runtime_error);
-  CHECK_THROWS_WITH_AS((void)make_rig({{"transport", "can"}, {"can_interface", "hystlabnope0"}}),
-                       doctest::Contains("cannot open CAN interface"), std::system_error);
+  CHECK_THROWS_WITH_AS((void)make_rig({{"transport", "can"}, {"can_interface", "hystlabnope0"}}), doctest::Contains("cannot open CAN interface"),
+                       std::system_error);
 }
 
 // --- The controller's latches and interlocks, over the real simulator process ---
@@ -485,8 +484,8 @@ TEST_CASE("controller: the e-stop and a latched fault stay until reset_faults; a
   CHECK((s.status_word & protocols::status::fault) != 0);
   CHECK((s.status_word & (protocols::status::ready | protocols::status::enabled)) == 0);
   CHECK(s.displacement_mm == doctest::Approx(2.0).epsilon(0.01));  // held
-  CHECK(rig.fault_text(7).empty());  // not in the map's fault_codes
-  REQUIRE(sim.control("clear").rfind("ok", 0) == 0);  // clears communication faults, not the controller's
+  CHECK(rig.fault_text(7).empty());                                // not in the map's fault_codes
+  REQUIRE(sim.control("clear").rfind("ok", 0) == 0);               // clears communication faults, not the controller's
   CHECK(read_now(rig).fault_code == 7);
   REQUIRE_FALSE(rig.reset_faults());
   CHECK(read_now(rig).fault_code == 0);

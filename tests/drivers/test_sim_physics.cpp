@@ -11,17 +11,15 @@
 #include "hystlab/protocols/signals.hpp"
 #include "load_frame_sim.hpp"
 #include "pacer.hpp"
-#include "world_clock.hpp"
-#include "shaker_sim.hpp"
 #include "shakedown_specimen.hpp"
+#include "shaker_sim.hpp"
+#include "world_clock.hpp"
 
 using namespace hystlab;
 using namespace hystlab::sim;
 
 namespace {
-std::unique_ptr<models::HysteresisModel> sma() {
-  return std::make_unique<models::SimplifiedSmaModel>(models::table1_parameters());
-}
+std::unique_ptr<models::HysteresisModel> sma() { return std::make_unique<models::SimplifiedSmaModel>(models::table1_parameters()); }
 LoadFrameParams quiet() {
   LoadFrameParams p;
   p.noise_N = 0;
@@ -38,7 +36,7 @@ TEST_CASE("load frame: the command follows the setpoint at the ramp rate, the ac
   f.set_commands({3.0, 1.0, true, false, false});
   run(f, 1.0);
   CHECK(f.state().command_mm == doctest::Approx(1.0).epsilon(1e-6));
-  CHECK(f.state().displacement_mm < f.state().command_mm);                  // first-order lag
+  CHECK(f.state().displacement_mm < f.state().command_mm);                   // first-order lag
   CHECK(f.state().displacement_mm == doctest::Approx(0.995).epsilon(1e-3));  // 1 mm/s × τ = 5 µm behind
   CHECK(f.state().force_N == doctest::Approx(40.0 * f.state().displacement_mm).epsilon(1e-6));
   CHECK(f.state().sample_counter == 1000);
@@ -302,7 +300,7 @@ TEST_CASE("specimen smoothing: corners rounded, straight parts exact, nearly ind
     worst = std::max(worst, std::fabs(s - f));
     if (x > 3.4 && x < 3.7) at_mf = std::max(at_mf, f - s);
     if (x > 0.1 && x < 0.9) on_line = std::max(on_line, std::fabs(s - f));  // the austenite line, no corner behind
-    CHECK(std::fabs(fine.step(x) - s) < 0.16);  // 0.1 % of full scale: the update is first order in the step
+    CHECK(std::fabs(fine.step(x) - s) < 0.16);                              // 0.1 % of full scale: the update is first order in the step
   }
   CHECK(at_mf > 2.0);            // the corner at Mf (12 -> 150 N/mm) is rounded off
   CHECK(on_line < 1e-9);         // no lag on a straight part
@@ -319,7 +317,7 @@ TEST_CASE("shaker: rests at its preload, follows the base at low frequency, refu
   CHECK(s.preload_mm() > 0);
   s.step(0.5);
   CHECK(std::fabs(s.state().mass_displacement_mm) < 1e-3);  // static equilibrium
-  s.set_drive(2.0, 0.2, true);  // far below resonance (17.7 Hz): transmissibility ≈ 1
+  s.set_drive(2.0, 0.2, true);                              // far below resonance (17.7 Hz): transmissibility ≈ 1
   double peak_mass = 0;
   for (int k = 0; k < 2000; ++k) {
     s.step(1e-3);
@@ -461,7 +459,7 @@ TEST_CASE("world clock: steps follow the wall clock; after a freeze at most 20 m
   CHECK(steps == 150);
   CHECK(w.lost_s() == 0);
   steps = w.steps_due(0.515);  // the machine froze for half a second
-  CHECK(steps == 200);          // 20 ms of it, at time scale 10
+  CHECK(steps == 200);         // 20 ms of it, at time scale 10
   CHECK(w.lost_s() == doctest::Approx(0.48));
   CHECK(w.steps_due(0.516) == 10);  // and on as before
 }
@@ -495,5 +493,3 @@ TEST_CASE("shakedown specimen: the upper plateau comes down cycle by cycle and s
   CHECK(models::transitions(s.parameters_of(3)).Ms.force - models::transitions(settled).Ms.force == doctest::Approx(10 * std::exp(-1.0)));
   CHECK(models::transitions(s.parameters_of(3)).As.force == doctest::Approx(models::transitions(settled).As.force));
 }
-
-

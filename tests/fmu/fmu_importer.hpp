@@ -69,8 +69,8 @@ struct Fmu {
     const auto so = dir / "binaries" / "linux64" / (identifier + ".so");
     handle = dlopen(so.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!handle) throw std::runtime_error(std::string("dlopen: ") + dlerror());
-#define HYSTLAB_TEST_FMI2_LOOKUP(name)                                                     \
-  name = reinterpret_cast<decltype(&::name)>(dlsym(handle, #name));                          \
+#define HYSTLAB_TEST_FMI2_LOOKUP(name)                              \
+  name = reinterpret_cast<decltype(&::name)>(dlsym(handle, #name)); \
   if (!name) throw std::runtime_error("the FMU's binary does not export " #name);
     HYSTLAB_FMI2_CS_FUNCTIONS(HYSTLAB_TEST_FMI2_LOOKUP)
 #undef HYSTLAB_TEST_FMI2_LOOKUP

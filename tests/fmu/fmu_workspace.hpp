@@ -9,8 +9,8 @@
 #include <random>
 #include <sstream>
 
-#include "fmu_importer.hpp"
 #include "../support/temp_dir.hpp"
+#include "fmu_importer.hpp"
 
 namespace hystlab::test {
 namespace fs = std::filesystem;
@@ -29,8 +29,10 @@ struct Workspace {
   std::string run(const std::string& args, int* status = nullptr) const {
     int st = 0;
     std::string out = shell("cd '" + dir.string() + "' && '" + kCli + "' " + args + " 2>&1", &st);
-    if (status) *status = st;
-    else if (st != 0) FAIL("hystlab " << args << ": " << out);
+    if (status)
+      *status = st;
+    else if (st != 0)
+      FAIL("hystlab " << args << ": " << out);
     return out;
   }
   fs::path fmu(const std::string& element, const std::string& name) const {

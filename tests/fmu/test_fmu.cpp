@@ -7,7 +7,6 @@
 
 using namespace hystlab::test;
 
-
 TEST_CASE("fmu: the archive holds what FMI 2.0 requires, well formed") {
   Workspace w;
   Fmu f(w.fmu("T.json", "T.fmu"), w.dir / "T");

@@ -10,8 +10,8 @@
 #include "hystlab/models/lsq_fit.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/representation_checks.hpp"
-#include "hystlab/models/sma_calibration.hpp"
 #include "hystlab/models/sine_fit.hpp"
+#include "hystlab/models/sma_calibration.hpp"
 #include "test_support.hpp"
 
 using namespace hystlab::models;
@@ -30,8 +30,7 @@ TEST_CASE("5a: constrained least squares recovers a Preisach table from arbitrar
   for (double w : fit.cell_weight) CHECK(w >= 0.0);                // F monotone
   for (int i = 0; i <= g.n; ++i) CHECK(fit.table.node_value(i, i) == 0.0);
   double worst = 0.0, scale = truth.node_value(g.n, 0);
-  for (std::size_t k = 0; k < truth.values().size(); ++k)
-    worst = std::max(worst, std::fabs(fit.table.values()[k] - truth.values()[k]));
+  for (std::size_t k = 0; k < truth.values().size(); ++k) worst = std::max(worst, std::fabs(fit.table.values()[k] - truth.values()[k]));
   CHECK(worst < 0.05 * scale);
   CHECK(std::fabs(fit.force_offset) < 0.1);
   std::size_t with_sigma = 0;
@@ -111,9 +110,8 @@ TEST_CASE("5b: calibration recovers Table 1 within 2% from a loop with 1% force 
     for (double& v : y) v += noise(rng);
     const SmaCalibration cal = calibrate_simplified_sma(x, y, SmaCalibrationOptions{5.7, 25.0, 200});
     const SmaParameters t1 = table1_parameters(), p = cal.parameters;
-    const std::pair<double, double> pairs[] = {{p.KA, t1.KA},   {p.KM, t1.KM},   {p.dtr_max, t1.dtr_max},
-                                               {p.Mf0, t1.Mf0}, {p.Ms0, t1.Ms0}, {p.As0, t1.As0},
-                                               {p.Af0, t1.Af0}};
+    const std::pair<double, double> pairs[] = {{p.KA, t1.KA},   {p.KM, t1.KM},   {p.dtr_max, t1.dtr_max}, {p.Mf0, t1.Mf0},
+                                               {p.Ms0, t1.Ms0}, {p.As0, t1.As0}, {p.Af0, t1.Af0}};
     for (const auto& [got, want] : pairs) {
       CAPTURE(got);
       CAPTURE(want);

@@ -9,9 +9,7 @@
 using namespace hystlab::models;
 
 namespace {
-EverettTable random_table(std::mt19937_64& rng, const Grid& g) {
-  return hystlab::models::RelayGrid(hystlab::test::random_relays(rng, g)).everett_table(g);
-}
+EverettTable random_table(std::mt19937_64& rng, const Grid& g) { return hystlab::models::RelayGrid(hystlab::test::random_relays(rng, g)).everett_table(g); }
 }  // namespace
 
 TEST_CASE("grid: node count matches the paper's 90 points plus the trivial one") {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/preisach_fit.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/simplified_sma.hpp"

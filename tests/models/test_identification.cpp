@@ -4,8 +4,8 @@
 #include <random>
 
 #include "hystlab/models/accuracy.hpp"
-#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/relay_grid.hpp"
 #include "hystlab/models/simplified_sma.hpp"

@@ -70,7 +70,7 @@ TEST_CASE("loop figures of a hand-drawn superelastic loop") {
   CHECK(L.residual_mm == doctest::Approx(0.5 * 2.2 / 20).epsilon(1e-6));
   REQUIRE(L.plateaus.size() == 1);
   CHECK(L.plateaus[0].at_mm == 2.0);
-  CHECK(L.plateaus[0].loading_N == doctest::Approx(55.0));                        // 40 + 15 * 1
+  CHECK(L.plateaus[0].loading_N == doctest::Approx(55.0));  // 40 + 15 * 1
   CHECK(L.plateaus[0].unloading_N == doctest::Approx(20 + 25.0 / (kAsX - 0.5) * 1.5));
   REQUIRE(L.transformation);
   const auto& t = *L.transformation;

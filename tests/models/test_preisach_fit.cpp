@@ -186,8 +186,7 @@ TEST_CASE("acceptance: on the simplified SMA model, auto's error on held-out dat
     // The specimen needs cells of negative mass: the signed prior wins, on held-out data.
     CHECK(r.chosen.prior == FitPrior::signed_masses);
     CHECK(r.chosen.heldout_rms < r.candidates[1].heldout_rms);
-    MESSAGE("n = " << n << ": fit " << fit_rms << " N, FOT " << fot_rms << " N on held-out data; " << r.reason
-                   << "; " << r.seconds << " s");
+    MESSAGE("n = " << n << ": fit " << fit_rms << " N, FOT " << fot_rms << " N on held-out data; " << r.reason << "; " << r.seconds << " s");
   }
 }
 
@@ -203,8 +202,7 @@ TEST_CASE("monotone prior: a record from a table of non-negative masses is recov
   CHECK(f.rms_residual == doctest::Approx(sigma).epsilon(0.3));  // down to the noise, not below
   for (double w : f.cell_weight) CHECK(w >= 0.0);
   double worst = 0.0;
-  for (std::size_t k = 0; k < truth.values().size(); ++k)
-    worst = std::max(worst, std::fabs(f.table.values()[k] - truth.values()[k]));
+  for (std::size_t k = 0; k < truth.values().size(); ++k) worst = std::max(worst, std::fabs(f.table.values()[k] - truth.values()[k]));
   CHECK(worst < 0.05 * truth.node_value(g.n, 0));
   CHECK(std::fabs(f.force_offset) < 0.1);
   // σ: finite everywhere, positive off the bound, and of the size the noise implies.
@@ -248,8 +246,10 @@ TEST_CASE("the monotone solver reaches the constrained optimum: no feasible move
     for (std::size_t c = 0; c < sys.size(); ++c) {
       CAPTURE(c);
       const double gc = grad[c] - sys.rhs()[c];
-      if (c < sys.cells() && u[c] == 0.0) CHECK(gc >= -1e-7 * bnorm);
-      else CHECK(std::fabs(gc) <= 1e-7 * bnorm);
+      if (c < sys.cells() && u[c] == 0.0)
+        CHECK(gc >= -1e-7 * bnorm);
+      else
+        CHECK(std::fabs(gc) <= 1e-7 * bnorm);
     }
   }
   auto rms_of = [&](const std::vector<double>& w) {

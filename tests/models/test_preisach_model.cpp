@@ -82,8 +82,8 @@ TEST_CASE("preisach: congruency: minor loops between the same extrema differ onl
     for (double x = 2.5; x >= 1.5 - 1e-12; x -= 0.05) shape.push_back(m.step(x) - f0);
     return shape;
   };
-  const auto a = loop_shape({3.8, 0.2, 2.9});        // approach 1.5 from above after a big loop
-  const auto b = loop_shape({1.0, 3.2, 0.6, 3.0});    // a different history, same extrema 1.5 / 2.5
+  const auto a = loop_shape({3.8, 0.2, 2.9});       // approach 1.5 from above after a big loop
+  const auto b = loop_shape({1.0, 3.2, 0.6, 3.0});  // a different history, same extrema 1.5 / 2.5
   REQUIRE(a.size() == b.size());
   for (std::size_t k = 0; k < a.size(); ++k) CHECK(a[k] == doctest::Approx(b[k]).epsilon(1e-10));
 }

@@ -83,7 +83,7 @@ TEST_CASE("sdof: energy balance: input work = damper + spring work + kinetic + g
     const SdofEnergy coarse = run(1e-4), fine = run(2.5e-5);
     CAPTURE(coarse.residual());
     CAPTURE(fine.residual());
-    CHECK(fine.input > 100);          // N·mm fed in by the base
+    CHECK(fine.input > 100);                // N·mm fed in by the base
     CHECK(fine.spring > 0.3 * fine.input);  // most of it went into the springs' hysteresis
     CHECK(std::fabs(fine.residual()) < 1e-3 * fine.input);
     CHECK(std::fabs(fine.residual()) < std::fabs(coarse.residual()));  // it is integration error: it shrinks with the step

@@ -24,7 +24,7 @@ TEST_CASE("simplified SMA: Table 1 transition points (MODELS.md §2, with the er
 TEST_CASE("simplified SMA: major loop corners and 157.5 N at 4 mm") {
   SimplifiedSmaModel m(table1_parameters());
   const SmaTransitions& t = m.transition_points();
-  CHECK(m.step(0.5) == doctest::Approx(20.0));                  // austenite line, KA = 40
+  CHECK(m.step(0.5) == doctest::Approx(20.0));  // austenite line, KA = 40
   CHECK(m.step(t.Ms.displacement) == doctest::Approx(t.Ms.force));
   CHECK(m.step(2.0) == doctest::Approx(t.Ms.force + t.forward_slope() * (2.0 - t.Ms.displacement)));
   CHECK(m.step(t.Mf.displacement) == doctest::Approx(t.Mf.force));
@@ -52,7 +52,7 @@ TEST_CASE("simplified SMA: minor loop leaves the transformation on the Reuss ela
   CHECK(m.martensite_fraction() == xi);
   CHECK(m.step(2.5) == doctest::Approx(f));  // reloading returns to the reversal point
   m.step(2.6);
-  CHECK(m.martensite_fraction() > xi);       // and the forward transformation resumes
+  CHECK(m.martensite_fraction() > xi);  // and the forward transformation resumes
 }
 
 TEST_CASE("simplified SMA: force is continuous along random paths (randomized)") {

@@ -86,7 +86,7 @@ TEST_CASE("resonance: the linear curve's peak, half-power points and Q = 1/(2ζ)
     const double rp = std::sqrt(std::sqrt(1 + 8 * zeta * zeta) - 1) / (2 * zeta);
     CHECK(r->frequency_hz == doctest::Approx(20 * rp).epsilon(0.003));
     CHECK(r->peak_ratio == doctest::Approx(linear_transmissibility(rp, zeta)).epsilon(0.02));  // a parabola over 3 points of a sharp peak
-    CHECK(r->q == doctest::Approx(1 / (2 * zeta)).epsilon(0.05 + zeta));  // Q ≈ 1/(2ζ) for light damping
+    CHECK(r->q == doctest::Approx(1 / (2 * zeta)).epsilon(0.05 + zeta));                       // Q ≈ 1/(2ζ) for light damping
     CHECK(r->resolved);
     // Steps of 30 %: the peak falls between points; the bandwidth is an upper bound, and said to be.
     std::vector<SweepPoint> coarse;
@@ -133,7 +133,7 @@ TEST_CASE("the default simulated isolator: resonance at its linearised frequency
   CAPTURE(res->frequency_hz);
   CHECK(res->frequency_hz == doctest::Approx(fn).epsilon(0.02));
   CHECK(res->q == doctest::Approx(1 / (2 * zeta)).epsilon(0.25));  // 29 steps over the peak of a Q ≈ 25 resonance
-  CHECK(find_jumps(small_up, small_down, 0.10).empty());  // elastic: no memory, the directions agree
+  CHECK(find_jumps(small_up, small_down, 0.10).empty());           // elastic: no memory, the directions agree
   // 0.05 mm: at resonance the springs transform (the relative motion passes Ms, 0.21 mm above the
   // preload); the martensite the up sweep leaves behind changes the springs the down sweep sees,
   // so the two directions differ below the resonance, by more than 10 %.

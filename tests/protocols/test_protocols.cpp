@@ -112,8 +112,13 @@ TEST_CASE("register maps: a bad map is rejected with the field named") {
   // found by the fuzzer: numbers too large for a double, fields of the wrong type
   CHECK_THROWS_AS((void)RegisterMap::from_json(R"({"format": "hystlab-modbus-map", "version": 6e666})"), MapError);
   CHECK_THROWS_AS((void)RegisterMap::from_json(R"({"format": 3, "version": 1})"), MapError);
-  refused_after([](auto& j) { j["name"] = 7; j["signals"]["force_N"]["unit"] = 3; j["signals"]["force_N"]["address"] = "two"; },
-         "signals.force_N.address");
+  refused_after(
+      [](auto& j) {
+        j["name"] = 7;
+        j["signals"]["force_N"]["unit"] = 3;
+        j["signals"]["force_N"]["address"] = "two";
+      },
+      "signals.force_N.address");
 }
 
 TEST_CASE("register maps: the controller signals fault_reset and host_heartbeat, and fault_codes") {
@@ -157,8 +162,7 @@ TEST_CASE("register maps: bad fault_codes, fault_reset or host_heartbeat are ref
   refused_after([](auto& j) { j["fault_codes"]["1.5"] = "text"; }, "fault_codes.\"1.5\": the code must be a decimal integer");
   refused_after([](auto& j) { j["fault_codes"]["9"] = 9; }, "fault_codes.\"9\" must be a non-empty string");
   refused_after([](auto& j) { j["fault_codes"]["9"] = ""; }, "fault_codes.\"9\" must be a non-empty string");
-  refused_after([](auto& j) { j["signals"]["fault_reset"] = {{"table", "holding_register"}, {"address", 9}}; },
-                "signals.fault_reset must be a coil");
+  refused_after([](auto& j) { j["signals"]["fault_reset"] = {{"table", "holding_register"}, {"address", 9}}; }, "signals.fault_reset must be a coil");
   refused_after([](auto& j) { j["signals"]["host_heartbeat"]["type"] = "float32"; },
                 "signals.host_heartbeat must be a holding_register of type uint16 or uint32");
   refused_after([](auto& j) { j["signals"]["host_heartbeat"]["table"] = "input_register"; }, "signals.host_heartbeat is a command");
@@ -280,5 +284,5 @@ TEST_CASE("CAN: malformed frames are typed decode errors") {
 
 TEST_CASE("Modbus CRC-16 matches the standard's example") {
   const std::uint8_t frame[] = {0x01, 0x03, 0x00, 0x00, 0x00, 0x0A};  // read 10 holding registers from slave 1
-  CHECK(crc16_modbus(frame) == 0xCDC5);  // sent as C5 CD
+  CHECK(crc16_modbus(frame) == 0xCDC5);                               // sent as C5 CD
 }

@@ -67,9 +67,7 @@ class DaemonProcess {
     if (prepare) prepare((dir_ / "bench.db").string());
     std::ofstream(dir_ / "hystlab.json") << config_json;
     const std::string log = (dir_ / "daemon.log").string();
-    pid_ = spawn_logged({HYSTLABD, "--config", (dir_ / "hystlab.json").string(), "--db", (dir_ / "bench.db").string(),
-                         "--port", "0"},
-                        log);
+    pid_ = spawn_logged({HYSTLABD, "--config", (dir_ / "hystlab.json").string(), "--db", (dir_ / "bench.db").string(), "--port", "0"}, log);
     port_ = served_port(log);
     if (port_ == 0) {
       const std::string text = this->log();

@@ -19,10 +19,10 @@
 #include <string>
 #include <thread>
 
+#include "../support/temp_dir.hpp"
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/daemon/daemon_control.hpp"
 #include "hystlab/web/http_api.hpp"
-#include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
 
@@ -35,8 +35,13 @@ struct TempDir {  // the API tests' folder (test_support::TempDir), its path a m
 };
 
 inline json fot_plan(int n, double rate_mm_s = 1.0) {
-  return json{{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", n}, {"ramp_rate_mm_s", rate_mm_s}, {"dwell_s", 0.05},
-              {"sample_rate_hz", 500}, {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
+  return json{{"kind", "fot"},
+              {"range_mm", {0, 4}},
+              {"subdivisions", n},
+              {"ramp_rate_mm_s", rate_mm_s},
+              {"dwell_s", 0.05},
+              {"sample_rate_hz", 500},
+              {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
 }
 
 class LiveDaemon {

@@ -7,8 +7,8 @@
 #include <sstream>
 
 #include "api_fixture.hpp"
-#include "hystlab/models/formats.hpp"
 #include "hystlab/models/accuracy.hpp"
+#include "hystlab/models/formats.hpp"
 #include "hystlab/models/preisach_model.hpp"
 
 using namespace hystlab;
@@ -25,9 +25,7 @@ void check_error(const httplib::Result& r, int status, const std::string& detail
   CHECK(j["detail"].get<std::string>().find(detail_part) != std::string::npos);
 }
 
-httplib::Result post(httplib::Client& c, const std::string& path, const json& body) {
-  return c.Post(path.c_str(), body.dump(), "application/json");
-}
+httplib::Result post(httplib::Client& c, const std::string& path, const json& body) { return c.Post(path.c_str(), body.dump(), "application/json"); }
 }  // namespace
 
 TEST_CASE("a campaign through the API: submit, follow, nodes, tables and their exports, samples, evaluation") {
@@ -283,9 +281,9 @@ TEST_CASE("static files: the page and the plotting library, and nothing outside 
   REQUIRE(r);
   CHECK(r->status == 200);  // installed by the set-up command (npm ci in web/)
   const int port = live.http->port();
-  for (const std::string path : {"/../../../../etc/passwd", "/vendor/uplot/../../package.json", "/%2e%2e/%2e%2e/%2e%2e/etc/passwd",
-                                 "/..%2f..%2f..%2fetc%2fpasswd", "/vendor/uplot/..%2f..%2fpackage.json", "/static/../CMakeLists.txt",
-                                 "//etc/passwd", "/....//....//etc/passwd"}) {
+  for (const std::string path :
+       {"/../../../../etc/passwd", "/vendor/uplot/../../package.json", "/%2e%2e/%2e%2e/%2e%2e/etc/passwd", "/..%2f..%2f..%2fetc%2fpasswd",
+        "/vendor/uplot/..%2f..%2fpackage.json", "/static/../CMakeLists.txt", "//etc/passwd", "/....//....//etc/passwd"}) {
     const std::string answer = test::raw_request(port, "GET " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
     CAPTURE(path);
     CAPTURE(answer.substr(0, 200));
@@ -302,7 +300,8 @@ TEST_CASE("static files: the page and the plotting library, and nothing outside 
 TEST_CASE("/metrics in Prometheus text format") {
   test::LiveDaemon live;
   auto c = live.client();
-  REQUIRE(live.wait_json("/api/rigs", [](const json& j) { return !j[0]["sample"].is_null(); }, 20));
+  REQUIRE(live.wait_json(
+      "/api/rigs", [](const json& j) { return !j[0]["sample"].is_null(); }, 20));
   auto r = c.Get("/metrics");
   REQUIRE(r);
   CHECK(r->status == 200);

@@ -57,8 +57,9 @@ TEST_CASE("bodies that once killed or stalled the daemon are refused at once, an
   for (const std::string len : {"-5", "1e23", "100000000000000000000000", "abc"}) {
     CAPTURE(len);
     const auto t0 = std::chrono::steady_clock::now();
-    const std::string raw = test::raw_request(port, "POST /api/campaigns HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: " +
-                                                        len + "\r\n\r\n{}");
+    const std::string raw = test::raw_request(
+        port,
+        "POST /api/campaigns HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: " + len + "\r\n\r\n{}");
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     CHECK((status_line(raw) == "HTTP/1.1 400 Bad Request" || status_line(raw) == "HTTP/1.1 413 Payload Too Large"));
     CHECK(s < 4.0);  // it was 5 s (cpp-httplib waited that long for the body); a VM's freeze is well under 4
@@ -83,10 +84,12 @@ TEST_CASE("commands need no body: the documented curl -X POST works, and an unkn
   raw = test::raw_request(port, request("POST", "/api/campaigns/" + id + "/pause", ""));
   CAPTURE(raw);
   CHECK(status_line(raw) == "HTTP/1.1 202 Accepted");
-  CHECK(live.wait_json("/api/campaigns/" + id, [](const json& j) { return j["state"] == "paused"; }, 30));
+  CHECK(live.wait_json(
+      "/api/campaigns/" + id, [](const json& j) { return j["state"] == "paused"; }, 30));
   raw = test::raw_request(port, request("POST", "/api/campaigns/" + id + "/abort", ""));
   CHECK(status_line(raw) == "HTTP/1.1 202 Accepted");
-  CHECK(live.wait_json("/api/campaigns/" + id, [](const json& j) { return j["state"] == "aborted"; }, 30));
+  CHECK(live.wait_json(
+      "/api/campaigns/" + id, [](const json& j) { return j["state"] == "aborted"; }, 30));
   // The rig's e-stop and reset the same way.
   // The e-stop answers once latched and seen in the rig's status word; the reset once the rig
   // reports ready again.
@@ -94,10 +97,12 @@ TEST_CASE("commands need no body: the documented curl -X POST works, and an unkn
   CHECK(status_line(raw) == "HTTP/1.1 200 OK");
   CHECK(error_of(raw)["latched"] == true);
   CHECK(error_of(raw)["confirmed"] == true);
-  CHECK(live.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["latched"] == true; }, 30));
+  CHECK(live.wait_json(
+      "/api/rigs/sim%20frame", [](const json& j) { return j["latched"] == true; }, 30));
   raw = test::raw_request(port, request("POST", "/api/rigs/sim%20frame/reset", ""));
   CHECK(status_line(raw) == "HTTP/1.1 200 OK");
-  CHECK(live.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["latched"] == false; }, 30));
+  CHECK(live.wait_json(
+      "/api/rigs/sim%20frame", [](const json& j) { return j["latched"] == false; }, 30));
 }
 
 TEST_CASE("no other site drives the daemon: DNS rebinding, form posts, framing, NUL paths") {
@@ -105,10 +110,9 @@ TEST_CASE("no other site drives the daemon: DNS rebinding, form posts, framing, 
   const int port = live.http->port();
   const std::string plan = json{{"plan", test::fot_plan(2)}}.dump();
   // A page from attacker.example whose name now points at 127.0.0.1: same origin to the browser.
-  std::string raw = test::raw_request(port, "POST /api/campaigns HTTP/1.1\r\nHost: attacker.example:" + std::to_string(port) +
-                                                "\r\nOrigin: http://attacker.example:" + std::to_string(port) +
-                                                "\r\nContent-Type: application/json\r\nConnection: close\r\nContent-Length: " +
-                                                std::to_string(plan.size()) + "\r\n\r\n" + plan);
+  std::string raw = test::raw_request(
+      port, "POST /api/campaigns HTTP/1.1\r\nHost: attacker.example:" + std::to_string(port) + "\r\nOrigin: http://attacker.example:" + std::to_string(port) +
+                "\r\nContent-Type: application/json\r\nConnection: close\r\nContent-Length: " + std::to_string(plan.size()) + "\r\n\r\n" + plan);
   CHECK(status_line(raw) == "HTTP/1.1 403 Forbidden");
   CHECK(error_of(raw)["detail"].get<std::string>().find("attacker.example") != std::string::npos);
   raw = test::raw_request(port, "GET /api/campaigns HTTP/1.1\r\nHost: attacker.example\r\nConnection: close\r\n\r\n");
@@ -153,7 +157,7 @@ TEST_CASE("tokens: at least 16 non-blank characters; a read token keeps the data
   REQUIRE(r);
   CHECK(r->status == 401);
   CHECK(c.Get("/metrics")->status == 401);
-  CHECK(c.Get("/")->status == 200);  // the page itself holds no data
+  CHECK(c.Get("/")->status == 200);                                             // the page itself holds no data
   CHECK(c.Get("/api/campaigns?token=reader-0123456789abcdef")->status == 200);  // as an EventSource sends it
   c.set_bearer_token_auth("reader-0123456789abcdef");
   CHECK(c.Get("/api/campaigns")->status == 200);
@@ -186,8 +190,8 @@ TEST_CASE("bodies are bounded whatever their encoding: chunked and compressed bo
   test::LiveDaemon live;
   const int port = live.http->port();
   // A chunked body (256 MiB took the daemon to 1.14 GB): refused before a byte of it is read.
-  std::string raw = test::raw_request(port, request("POST", "/api/campaigns", "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n") +
-                                                "10\r\n{\"plan\": {}}    \r\n0\r\n\r\n");
+  std::string raw = test::raw_request(
+      port, request("POST", "/api/campaigns", "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n") + "10\r\n{\"plan\": {}}    \r\n0\r\n\r\n");
   CAPTURE(raw);
   CHECK(status_line(raw) == "HTTP/1.1 411 Length Required");
   CHECK(error_of(raw)["detail"].get<std::string>().find("Content-Length") != std::string::npos);

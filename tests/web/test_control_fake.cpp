@@ -136,7 +136,8 @@ TEST_CASE("the web layer runs on the daemon's interface alone: snapshots, comman
     CHECK(fake.commands[0].second == control::CampaignCommand::abort);
   }
   SUBCASE("a campaign's specimen and notes change through the interface; a field it refuses is named as the body's") {
-    auto r = c.Post("/api/campaigns", json{{"plan", {{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 2}, {"specimen", "S-1"}}}}.dump(), "application/json");
+    auto r =
+        c.Post("/api/campaigns", json{{"plan", {{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 2}, {"specimen", "S-1"}}}}.dump(), "application/json");
     REQUIRE(r);
     REQUIRE(r->status == 201);
     const std::string id = std::to_string(json::parse(r->body)["id"].get<std::int64_t>());

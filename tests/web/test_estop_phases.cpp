@@ -19,16 +19,16 @@ using namespace hystlab::test;
 namespace {
 
 json plan() {  // a preamble at 0 mm (dwell 1 s), a rise to 1 mm, a dwell there, descents: about 12 s
-  return json{{"kind", "fot"}, {"range_mm", {0, 2}}, {"subdivisions", 2}, {"ramp_rate_mm_s", 1.0}, {"dwell_s", 1.0},
-              {"sample_rate_hz", 500}, {"validation", false},
-              {"limits", {{"displacement_mm", {-0.5, 2.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
+  return json{
+      {"kind", "fot"},  {"range_mm", {0, 2}},    {"subdivisions", 2},   {"ramp_rate_mm_s", 1.0},
+      {"dwell_s", 1.0}, {"sample_rate_hz", 500}, {"validation", false}, {"limits", {{"displacement_mm", {-0.5, 2.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
 }
 
 struct Press {
   int status = 0;
   json answer;
-  double seconds = 0;      // from the request to the answer
-  double moved_mm = 0;     // from the last sample before the request to the farthest within 1 s after it
+  double seconds = 0;        // from the request to the answer
+  double moved_mm = 0;       // from the last sample before the request to the farthest within 1 s after it
   double estop_seen_s = -1;  // from the request to the first sample whose status word shows the e-stop
 };
 
@@ -89,8 +89,9 @@ std::int64_t submit(httplib::Client& c) {
 }
 }  // namespace
 
-TEST_CASE("operator e-stop in every phase of a campaign (hystlabd, hystlab-sim over Modbus, real time): latched and confirmed before the answer, "
-          "the campaign aborted, the frame stopped") {
+TEST_CASE(
+    "operator e-stop in every phase of a campaign (hystlabd, hystlab-sim over Modbus, real time): latched and confirmed before the answer, "
+    "the campaign aborted, the frame stopped") {
   LiveDaemon ld([](daemon::DaemonConfig& c) {
     c.rigs[0].sim.time_scale = 1.0;
     c.rigs[0].sim.noise_N = 0.0;
@@ -115,8 +116,8 @@ TEST_CASE("operator e-stop in every phase of a campaign (hystlabd, hystlab-sim o
     }
     const Press p = press(ld);
     CAPTURE(p.answer.dump());
-    MESSAGE(phase << ": answered in " << p.seconds * 1e3 << " ms; e-stop in the status word " << p.estop_seen_s * 1e3
-                  << " ms after the request; moved " << p.moved_mm << " mm after it");
+    MESSAGE(phase << ": answered in " << p.seconds * 1e3 << " ms; e-stop in the status word " << p.estop_seen_s * 1e3 << " ms after the request; moved "
+                  << p.moved_mm << " mm after it");
     CHECK(p.status == 200);  // never 202 "armed": answered once latched and seen in the status word
     CHECK(p.answer["latched"] == true);
     CHECK(p.answer["confirmed"] == true);
@@ -127,7 +128,8 @@ TEST_CASE("operator e-stop in every phase of a campaign (hystlabd, hystlab-sim o
     // At 1 mm/s, 2 periods of 2 ms and the controller's own stop: far below 0.05 mm (it was
     // 0.7-1.0 mm in 0.6 s when the press waited for the campaign).
     CHECK(p.moved_mm < 0.05);
-    CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["final"] == true; }, 30));
+    CHECK(ld.wait_json(
+        "/api/campaigns/" + std::to_string(id), [](const json& j) { return j["final"] == true; }, 30));
     const json camp = json::parse(c.Get(("/api/campaigns/" + std::to_string(id)).c_str())->body);
     CHECK((camp["state"] == "aborted" || camp["state"] == "failed"));
     CHECK(camp["reason"].get<std::string>().find("e-stop") != std::string::npos);  // why, beside the state
@@ -140,7 +142,8 @@ TEST_CASE("operator e-stop in every phase of a campaign (hystlabd, hystlab-sim o
     REQUIRE(reset);
     CAPTURE(reset->body);
     CHECK(reset->status == 200);
-    REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle" && j["latched"] == false; }, 10));
+    REQUIRE(ld.wait_json(
+        "/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle" && j["latched"] == false; }, 10));
   }
 }
 
@@ -162,7 +165,8 @@ TEST_CASE("the documented commands as written: curl -d '' reaches the e-stop; a 
   CHECK(r->status == 415);
   // Resume a running campaign: 409, and what does apply.
   const auto id = submit(c);
-  REQUIRE(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "running"; }, 30));
+  REQUIRE(ld.wait_json(
+      "/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "running"; }, 30));
   r = c.Post(("/api/campaigns/" + std::to_string(id) + "/resume").c_str(), "", "application/json");
   REQUIRE(r);
   CHECK(r->status == 409);
@@ -170,11 +174,13 @@ TEST_CASE("the documented commands as written: curl -d '' reaches the e-stop; a 
   r = c.Post(("/api/campaigns/" + std::to_string(id) + "/abort").c_str(), "", "application/json");
   REQUIRE(r);
   CHECK(r->status == 202);
-  CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "aborted"; }, 30));
+  CHECK(ld.wait_json(
+      "/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "aborted"; }, 30));
 }
 
-TEST_CASE("kill -9 loses at most 250 ms of samples wherever it lands (hystlabd at 1 kHz in real time: preamble, training, ramping, "
-          "dwelling, paused, validation, safing)") {
+TEST_CASE(
+    "kill -9 loses at most 250 ms of samples wherever it lands (hystlabd at 1 kHz in real time: preamble, training, ramping, "
+    "dwelling, paused, validation, safing)") {
   for (const std::string phase : {"preamble", "training", "ramping", "dwelling", "paused", "validation", "safing"}) {
     CAPTURE(phase);
     test_support::DaemonProcess d(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1, "noise_N": 0}}]})");
@@ -211,8 +217,8 @@ TEST_CASE("kill -9 loses at most 250 ms of samples wherever it lands (hystlabd a
     db::Statement st(s.database(), "SELECT max(t) FROM samples WHERE run_id IN (SELECT id FROM runs WHERE campaign_id = 1)");
     REQUIRE(st.step());
     const double stored_t = st.column_double(0);
-    MESSAGE(phase << ": the newest sample acquired before the kill at " << acquired_t << " s, the newest stored " << stored_t << " s: "
-                  << (acquired_t - stored_t) * 1e3 << " ms lost at most");
+    MESSAGE(phase << ": the newest sample acquired before the kill at " << acquired_t << " s, the newest stored " << stored_t
+                  << " s: " << (acquired_t - stored_t) * 1e3 << " ms lost at most");
     CHECK(acquired_t - stored_t <= 0.25);
     CHECK(s.integrity_check() == "ok");
   }

@@ -33,11 +33,13 @@ double fastest(LiveDaemon& ld, std::uint64_t from) {
 }
 }  // namespace
 
-TEST_CASE("limit recovery: a frame beyond its stroke is refused a reset, brought back by recover at the safe rate, then runs a campaign; "
-          "an e-stop on the way back wins") {
+TEST_CASE(
+    "limit recovery: a frame beyond its stroke is refused a reset, brought back by recover at the safe rate, then runs a campaign; "
+    "an e-stop on the way back wins") {
   SimProcess sim({"--port", "0", "--time-scale", std::to_string(kTimeScale), "--noise", "0"});
   LiveDaemon ld([&](daemon::DaemonConfig& c) {
-    const json cfg{{"rigs", {{{"name", "sim frame"}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", sim.modbus_port}, {"time_scale", kTimeScale}}}}};
+    const json cfg{
+        {"rigs", {{{"name", "sim frame"}, {"transport", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", sim.modbus_port}, {"time_scale", kTimeScale}}}}};
     c.rigs = daemon::parse_daemon_config(cfg, ".").rigs;
   });
   auto c = ld.client();
@@ -46,7 +48,8 @@ TEST_CASE("limit recovery: a frame beyond its stroke is refused a reset, brought
   CHECK(c.Post("/api/rigs/sim%20frame/recover", "", "application/json")->status == 409);  // nothing to recover
 
   REQUIRE(sim.control("fault overtravel 13").rfind("ok", 0) == 0);
-  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["latched"] == true && j["recoverable"] == true; }, 30));
+  REQUIRE(ld.wait_json(
+      "/api/rigs/sim%20frame", [](const json& j) { return j["latched"] == true && j["recoverable"] == true; }, 30));
   const json tripped = rig(c);
   CAPTURE(tripped.dump());
   CHECK(tripped["status"]["limit_tripped"] == true);
@@ -83,14 +86,16 @@ TEST_CASE("limit recovery: a frame beyond its stroke is refused a reset, brought
   REQUIRE(sub->status == 201);
   const std::string id = std::to_string(json::parse(sub->body)["id"].get<std::int64_t>());
   json ended;
-  REQUIRE(ld.wait_json("/api/campaigns/" + id, [&](const json& j) { return ended = j, j["final"] == true; }, 120));
+  REQUIRE(ld.wait_json(
+      "/api/campaigns/" + id, [&](const json& j) { return ended = j, j["final"] == true; }, 120));
   CAPTURE(ended.dump());
   CHECK(ended["state"] == "completed");
 
   // Out the other side, and an e-stop while it comes back: latched, nothing moves after it.
   REQUIRE(sim.control("fault overtravel -13").rfind("ok", 0) == 0);
   // Tripped, not merely outside the configured ±10 mm on the way out (recoverable too, but pushed on).
-  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["recoverable"] == true && j["latched"] == true; }, 30));
+  REQUIRE(ld.wait_json(
+      "/api/rigs/sim%20frame", [](const json& j) { return j["recoverable"] == true && j["latched"] == true; }, 30));
   const double start = rig(c)["sample"]["displacement_mm"].get<double>();
   struct Joined : std::thread {  // joined on every way out, a failed REQUIRE's too
     using std::thread::thread;
@@ -108,7 +113,8 @@ TEST_CASE("limit recovery: a frame beyond its stroke is refused a reset, brought
     CHECK(r->status == 409);
     CHECK(json::parse(r->body)["reason"].get<std::string>().find("e-stop") != std::string::npos);
   });
-  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [&](const json& j) { return j["sample"]["displacement_mm"].get<double>() > start + 0.3; }, 30));
+  REQUIRE(ld.wait_json(
+      "/api/rigs/sim%20frame", [&](const json& j) { return j["sample"]["displacement_mm"].get<double>() > start + 0.3; }, 30));
   const auto stop = c.Post("/api/rigs/sim%20frame/estop", "", "application/json");
   recover.join();
   REQUIRE(stop);

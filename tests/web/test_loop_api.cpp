@@ -10,9 +10,7 @@ using namespace hystlab;
 using test::json;
 
 namespace {
-httplib::Result post_json(httplib::Client& c, const std::string& path, const json& body) {
-  return c.Post(path.c_str(), body.dump(), "application/json");
-}
+httplib::Result post_json(httplib::Client& c, const std::string& path, const json& body) { return c.Post(path.c_str(), body.dump(), "application/json"); }
 
 // Branches of x between reversals (a turn counts past 2 % of the range): {x drop, y range} of
 // each descending one.
@@ -32,8 +30,10 @@ std::vector<std::pair<double, double>> descents(const std::vector<double>& x, co
       if (std::abs(x[k] - x[0]) > eps) dir = x[k] > x[0] ? 1 : -1, ext = k;
       continue;
     }
-    if (dir > 0 ? x[k] >= x[ext] : x[k] <= x[ext]) ext = k;
-    else if (std::abs(x[k] - x[ext]) > eps) close(start, ext), start = ext, dir = -dir, ext = k;
+    if (dir > 0 ? x[k] >= x[ext] : x[k] <= x[ext])
+      ext = k;
+    else if (std::abs(x[k] - x[ext]) > eps)
+      close(start, ext), start = ext, dir = -dir, ext = k;
   }
   close(start, ext);
   return out;
@@ -80,7 +80,8 @@ TEST_CASE("a run's loop keeps every descent, with the model's force from the ser
   r = post_json(c, "/api/campaigns", {{"plan", named}});
   REQUIRE(r->status == 201);
   CHECK(json::parse(r->body)["specimen"] == "NiTi spring A7");
-  REQUIRE(live.wait_json("/api/campaigns/1", [](const json& j) { return j["state"] == "completed"; }, 120));
+  REQUIRE(live.wait_json(
+      "/api/campaigns/1", [](const json& j) { return j["state"] == "completed"; }, 120));
   const json camp = json::parse(c.Get("/api/campaigns/1")->body);
   const std::int64_t run = camp["runs"][0]["id"];
   const json q = camp["runs"][0]["quality"];

@@ -32,7 +32,8 @@ TEST_CASE("operator e-stop from the API latches the rig; a campaign is refused u
   CHECK(r->status == 200);  // answered once latched and confirmed by the rig, never before
   CHECK(json::parse(r->body)["latched"] == true);
   CHECK(json::parse(r->body)["state"] == "estopped");
-  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "estopped" && j["latched"] == true; }, 10));
+  REQUIRE(ld.wait_json(
+      "/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "estopped" && j["latched"] == true; }, 10));
   const auto refused = c.Post("/api/campaigns", json{{"plan", waveform({0, 1})}}.dump(), "application/json");
   REQUIRE(refused);
   CHECK(refused->status == 400);
@@ -46,7 +47,8 @@ TEST_CASE("operator e-stop from the API latches the rig; a campaign is refused u
   REQUIRE(again);
   CHECK(again->status == 409);
   CHECK(again->body.find("nothing to reset") != std::string::npos);
-  REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle" && j["latched"] == false; }, 10));
+  REQUIRE(ld.wait_json(
+      "/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle" && j["latched"] == false; }, 10));
   const auto id = submit(c, waveform({0, 1.0, 0.5}));
   CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "completed"; }));
   // The rig view says what a lab engineer checks first.
@@ -91,11 +93,13 @@ TEST_CASE("another process holds the database's write lock for 8 s: an abort act
   REQUIRE(r);
   CHECK(r->status == 202);
   // The rig leaves its run at once: safing (or already idle), long before the lock goes.
-  CHECK(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "safing" || j["state"] == "idle"; }, 3));
+  CHECK(ld.wait_json(
+      "/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "safing" || j["state"] == "idle"; }, 3));
   CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(4));
   auto status = c.Get("/api/status");
   REQUIRE(status);
   CHECK(status->status == 200);
   holder.join();
-  CHECK(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "aborted"; }, 30));
+  CHECK(ld.wait_json(
+      "/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "aborted"; }, 30));
 }

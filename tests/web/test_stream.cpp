@@ -97,9 +97,8 @@ TEST_CASE("the event stream carries samples, states, nodes and tables; Last-Even
   REQUIRE(first.wait([](const auto& ev) { return !ev.empty() && ev.front().type == "hello"; }, 10));
   auto c = live.client();
   REQUIRE(c.Post("/api/campaigns", json{{"plan", test::fot_plan(3)}}.dump(), "application/json")->status == 201);
-  REQUIRE(first.wait([](const auto& ev) {
-    return has_state(ev, "completed") && std::count_if(ev.begin(), ev.end(), [](const Event& e) { return e.type == "table"; }) == 2;
-  }));
+  REQUIRE(first.wait(
+      [](const auto& ev) { return has_state(ev, "completed") && std::count_if(ev.begin(), ev.end(), [](const Event& e) { return e.type == "table"; }) == 2; }));
   const auto all = first.events();
   std::vector<std::string> states;
   std::size_t nodes = 0, sample_frames = 0;
@@ -140,11 +139,15 @@ TEST_CASE("the event stream carries samples, states, nodes and tables; Last-Even
   const auto again = records(second.events());
   auto keys = [](const std::vector<Event>& ev, std::size_t from) {
     std::vector<std::pair<std::string, std::int64_t>> k;
-    for (std::size_t i = from; i < ev.size(); ++i) k.emplace_back(ev[i].type == "node" || ev[i].type == "table" ? ev[i].type : "event", ev[i].data["id"].get<std::int64_t>());
+    for (std::size_t i = from; i < ev.size(); ++i)
+      k.emplace_back(ev[i].type == "node" || ev[i].type == "table" ? ev[i].type : "event", ev[i].data["id"].get<std::int64_t>());
     return k;
   };
   const auto expected = keys(recs, 3), got = keys(again, 0);
-  auto sorted = [](auto v) { std::sort(v.begin(), v.end()); return v; };
+  auto sorted = [](auto v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
   CHECK(sorted(got) == sorted(expected));
   std::map<std::string, std::int64_t> last;
   for (const auto& [kind, id] : got) {

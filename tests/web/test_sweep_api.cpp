@@ -13,13 +13,14 @@ TEST_CASE("a sweep through the API: points, prediction, resonance report, CSVs w
     c.rigs = daemon::parse_daemon_config(json{{"rigs", {{{"name", "sim shaker"}, {"simulate", {{"rig", "shaker"}, {"time_scale", 0.5}}}}}}}).rigs;
   });
   auto c = live.client();
-  const json plan{{"kind", "sine"}, {"frequencies_hz", {10, 20}}, {"direction", "up-down"}, {"amplitude_mm", 0.005}, {"settle_cycles", 4},
-                  {"measured_cycles", 4}, {"control", {{"window_cycles", 2}}}};
+  const json plan{{"kind", "sine"},     {"frequencies_hz", {10, 20}}, {"direction", "up-down"},           {"amplitude_mm", 0.005},
+                  {"settle_cycles", 4}, {"measured_cycles", 4},       {"control", {{"window_cycles", 2}}}};
   auto r = c.Post("/api/campaigns", json{{"plan", plan}, {"rig", "sim shaker"}}.dump(), "application/json");
   REQUIRE(r);
   REQUIRE(r->status == 201);
   const std::string id = std::to_string(json::parse(r->body)["id"].get<std::int64_t>());
-  REQUIRE(live.wait_json("/api/campaigns/" + id, [](const json& j) { return j["state"] == "completed"; }, 120));
+  REQUIRE(live.wait_json(
+      "/api/campaigns/" + id, [](const json& j) { return j["state"] == "completed"; }, 120));
 
   const json pts = json::parse(c.Get(("/api/campaigns/" + id + "/transmissibility").c_str())->body);
   REQUIRE(pts.size() == 4);  // 10 and 20 Hz, up then down
@@ -61,7 +62,8 @@ TEST_CASE("a sweep through the API: points, prediction, resonance report, CSVs w
   r = c.Get(("/api/runs/" + run + "/samples.csv").c_str());
   REQUIRE(r->status == 200);
   CHECK(r->body.rfind(db::csv_header(db::kShakerSignals), 0) == 0);
-  CHECK(r->body.rfind("seq,t_s,drive_frequency_hz,drive_amplitude_mm,base_displacement_mm,mass_displacement_mm,base_accel_m_s2,mass_accel_m_s2,status\n", 0) == 0);
+  CHECK(r->body.rfind("seq,t_s,drive_frequency_hz,drive_amplitude_mm,base_displacement_mm,mass_displacement_mm,base_accel_m_s2,mass_accel_m_s2,status\n", 0) ==
+        0);
   CHECK(std::count(r->body.begin(), r->body.end(), '\n') > 500);
   const json ov = json::parse(c.Get(("/api/runs/" + run + "/samples?points=50").c_str())->body);
   REQUIRE(ov.contains("base_displacement_max_mm"));

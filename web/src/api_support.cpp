@@ -87,8 +87,7 @@ double query_number(const httplib::Request& req, const char* name, double def, d
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != s.size() || s.empty() || !std::isfinite(v))
-    throw ApiError(400, "invalid parameter", std::string(name) + ": '" + s + "' is not a number");
+  if (used != s.size() || s.empty() || !std::isfinite(v)) throw ApiError(400, "invalid parameter", std::string(name) + ": '" + s + "' is not a number");
   if (v < lo || v > hi)
     throw ApiError(400, "invalid parameter", std::string(name) + ": " + s + " is outside [" + json(lo).dump() + ", " + json(hi).dump() + "]");
   return v;
@@ -96,9 +95,7 @@ double query_number(const httplib::Request& req, const char* name, double def, d
 
 json body_object(const httplib::Request& req, bool allow_empty) { return parse_body(req.body, allow_empty); }
 
-void set_thread_nice(int nice) noexcept {
-  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), nice);
-}
+void set_thread_nice(int nice) noexcept { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), nice); }
 
 db::Store& reader(const std::string& db_path) {
   thread_local std::unique_ptr<db::Store> store;

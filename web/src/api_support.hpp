@@ -7,12 +7,12 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
-#include <regex>
-#include <utility>
-#include <vector>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "hystlab/control/daemon_interface.hpp"
 #include "hystlab/control/http_config.hpp"

@@ -52,9 +52,12 @@ HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg) : 
   s.set_pre_routing_handler([&m](const httplib::Request& req, httplib::Response& res) { return guard_request(m.ctx, req, res); });
   s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;  // the handler's own JSON error
-    if (res.status == 404) send_error(res, 404, "not found", "no such resource: " + req.method + " " + req.path);
-    else if (res.status == 413) send_error(res, 413, "payload too large", "the request body is larger than http.max_body_bytes");
-    else send_error(res, res.status, "bad request", "the request could not be served (HTTP " + std::to_string(res.status) + ")");
+    if (res.status == 404)
+      send_error(res, 404, "not found", "no such resource: " + req.method + " " + req.path);
+    else if (res.status == 413)
+      send_error(res, 413, "payload too large", "the request body is larger than http.max_body_bytes");
+    else
+      send_error(res, res.status, "bad request", "the request could not be served (HTTP " + std::to_string(res.status) + ")");
   });
   add_status_routes(s, m.ctx);
   add_campaign_routes(s, m.ctx);

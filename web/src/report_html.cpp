@@ -33,7 +33,10 @@ void kv(std::ostringstream& o, const std::string& k, const std::string& v) { o <
 
 void header(std::ostringstream& o, const json& doc) {
   const json& c = doc["campaign"];
-  o << "<h1>Campaign #" << c.value("id", 0) << ": " << esc(s(c, "kind") == "sine" ? "sine sweep" : s(c, "kind") == "fot" ? "FOT identification" : s(c, "kind"))
+  o << "<h1>Campaign #" << c.value("id", 0) << ": "
+    << esc(s(c, "kind") == "sine"  ? "sine sweep"
+           : s(c, "kind") == "fot" ? "FOT identification"
+                                   : s(c, "kind"))
     << " on " << esc(s(c, "rig")) << "</h1>";
   o << "<p><span class=\"state\">" << esc(s(c, "state")) << "</span> " << esc(s(c, "reason")) << "</p><table>";
   kv(o, "created", esc(s(c, "created_at")) + " (UTC)");
@@ -49,15 +52,19 @@ void header(std::ostringstream& o, const json& doc) {
 void rig_section(std::ostringstream& o, const json& doc) {
   const json& r = doc["rig"];
   o << "<section><h2>Rig and plan</h2><table>";
-  kv(o, "rig", esc(s(doc["campaign"], "rig")) + (r.is_object() ? " · " + esc(s(r, "kind") == "shaker" ? "shaker" : "load frame") + " · " + esc(s(r, "description")) : ""));
+  kv(o, "rig",
+     esc(s(doc["campaign"], "rig")) +
+         (r.is_object() ? " · " + esc(s(r, "kind") == "shaker" ? "shaker" : "load frame") + " · " + esc(s(r, "description")) : ""));
   if (r.is_object() && r["envelope"].is_object()) {
     std::string env;
-    for (const auto& [k, v] : r["envelope"].items()) env += (env.empty() ? "" : " · ") + esc(k) + " " + esc(v.is_number_float() ? num(v.get<double>()) : v.dump());
+    for (const auto& [k, v] : r["envelope"].items())
+      env += (env.empty() ? "" : " · ") + esc(k) + " " + esc(v.is_number_float() ? num(v.get<double>()) : v.dump());
     kv(o, "envelope", env);
   }
   if (r.is_object() && r["supervision"].is_object()) {
     std::string sup;
-    for (const auto& [k, v] : r["supervision"].items()) sup += (sup.empty() ? "" : " · ") + esc(k) + " " + esc(v.is_number_float() ? num(v.get<double>()) : v.dump());
+    for (const auto& [k, v] : r["supervision"].items())
+      sup += (sup.empty() ? "" : " · ") + esc(k) + " " + esc(v.is_number_float() ? num(v.get<double>()) : v.dump());
     kv(o, "supervision", sup);
   }
   o << "</table><h3>The plan, as submitted</h3><table>";
@@ -92,7 +99,8 @@ void loop_figure(std::ostringstream& o, const json& loop) {
   Series measured{loop["x"].get<std::vector<double>>(), loop["y"].get<std::vector<double>>(), "measured", "#1565c0"};
   std::vector<Series> series{measured};
   if (loop["model"].is_object())
-    series.push_back({measured.x, loop["model"]["force_N"].get<std::vector<double>>(), "table #" + std::to_string(loop["model"].value("table", 0)), "#e65100", true});
+    series.push_back(
+        {measured.x, loop["model"]["force_N"].get<std::vector<double>>(), "table #" + std::to_string(loop["model"].value("table", 0)), "#e65100", true});
   o << "<figure>" << svg_xy(series, {"displacement (mm)"}, {"force (N)"}) << "<figcaption>Run #" << loop.value("run", 0) << ": " << loop.value("samples", 0)
     << " samples, " << loop.value("reversals", 0) << " reversals, drawn with " << loop.value("points", 0) << " points (every reversal kept)"
     << (loop["model"].is_object() ? "; dashed: the identified table's force on the same input" : "") << ".</figcaption></figure>";
@@ -148,7 +156,8 @@ void shakedown_figure(std::ostringstream& o, const json& c) {
     return;
   }
   Series energy{{}, {}, "dissipated energy (N·mm)", "#6a1b9a", false, true}, peak{{}, {}, "peak force (N)", "#2e7d32", true, true};
-  for (const json& k : cycles) energy.x.push_back(d(k, "cycle")), energy.y.push_back(d(k, "energy_Nmm")), peak.x.push_back(d(k, "cycle")), peak.y.push_back(d(k, "peak_force_N"));
+  for (const json& k : cycles)
+    energy.x.push_back(d(k, "cycle")), energy.y.push_back(d(k, "energy_Nmm")), peak.x.push_back(d(k, "cycle")), peak.y.push_back(d(k, "peak_force_N"));
   o << "<h3>Training (shakedown)</h3><figure>" << svg_xy({energy, peak}, {"training cycle"}, {"N·mm, N"}, 640, 260) << "<figcaption>"
     << esc(s(c.value("training", json::object()), "why")) << ".</figcaption></figure>";
 }
@@ -159,16 +168,18 @@ void shakedown_figure(std::ostringstream& o, const json& c) {
 void cycles_table(std::ostringstream& o, const json& loops) {
   if (!loops.is_array() || loops.empty()) return;
   o << "<h3>Loop figures, per closed cycle</h3><table><tr><th>cycle</th><th>phase</th><th class=n>range</th><th class=n>peak force</th>"
-       "<th class=n>loading plateau</th><th class=n>unloading plateau</th><th class=n>force at return</th><th class=n>residual displacement</th><th class=n>dissipated energy</th><th class=n>damping ratio</th></tr>";
+       "<th class=n>loading plateau</th><th class=n>unloading plateau</th><th class=n>force at return</th><th class=n>residual displacement</th><th "
+       "class=n>dissipated energy</th><th class=n>damping ratio</th></tr>";
   auto plateau = [](const json& k) {
     if (!k.is_object() || !k.value("plateau", false)) return std::string("<span class=muted>none</span>");
     return num(d(k, "lower_N")) + "–" + num(d(k, "upper_N")) + " N";
   };
   for (const json& l : loops)
-    o << "<tr><td>" << l.value("k", 0) << " (run #" << l.value("run", 0) << ")</td><td>" << esc(s(l, "phase")) << "</td><td class=n>" << num(d(l, "min_mm")) << "–"
-      << unit(d(l, "max_mm"), "mm") << "</td><td class=n>" << unit(d(l, "peak_force_N"), "N") << "</td><td class=n>" << plateau(l.value("loading_knees", json()))
-      << "</td><td class=n>" << plateau(l.value("unloading_knees", json())) << "</td><td class=n>" << unit(d(l, "return_N"), "N") << "</td><td class=n>"
-      << unit(d(l, "residual_mm"), "mm") << "</td><td class=n>" << unit(d(l, "energy_Nmm"), "N·mm") << "</td><td class=n>" << num(d(l, "damping_ratio")) << "</td></tr>";
+    o << "<tr><td>" << l.value("k", 0) << " (run #" << l.value("run", 0) << ")</td><td>" << esc(s(l, "phase")) << "</td><td class=n>" << num(d(l, "min_mm"))
+      << "–" << unit(d(l, "max_mm"), "mm") << "</td><td class=n>" << unit(d(l, "peak_force_N"), "N") << "</td><td class=n>"
+      << plateau(l.value("loading_knees", json())) << "</td><td class=n>" << plateau(l.value("unloading_knees", json())) << "</td><td class=n>"
+      << unit(d(l, "return_N"), "N") << "</td><td class=n>" << unit(d(l, "residual_mm"), "mm") << "</td><td class=n>" << unit(d(l, "energy_Nmm"), "N·mm")
+      << "</td><td class=n>" << num(d(l, "damping_ratio")) << "</td></tr>";
   o << "</table>";
 }
 
@@ -210,23 +221,27 @@ void sine_section(std::ostringstream& o, const json& sweep) {
   o << "<figure>" << svg_xy(r, {"frequency (Hz)", true}, {"transmissibility |X/Y|", true}) << "<figcaption>Mass against base amplitude, per amplitude and "
     << "direction; dashed: the isolator model's prediction.</figcaption></figure>";
   o << "<figure>" << svg_xy(ph, {"frequency (Hz)", true}, {"phase (°)"}, 640, 260) << "<figcaption>Phase of the mass against the base.</figcaption></figure>";
-  o << "<h3>Resonances</h3><table><tr><th>amplitude, direction</th><th class=n>frequency</th><th class=n>peak</th><th class=n>half-power band</th><th class=n>Q</th></tr>";
+  o << "<h3>Resonances</h3><table><tr><th>amplitude, direction</th><th class=n>frequency</th><th class=n>peak</th><th class=n>half-power band</th><th "
+       "class=n>Q</th></tr>";
   for (const json& cv : sweep["measured"]["curves"]) {
     const json& res = cv["resonance"];
     o << "<tr><td>" << num(d(cv, "amplitude_mm")) << " mm " << esc(s(cv, "direction")) << "</td>";
-    if (!res.is_object()) o << "<td colspan=4 class=muted>not within the swept band</td></tr>";
+    if (!res.is_object())
+      o << "<td colspan=4 class=muted>not within the swept band</td></tr>";
     else
       o << "<td class=n>" << unit(d(res, "frequency_hz"), "Hz") << (res.value("at_edge", false) ? " (at the band's edge)" : "") << "</td><td class=n>"
         << num(d(res, "peak_ratio")) << "</td><td class=n>" << unit(d(res, "bandwidth_hz"), "Hz") << "</td><td class=n>" << num(d(res, "q")) << "</td></tr>";
   }
   o << "</table><h3>Jumps (up against down)</h3>";
-  if (sweep["measured"].value("compared", 0) == 0) o << "<p>No amplitude was swept both ways: nothing to compare.</p>";
-  else if (sweep["measured"]["jumps"].empty()) o << "<p>No jump beyond " << num(d(sweep, "jump_threshold") * 100) << " % between the directions.</p>";
+  if (sweep["measured"].value("compared", 0) == 0)
+    o << "<p>No amplitude was swept both ways: nothing to compare.</p>";
+  else if (sweep["measured"]["jumps"].empty())
+    o << "<p>No jump beyond " << num(d(sweep, "jump_threshold") * 100) << " % between the directions.</p>";
   else {
     o << "<table><tr><th>amplitude</th><th class=n>between</th><th class=n>largest difference</th></tr>";
     for (const json& j : sweep["measured"]["jumps"])
-      o << "<tr><td>" << unit(d(j, "amplitude_mm"), "mm") << "</td><td class=n>" << num(d(j, "lo_hz")) << "–" << unit(d(j, "hi_hz"), "Hz") << "</td><td class=n>"
-        << num(d(j, "max_difference") * 100) << " %</td></tr>";
+      o << "<tr><td>" << unit(d(j, "amplitude_mm"), "mm") << "</td><td class=n>" << num(d(j, "lo_hz")) << "–" << unit(d(j, "hi_hz"), "Hz")
+        << "</td><td class=n>" << num(d(j, "max_difference") * 100) << " %</td></tr>";
     o << "</table>";
   }
   o << "</section>";
@@ -253,8 +268,10 @@ std::string render_html(const json& doc) {
   header(o, doc);
   rig_section(o, doc);
   quality_section(o, c.value("runs", json::array()));
-  if (s(c, "kind") == "sine") sine_section(o, doc.value("sweep", json()));
-  else fot_section(o, doc);
+  if (s(c, "kind") == "sine")
+    sine_section(o, doc.value("sweep", json()));
+  else
+    fot_section(o, doc);
   events_section(o, doc.value("events", json::array()));
   o << "</body></html>\n";
   return o.str();

@@ -28,8 +28,12 @@ std::int64_t own_run(const json& campaign) {
 }
 
 json report_document(ApiContext& c, db::Store& store, const db::CampaignRow& row, XYCache& cache) {
-  json doc{{"campaign", campaign_json(c.daemon, store, row, true)}, {"software", std::string("hystlab ") + HYSTLAB_VERSION}, {"generated_at", utc_now()},
-           {"events", events_json(store, row.id)}, {"loops", loops_json(store, row.id)}, {"rig", nullptr}};
+  json doc{{"campaign", campaign_json(c.daemon, store, row, true)},
+           {"software", std::string("hystlab ") + HYSTLAB_VERSION},
+           {"generated_at", utc_now()},
+           {"events", events_json(store, row.id)},
+           {"loops", loops_json(store, row.id)},
+           {"rig", nullptr}};
   const std::string rig = doc["campaign"].value("rig", "");
   for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
     if (c.daemon.rig_info(k).name == rig) doc["rig"] = rig_json(c.daemon, k);
@@ -59,11 +63,11 @@ json report_document(ApiContext& c, db::Store& store, const db::CampaignRow& row
 void add_report_routes(httplib::Server& s, ApiContext& c) {
   auto cache = make_xy_cache();
   s.Get(R"(/api/campaigns/(\d+)/report\.html)", guarded([&c, cache](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    const auto row = campaign_or_404(store, path_id(req));
-    res.set_header("Content-Disposition", "inline; filename=\"hystlab-campaign-" + std::to_string(row.id) + "-report.html\"");
-    res.set_content(report::render_html(report_document(c, store, row, *cache)), "text/html; charset=utf-8");
-  }));
+          auto& store = reader(c.db_path);
+          const auto row = campaign_or_404(store, path_id(req));
+          res.set_header("Content-Disposition", "inline; filename=\"hystlab-campaign-" + std::to_string(row.id) + "-report.html\"");
+          res.set_content(report::render_html(report_document(c, store, row, *cache)), "text/html; charset=utf-8");
+        }));
 }
 
 }  // namespace hystlab::web

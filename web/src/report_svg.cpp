@@ -13,9 +13,12 @@ std::string num(double v, int digits) {
   char b[48];
   const double a = std::fabs(v);
   if (a < 1e-9) return "0";  // a float's zero that a sum left at 1e-20
-  if (a >= 1e6 || a < 1e-3) std::snprintf(b, sizeof b, "%.*e", std::max(digits - 2, 0), v);
-  else if (a >= std::pow(10.0, digits - 1)) std::snprintf(b, sizeof b, "%.0f", v);
-  else std::snprintf(b, sizeof b, "%.*g", digits, v);
+  if (a >= 1e6 || a < 1e-3)
+    std::snprintf(b, sizeof b, "%.*e", std::max(digits - 2, 0), v);
+  else if (a >= std::pow(10.0, digits - 1))
+    std::snprintf(b, sizeof b, "%.0f", v);
+  else
+    std::snprintf(b, sizeof b, "%.*g", digits, v);
   return b;
 }
 
@@ -23,11 +26,16 @@ std::string esc(const std::string& s) {
   std::string o;
   o.reserve(s.size());
   for (const char c : s) {
-    if (c == '&') o += "&amp;";
-    else if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
+    if (c == '&')
+      o += "&amp;";
+    else if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '"')
+      o += "&quot;";
+    else
+      o += c;
   }
   return o;
 }
@@ -80,13 +88,17 @@ std::string svg_xy(const std::vector<Series>& series, const Axis& x, const Axis&
     for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k)
       if ((!x.log || s.x[k] > 0) && (!y.log || s.y[k] > 0)) rx.add(s.x[k]), ry.add(s.y[k]);
   std::ostringstream o;
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plot\" width=\"" << width << "\" height=\"" << height << "\" viewBox=\"0 0 " << width << ' '
-    << height << "\" font-family=\"sans-serif\" font-size=\"11\">";
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plot\" width=\"" << width << "\" height=\"" << height << "\" viewBox=\"0 0 " << width << ' ' << height
+    << "\" font-family=\"sans-serif\" font-size=\"11\">";
   if (!rx.ok() || !ry.ok()) return o.str() + "<text x=\"10\" y=\"20\">no data</text></svg>";
   rx = axis_range(rx, x.log), ry = axis_range(ry, y.log);
   const double L = 62, R = width - 12.0, T = 12, B = height - 40.0;
-  auto px = [&](double v) { return x.log ? L + (std::log10(v) - std::log10(rx.lo)) / (std::log10(rx.hi) - std::log10(rx.lo)) * (R - L) : L + (v - rx.lo) / (rx.hi - rx.lo) * (R - L); };
-  auto py = [&](double v) { return y.log ? B - (std::log10(v) - std::log10(ry.lo)) / (std::log10(ry.hi) - std::log10(ry.lo)) * (B - T) : B - (v - ry.lo) / (ry.hi - ry.lo) * (B - T); };
+  auto px = [&](double v) {
+    return x.log ? L + (std::log10(v) - std::log10(rx.lo)) / (std::log10(rx.hi) - std::log10(rx.lo)) * (R - L) : L + (v - rx.lo) / (rx.hi - rx.lo) * (R - L);
+  };
+  auto py = [&](double v) {
+    return y.log ? B - (std::log10(v) - std::log10(ry.lo)) / (std::log10(ry.hi) - std::log10(ry.lo)) * (B - T) : B - (v - ry.lo) / (ry.hi - ry.lo) * (B - T);
+  };
   char b[96];
   for (const double t : ticks(rx.lo, rx.hi, x.log)) {
     std::snprintf(b, sizeof b, "%.1f", px(t));
@@ -114,11 +126,13 @@ std::string svg_xy(const std::vector<Series>& series, const Axis& x, const Axis&
       }
     }
     if (!s.markers || s.x.size() > 1)
-      o << "<path d=\"" << path << "\" fill=\"none\" stroke=\"" << s.color << "\" stroke-width=\"1.2\"" << (s.dashed ? " stroke-dasharray=\"5 3\"" : "") << "/>";
+      o << "<path d=\"" << path << "\" fill=\"none\" stroke=\"" << s.color << "\" stroke-width=\"1.2\"" << (s.dashed ? " stroke-dasharray=\"5 3\"" : "")
+        << "/>";
     if (!s.label.empty() && series.size() > 1) {
       const double ly = T + 14 + 14.0 * legend++;
-      o << "<line x1=\"" << L + 10 << "\" x2=\"" << L + 30 << "\" y1=\"" << ly - 4 << "\" y2=\"" << ly - 4 << "\" stroke=\"" << s.color << "\" stroke-width=\"2\""
-        << (s.dashed ? " stroke-dasharray=\"5 3\"" : "") << "/><text x=\"" << L + 34 << "\" y=\"" << ly << "\">" << esc(s.label) << "</text>";
+      o << "<line x1=\"" << L + 10 << "\" x2=\"" << L + 30 << "\" y1=\"" << ly - 4 << "\" y2=\"" << ly - 4 << "\" stroke=\"" << s.color
+        << "\" stroke-width=\"2\"" << (s.dashed ? " stroke-dasharray=\"5 3\"" : "") << "/><text x=\"" << L + 34 << "\" y=\"" << ly << "\">" << esc(s.label)
+        << "</text>";
     }
   }
   return o.str() + "</svg>";
@@ -132,8 +146,12 @@ std::string ramp(double t) {
   const double m = t < 0.5 ? t * 2 : (t - 0.5) * 2;
   const double rm = 33, gm = 145, bm = 140;  // viridis' middle, teal
   char b[16];
-  if (t < 0.5) std::snprintf(b, sizeof b, "#%02x%02x%02x", static_cast<int>(r0 + (rm - r0) * m), static_cast<int>(g0 + (gm - g0) * m), static_cast<int>(b0 + (bm - b0) * m));
-  else std::snprintf(b, sizeof b, "#%02x%02x%02x", static_cast<int>(rm + (r1 - rm) * m), static_cast<int>(gm + (g1 - gm) * m), static_cast<int>(bm + (b1 - bm) * m));
+  if (t < 0.5)
+    std::snprintf(b, sizeof b, "#%02x%02x%02x", static_cast<int>(r0 + (rm - r0) * m), static_cast<int>(g0 + (gm - g0) * m),
+                  static_cast<int>(b0 + (bm - b0) * m));
+  else
+    std::snprintf(b, sizeof b, "#%02x%02x%02x", static_cast<int>(rm + (r1 - rm) * m), static_cast<int>(gm + (g1 - gm) * m),
+                  static_cast<int>(bm + (b1 - bm) * m));
   return b;
 }
 }  // namespace
@@ -167,7 +185,8 @@ std::string svg_heatmap(const std::vector<HeatCell>& cells, double lo_mm, double
   // The colour scale: the measured range of F, in N.
   const double lx = L + S + 24, lh = S * 0.8;
   for (int k = 0; k < 40; ++k)
-    o << "<rect x=\"" << lx << "\" y=\"" << T + lh - (k + 1) * lh / 40 << "\" width=\"14\" height=\"" << lh / 40 + 0.5 << "\" fill=\"" << ramp((k + 0.5) / 40) << "\"/>";
+    o << "<rect x=\"" << lx << "\" y=\"" << T + lh - (k + 1) * lh / 40 << "\" width=\"14\" height=\"" << lh / 40 + 0.5 << "\" fill=\"" << ramp((k + 0.5) / 40)
+      << "\"/>";
   for (const double t : ticks(r.lo, r.hi, false))
     o << "<text x=\"" << lx + 18 << "\" y=\"" << T + lh - (t - r.lo) / (r.hi - r.lo) * lh << "\" dy=\"4\">" << num(t) << "</text>";
   o << "<text x=\"" << lx << "\" y=\"" << T + lh + 18 << "\">F (N)</text>";

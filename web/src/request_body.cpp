@@ -9,12 +9,16 @@ void check_nesting(std::string_view text, std::size_t max_depth) {
   bool in_string = false, escaped = false;
   for (const char ch : text) {
     if (in_string) {
-      if (escaped) escaped = false;
-      else if (ch == '\\') escaped = true;
-      else if (ch == '"') in_string = false;
+      if (escaped)
+        escaped = false;
+      else if (ch == '\\')
+        escaped = true;
+      else if (ch == '"')
+        in_string = false;
       continue;
     }
-    if (ch == '"') in_string = true;
+    if (ch == '"')
+      in_string = true;
     else if (ch == '[' || ch == '{') {
       if (++depth > max_depth)
         throw ApiError(400, "malformed JSON", "the request body nests arrays or objects deeper than " + std::to_string(max_depth) + " levels");
@@ -42,8 +46,7 @@ json parse_body(std::string_view body, bool allow_empty) {
 PlanRequest decode_plan_request(const json& body) {
   for (const auto& [k, _] : body.items())
     if (k != "plan" && k != "rig") throw ApiError(400, "invalid request", k + ": not a known field (plan, rig)", k);
-  if (!body.contains("plan") || !body["plan"].is_object())
-    throw ApiError(400, "invalid request", "plan: must be a JSON object (a campaign plan)", "plan");
+  if (!body.contains("plan") || !body["plan"].is_object()) throw ApiError(400, "invalid request", "plan: must be a JSON object (a campaign plan)", "plan");
   if (body.contains("rig") && !body["rig"].is_string()) throw ApiError(400, "invalid request", "rig: must be a rig's name", "rig");
   return {body.value("rig", std::string()), body["plan"]};
 }

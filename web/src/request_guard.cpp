@@ -56,8 +56,10 @@ bool bad_length(const ApiContext& c, const httplib::Request& req, httplib::Respo
   if (digits && std::stoull(v) <= 2 * c.config.max_body_bytes) return false;
   // The body is never read: the client is told the connection ends here.
   res.set_header("Connection", "close");
-  if (!digits) send_error(res, 400, "bad request", "Content-Length '" + v + "' is not a byte count");
-  else send_error(res, 413, "payload too large", "the request body (" + v + " bytes) is larger than http.max_body_bytes");
+  if (!digits)
+    send_error(res, 400, "bad request", "Content-Length '" + v + "' is not a byte count");
+  else
+    send_error(res, 413, "payload too large", "the request body (" + v + " bytes) is larger than http.max_body_bytes");
   return true;
 }
 
@@ -124,7 +126,8 @@ HR check_write(ApiContext& c, const httplib::Request& req, httplib::Response& re
   // handler sees it (199 KB became 200 MB). Every client of this API sends a length, and JSON as is.
   if (req.has_header("Transfer-Encoding")) {
     res.set_header("Connection", "close");
-    return refuse(res, 411, "length required", "send the request body with a Content-Length, not Transfer-Encoding: " + req.get_header_value("Transfer-Encoding"));
+    return refuse(res, 411, "length required",
+                  "send the request body with a Content-Length, not Transfer-Encoding: " + req.get_header_value("Transfer-Encoding"));
   }
   if (req.has_header("Content-Encoding") && lower(req.get_header_value("Content-Encoding")) != "identity") {
     res.set_header("Connection", "close");
@@ -136,9 +139,9 @@ HR check_write(ApiContext& c, const httplib::Request& req, httplib::Response& re
   // An empty body of any type is no body (curl -d '' sends it as a form): a command works as the
   // docs write it.
   if (!has_token && has_body && !(req.has_header("Content-Type") && is_json_type(req.get_header_value("Content-Type"))))
-    return refuse(res, 415, "unsupported media type",
-                  "a request that changes state sends JSON (Content-Type: application/json) or no body at all, not '" +
-                      req.get_header_value("Content-Type") + "'");
+    return refuse(
+        res, 415, "unsupported media type",
+        "a request that changes state sends JSON (Content-Type: application/json) or no body at all, not '" + req.get_header_value("Content-Type") + "'");
   if (!req.has_header("Content-Length")) return dispatch_bodiless(c, req, res);
   return HR::Unhandled;
 }
@@ -173,8 +176,7 @@ HR guard_request(ApiContext& c, const httplib::Request& req, httplib::Response& 
   // DNS rebinding: a page from attacker.example, its name re-pointed at 127.0.0.1, reaches this
   // port as "same origin"; its Host header still says attacker.example.
   if (!host_allowed(c.config, req.get_header_value("Host")))
-    return refuse(res, 403, "unknown host",
-                  "Host '" + req.get_header_value("Host") + "' is not a name this daemon serves (add it to http.allowed_hosts)");
+    return refuse(res, 403, "unknown host", "Host '" + req.get_header_value("Host") + "' is not a name this daemon serves (add it to http.allowed_hosts)");
   return changes_state(req.method) ? check_write(c, req, res) : check_read(c, req, res);
 }
 

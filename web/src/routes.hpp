@@ -24,15 +24,15 @@ json table_json(const db::TableInfo& t);
 json parse_or_text(const std::string& s);  // stored JSON text as JSON (or as the text itself)
 
 // What the report (report_route.cpp) shares with the routes that serve the same JSON.
-json rig_json(const control::DaemonInterface& d, std::size_t k);                                 // GET /api/rigs/NAME
+json rig_json(const control::DaemonInterface& d, std::size_t k);                                   // GET /api/rigs/NAME
 json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row);  // .../nodes
-json events_json(db::Store& store, std::int64_t campaign);                                        // .../events
-json loops_json(db::Store& store, std::int64_t campaign);                                         // .../loops
-json sweep_json(db::Store& store, const db::CampaignRow& row);                                    // .../sweep
+json events_json(db::Store& store, std::int64_t campaign);                                         // .../events
+json loops_json(db::Store& store, std::int64_t campaign);                                          // .../loops
+json sweep_json(db::Store& store, const db::CampaignRow& row);                                     // .../sweep
 class XYCache;                                                                                     // runs' x-y columns, read once
 std::shared_ptr<XYCache> make_xy_cache();
-json loop_json(db::Store& store, XYCache& cache, std::int64_t run_id, std::size_t points);        // /api/runs/ID/loop
-void add_report_routes(httplib::Server& s, ApiContext& c);  // GET /api/campaigns/ID/report.html
+json loop_json(db::Store& store, XYCache& cache, std::int64_t run_id, std::size_t points);  // /api/runs/ID/loop
+void add_report_routes(httplib::Server& s, ApiContext& c);                                  // GET /api/campaigns/ID/report.html
 
 // A run's data quality, from its "quality" event (null while it runs), with warnings in words.
 json run_quality(db::Store& store, std::int64_t campaign, std::int64_t run);

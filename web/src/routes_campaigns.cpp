@@ -19,8 +19,14 @@ namespace {
 json runs_of(db::Store& store, std::int64_t campaign) {
   json runs = json::array();
   for (const db::RunInfo& r : store.runs(campaign))
-    runs.push_back({{"id", r.id}, {"role", r.role}, {"state", r.state}, {"started_at", r.started_at}, {"ended_at", r.ended_at},
-                    {"samples", r.samples}, {"nodes", r.nodes}, {"quality", run_quality(store, campaign, r.id)}});
+    runs.push_back({{"id", r.id},
+                    {"role", r.role},
+                    {"state", r.state},
+                    {"started_at", r.started_at},
+                    {"ended_at", r.ended_at},
+                    {"samples", r.samples},
+                    {"nodes", r.nodes},
+                    {"quality", run_quality(store, campaign, r.id)}});
   return runs;
 }
 
@@ -60,8 +66,7 @@ json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::C
   json out{{"campaign", row.id}, {"nodes", nodes}};
   const auto grid = row.kind == db::CampaignKind::fot ? d.fot_grid(json::parse(row.plan)) : std::nullopt;
   if (!grid) return out;
-  const models::Grid g = grid->nodes_mm.empty() ? models::Grid::make(grid->lo_mm, grid->hi_mm, grid->subdivisions)
-                                                : models::Grid::from_nodes(grid->nodes_mm);
+  const models::Grid g = grid->nodes_mm.empty() ? models::Grid::make(grid->lo_mm, grid->hi_mm, grid->subdivisions) : models::Grid::from_nodes(grid->nodes_mm);
   std::set<std::pair<int, int>> seen;  // a resumed campaign may measure a node twice
   const double tol = 0.25 * g.step();
   for (const json& n : nodes) {
@@ -97,8 +102,12 @@ json loops_json(db::Store& store, std::int64_t campaign) {
 }
 
 json campaign_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row, bool details) {
-  json j{{"id", row.id}, {"rig", store.rig_name(row.rig_id)}, {"kind", db::to_string(row.kind)}, {"state", db::to_string(row.state)},
-         {"created_at", row.created_at}, {"updated_at", row.updated_at}};
+  json j{{"id", row.id},
+         {"rig", store.rig_name(row.rig_id)},
+         {"kind", db::to_string(row.kind)},
+         {"state", db::to_string(row.state)},
+         {"created_at", row.created_at},
+         {"updated_at", row.updated_at}};
   // What the state means, so that a page needs no list of states of its own.
   json commands = json::array();
   for (const control::CampaignCommand cmd : control::commands_for(row.state)) commands.push_back(control::to_string(cmd));
@@ -139,72 +148,73 @@ json campaign_json(const control::DaemonInterface& d, db::Store& store, const db
 
 void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   s.Get("/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    const std::string state = req.has_param("state") ? req.get_param_value("state") : "";
-    if (!state.empty() && !db::campaign_state_from(state)) {
-      std::string known;
-      for (const db::CampaignState k : db::kCampaignStates) known += (known.empty() ? "" : ", ") + std::string(db::to_string(k));
-      throw ApiError(400, "invalid parameter", "state: '" + state + "' is not a campaign state (" + known + ")", "state");
-    }
-    json out = json::array();
-    for (const auto& row : store.campaigns())
-      if (state.empty() || db::to_string(row.state) == state) out.push_back(campaign_json(c.daemon, store, row, false));
-    send_json(res, out);
-  }));
+          auto& store = reader(c.db_path);
+          const std::string state = req.has_param("state") ? req.get_param_value("state") : "";
+          if (!state.empty() && !db::campaign_state_from(state)) {
+            std::string known;
+            for (const db::CampaignState k : db::kCampaignStates) known += (known.empty() ? "" : ", ") + std::string(db::to_string(k));
+            throw ApiError(400, "invalid parameter", "state: '" + state + "' is not a campaign state (" + known + ")", "state");
+          }
+          json out = json::array();
+          for (const auto& row : store.campaigns())
+            if (state.empty() || db::to_string(row.state) == state) out.push_back(campaign_json(c.daemon, store, row, false));
+          send_json(res, out);
+        }));
   post_route(s, c, "/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    const PlanRequest r = decode_plan_request(body_object(req));
-    const std::int64_t id = c.daemon.submit(r.rig, r.plan);
-    res.set_header("Location", "/api/campaigns/" + std::to_string(id));
-    send_json(res, campaign_json(c.daemon, reader(c.db_path), campaign_or_404(reader(c.db_path), id), false), 201);
-  }));
+               const PlanRequest r = decode_plan_request(body_object(req));
+               const std::int64_t id = c.daemon.submit(r.rig, r.plan);
+               res.set_header("Location", "/api/campaigns/" + std::to_string(id));
+               send_json(res, campaign_json(c.daemon, reader(c.db_path), campaign_or_404(reader(c.db_path), id), false), 201);
+             }));
   s.Get(R"(/api/campaigns/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, path_id(req)), true));
-  }));
+          auto& store = reader(c.db_path);
+          send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, path_id(req)), true));
+        }));
   // The specimen and notes, changed after submission (any state): {"specimen": ..., "notes": ...}.
   post_route(s, c, R"(/api/campaigns/(\d+)/record)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    const auto row = campaign_or_404(reader(c.db_path), path_id(req));
-    try {
-      c.daemon.set_record(row.id, body_object(req));
-    } catch (const control::PlanError& e) {  // not a plan's field: named as the body's
-      throw ApiError(400, "invalid record", e.what(), e.field);
-    } catch (const std::out_of_range& e) {
-      throw ApiError(404, "not found", e.what());
-    }
-    auto& store = reader(c.db_path);
-    send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, row.id), false));
-  }));
+               const auto row = campaign_or_404(reader(c.db_path), path_id(req));
+               try {
+                 c.daemon.set_record(row.id, body_object(req));
+               } catch (const control::PlanError& e) {  // not a plan's field: named as the body's
+                 throw ApiError(400, "invalid record", e.what(), e.field);
+               } catch (const std::out_of_range& e) {
+                 throw ApiError(404, "not found", e.what());
+               }
+               auto& store = reader(c.db_path);
+               send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, row.id), false));
+             }));
   post_route(s, c, R"(/api/campaigns/(\d+)/([a-z_]+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    const std::string verb = req.matches[2].str();
-    const auto cmd = control::campaign_command_from(verb);
-    if (!cmd) throw ApiError(404, "not found", "no command '" + verb + "' for a campaign (pause, resume, abort, estop)");
-    auto& store = reader(c.db_path);
-    const auto row = campaign_or_404(store, path_id(req));
-    const auto applies = control::commands_for(row.state);
-    if (std::find(applies.begin(), applies.end(), *cmd) == applies.end()) {
-      std::string which;
-      for (const auto a : applies) which += std::string(which.empty() ? "" : ", ") + control::to_string(a);
-      throw ApiError(409, "conflict", "campaign " + std::to_string(row.id) + " is " + db::to_string(row.state) + ": '" + verb + "' does not apply" +
-                                          (which.empty() ? std::string() : " (" + which + " do)"));
-    }
-    send_outcome(res, json{{"campaign", row.id}, {"command", verb}}, c.daemon.command(row.id, *cmd));
-  }));
+               const std::string verb = req.matches[2].str();
+               const auto cmd = control::campaign_command_from(verb);
+               if (!cmd) throw ApiError(404, "not found", "no command '" + verb + "' for a campaign (pause, resume, abort, estop)");
+               auto& store = reader(c.db_path);
+               const auto row = campaign_or_404(store, path_id(req));
+               const auto applies = control::commands_for(row.state);
+               if (std::find(applies.begin(), applies.end(), *cmd) == applies.end()) {
+                 std::string which;
+                 for (const auto a : applies) which += std::string(which.empty() ? "" : ", ") + control::to_string(a);
+                 throw ApiError(409, "conflict",
+                                "campaign " + std::to_string(row.id) + " is " + db::to_string(row.state) + ": '" + verb + "' does not apply" +
+                                    (which.empty() ? std::string() : " (" + which + " do)"));
+               }
+               send_outcome(res, json{{"campaign", row.id}, {"command", verb}}, c.daemon.command(row.id, *cmd));
+             }));
   s.Get(R"(/api/campaigns/(\d+)/events)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    send_json(res, events_json(store, campaign_or_404(store, path_id(req)).id));
-  }));
+          auto& store = reader(c.db_path);
+          send_json(res, events_json(store, campaign_or_404(store, path_id(req)).id));
+        }));
   s.Get(R"(/api/campaigns/(\d+)/nodes)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    send_json(res, nodes_json(c.daemon, store, campaign_or_404(store, path_id(req))));
-  }));
+          auto& store = reader(c.db_path);
+          send_json(res, nodes_json(c.daemon, store, campaign_or_404(store, path_id(req))));
+        }));
   s.Get(R"(/api/campaigns/(\d+)/loops)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    send_json(res, loops_json(store, campaign_or_404(store, path_id(req)).id));
-  }));
+          auto& store = reader(c.db_path);
+          send_json(res, loops_json(store, campaign_or_404(store, path_id(req)).id));
+        }));
   s.Get(R"(/api/campaigns/(\d+)/runs)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    send_json(res, runs_of(store, campaign_or_404(store, path_id(req)).id));
-  }));
+          auto& store = reader(c.db_path);
+          send_json(res, runs_of(store, campaign_or_404(store, path_id(req)).id));
+        }));
 }
 
 }  // namespace hystlab::web

@@ -85,28 +85,27 @@ void send_file(httplib::Response& res, std::shared_ptr<OpenFile> file, const std
   const off_t size = ::lseek(file->fd, 0, SEEK_END);
   if (size < 0) throw ApiError(500, "export failed", std::string("cannot size the export: ") + std::strerror(errno));
   res.set_header("Content-Disposition", "attachment; filename=\"" + filename + "\"");
-  res.set_content_provider(static_cast<std::size_t>(size), "application/x-hdf5",
-                           [file](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
-                             char buf[kH5SendChunk];
-                             const ssize_t n = ::pread(file->fd, buf, std::min(length, sizeof buf), static_cast<off_t>(offset));
-                             return n > 0 && sink.write(buf, static_cast<std::size_t>(n));
-                           });
+  res.set_content_provider(static_cast<std::size_t>(size), "application/x-hdf5", [file](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+    char buf[kH5SendChunk];
+    const ssize_t n = ::pread(file->fd, buf, std::min(length, sizeof buf), static_cast<off_t>(offset));
+    return n > 0 && sink.write(buf, static_cast<std::size_t>(n));
+  });
 }
 }  // namespace
 
 void add_h5_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/runs/(\d+)/samples\.h5)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    db::Store& store = reader(c.db_path);
-    const std::int64_t id = path_id(req);
-    auto file = export_to_temp(c.db_path, [&](const std::string& path) { (void)db::export_run_h5(store, id, path); });
-    send_file(res, std::move(file), "run-" + std::to_string(id) + ".h5");
-  }));
+          db::Store& store = reader(c.db_path);
+          const std::int64_t id = path_id(req);
+          auto file = export_to_temp(c.db_path, [&](const std::string& path) { (void)db::export_run_h5(store, id, path); });
+          send_file(res, std::move(file), "run-" + std::to_string(id) + ".h5");
+        }));
   s.Get(R"(/api/campaigns/(\d+)/samples\.h5)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    db::Store& store = reader(c.db_path);
-    const std::int64_t id = path_id(req);
-    auto file = export_to_temp(c.db_path, [&](const std::string& path) { (void)db::export_campaign_h5(store, id, path); });
-    send_file(res, std::move(file), "campaign-" + std::to_string(id) + ".h5");
-  }));
+          db::Store& store = reader(c.db_path);
+          const std::int64_t id = path_id(req);
+          auto file = export_to_temp(c.db_path, [&](const std::string& path) { (void)db::export_campaign_h5(store, id, path); });
+          send_file(res, std::move(file), "campaign-" + std::to_string(id) + ".h5");
+        }));
 }
 
 }  // namespace hystlab::web

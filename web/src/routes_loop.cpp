@@ -73,9 +73,16 @@ json loop_json(db::Store& store, XYCache& cache, std::int64_t run_id, std::size_
   const models::PathReduction r = models::reduce_path(xy->x, xy->y, points);
   json xs = json::array(), ys = json::array();
   for (const std::size_t k : r.index) xs.push_back(rounded(xy->x[k])), ys.push_back(rounded(xy->y[k]));
-  json out{{"run", run_id}, {"kind", campaign ? db::to_string(campaign->kind) : ""}, {"x_label", shaker ? "base displacement (mm)" : "displacement (mm)"},
-           {"y_label", shaker ? "mass displacement (mm)" : "force (N)"}, {"samples", xy->x.size()}, {"reversals", r.reversals},
-           {"points", r.index.size()}, {"x", xs}, {"y", ys}, {"model", nullptr}};
+  json out{{"run", run_id},
+           {"kind", campaign ? db::to_string(campaign->kind) : ""},
+           {"x_label", shaker ? "base displacement (mm)" : "displacement (mm)"},
+           {"y_label", shaker ? "mass displacement (mm)" : "force (N)"},
+           {"samples", xy->x.size()},
+           {"reversals", r.reversals},
+           {"points", r.index.size()},
+           {"x", xs},
+           {"y", ys},
+           {"model", nullptr}};
   const auto table = shaker ? std::nullopt : store.newest_table_of_campaign(run->campaign, "fot");
   if (table) {
     // Every reversal of x is kept, and a Preisach model's output depends on its input's
@@ -96,17 +103,28 @@ json preview_json(ApiContext& c, const PlanRequest& req) {
   std::unique_ptr<models::HysteresisModel> model;
   std::string source;
   if (rig.kind != "shaker") {
-    if (const auto t = reader(c.db_path).newest_table_of_rig(rig.id, "fot")) model = table_model(reader(c.db_path), t->id), source = "table #" + std::to_string(t->id);
+    if (const auto t = reader(c.db_path).newest_table_of_rig(rig.id, "fot"))
+      model = table_model(reader(c.db_path), t->id), source = "table #" + std::to_string(t->id);
     if (!model) model = std::make_unique<models::SimplifiedSmaModel>(models::table1_parameters()), source = "the simplified model (the paper's Table 1)";
   }
   const control::PlanPreview v = c.daemon.preview(req.rig, req.plan, model.get());
-  json out{{"rig", rig.name}, {"kind", db::to_string(v.kind)}, {"duration_s", v.duration_s}, {"nodes", v.nodes}, {"peak_speed_mm_s", v.peak_speed_mm_s},
-           {"samples", std::llround(v.samples)}, {"sample_rate_hz", v.sample_rate_hz}, {"time_scale", v.time_scale},
+  json out{{"rig", rig.name},
+           {"kind", db::to_string(v.kind)},
+           {"duration_s", v.duration_s},
+           {"nodes", v.nodes},
+           {"peak_speed_mm_s", v.peak_speed_mm_s},
+           {"samples", std::llround(v.samples)},
+           {"sample_rate_hz", v.sample_rate_hz},
+           {"time_scale", v.time_scale},
            // what the rig can give at its time scale: the wall time, and what is stored in rig time
-           {"wall_s", v.duration_s / v.time_scale}, {"stored_samples", std::llround(v.samples / v.time_scale)},
-           {"stored_rate_hz", v.sample_rate_hz / v.time_scale}, {"limits_applied", v.limits_applied}};
-  if (model) out["peak_force_N"] = v.peak_force_N, out["force_source"] = source, out["force_limit_N"] = v.force_limit_N;
-  else out["peak_accel_m_s2"] = v.peak_accel_m_s2;
+           {"wall_s", v.duration_s / v.time_scale},
+           {"stored_samples", std::llround(v.samples / v.time_scale)},
+           {"stored_rate_hz", v.sample_rate_hz / v.time_scale},
+           {"limits_applied", v.limits_applied}};
+  if (model)
+    out["peak_force_N"] = v.peak_force_N, out["force_source"] = source, out["force_limit_N"] = v.force_limit_N;
+  else
+    out["peak_accel_m_s2"] = v.peak_accel_m_s2;
   return out;
 }
 }  // namespace
@@ -114,12 +132,11 @@ json preview_json(ApiContext& c, const PlanRequest& req) {
 void add_loop_routes(httplib::Server& s, ApiContext& c) {
   auto cache = std::make_shared<XYCache>();
   s.Get(R"(/api/runs/(\d+)/loop)", guarded([&c, cache](const httplib::Request& req, httplib::Response& res) {
-    const auto points = static_cast<std::size_t>(query_number(req, "points", 2000, 2, 200000));
-    send_json(res, loop_json(reader(c.db_path), *cache, path_id(req), points));
-  }));
-  post_route(s, c, "/api/plans/preview", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    send_json(res, preview_json(c, decode_plan_request(body_object(req))));
-  }));
+          const auto points = static_cast<std::size_t>(query_number(req, "points", 2000, 2, 200000));
+          send_json(res, loop_json(reader(c.db_path), *cache, path_id(req), points));
+        }));
+  post_route(s, c, "/api/plans/preview",
+             guarded([&c](const httplib::Request& req, httplib::Response& res) { send_json(res, preview_json(c, decode_plan_request(body_object(req)))); }));
 }
 
 }  // namespace hystlab::web

@@ -4,9 +4,9 @@
 #include <mutex>
 #include <vector>
 
+#include "hystlab/db/signals.hpp"
 #include "hystlab/protocols/signals.hpp"
 #include "request_guard.hpp"
-#include "hystlab/db/signals.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
@@ -21,11 +21,15 @@ std::map<std::string, std::int64_t> campaigns_by_state(db::Store& store) {
 json health_json(const control::LinkHealth& h) {
   json errors = json::object();
   for (const auto& [kind, n] : h.errors) errors[kind] = n;
-  return {{"reads", h.reads}, {"writes", h.writes}, {"reconnects", h.reconnects}, {"lost_samples", h.lost_samples}, {"errors", errors},
-          {"last_transaction_us", h.last_transaction_us}, {"max_transaction_us", h.max_transaction_us},
+  return {{"reads", h.reads},
+          {"writes", h.writes},
+          {"reconnects", h.reconnects},
+          {"lost_samples", h.lost_samples},
+          {"errors", errors},
+          {"last_transaction_us", h.last_transaction_us},
+          {"max_transaction_us", h.max_transaction_us},
           {"latency_histogram_us", h.latency_histogram_us}};
 }
-
 
 // A rig by its id or its name.
 std::size_t rig_of(ApiContext& c, const std::string& key) {
@@ -68,11 +72,14 @@ std::string metrics_text(ApiContext& c) {
   metric(o, "hystlab_writer_commits_total", "counter", "Write transactions committed.");
   line("hystlab_writer_commits_total", "", static_cast<double>(w.commits));
   metric(o, "hystlab_samples_acquired_total", "counter", "Samples acquired during campaigns.");
-  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_samples_acquired_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).samples));
+  for (std::size_t k = 0; k < d.rig_count(); ++k)
+    line("hystlab_samples_acquired_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).samples));
   metric(o, "hystlab_missed_deadlines_total", "counter", "Samples not taken in time: late periods when polling, lost samples with block reads.");
-  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_missed_deadlines_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).missed_deadlines));
+  for (std::size_t k = 0; k < d.rig_count(); ++k)
+    line("hystlab_missed_deadlines_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).missed_deadlines));
   metric(o, "hystlab_late_wakeups_total", "counter", "Acquisition periods that started more than a period late.");
-  for (std::size_t k = 0; k < d.rig_count(); ++k) line("hystlab_late_wakeups_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).late_wakeups));
+  for (std::size_t k = 0; k < d.rig_count(); ++k)
+    line("hystlab_late_wakeups_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_counters(k).late_wakeups));
   metric(o, "hystlab_submission_latency_seconds", "gauge", "The newest submission's time from the call to its rig's thread taking the job.");
   for (std::size_t k = 0; k < d.rig_count(); ++k)
     if (const double s = d.rig_counters(k).submit_latency_s; s >= 0) line("hystlab_submission_latency_seconds", "rig=\"" + label(d.rig_info(k).name) + "\"", s);
@@ -139,9 +146,19 @@ struct StatusCache {
 json rig_json(const control::DaemonInterface& d, std::size_t k) {
   const control::RigInfo info = d.rig_info(k);
   const control::AcquisitionCounters live = d.rig_counters(k);
-  json j{{"id", info.id}, {"index", k}, {"name", info.name}, {"kind", info.kind}, {"description", info.description},
-         {"simulated", info.simulated}, {"campaign", live.campaign}, {"phase", live.phase}, {"samples", live.samples},
-         {"missed_deadlines", live.missed_deadlines}, {"late_wakeups", live.late_wakeups}, {"health", health_json(d.rig_health(k))}, {"sample", nullptr}};
+  json j{{"id", info.id},
+         {"index", k},
+         {"name", info.name},
+         {"kind", info.kind},
+         {"description", info.description},
+         {"simulated", info.simulated},
+         {"campaign", live.campaign},
+         {"phase", live.phase},
+         {"samples", live.samples},
+         {"missed_deadlines", live.missed_deadlines},
+         {"late_wakeups", live.late_wakeups},
+         {"health", health_json(d.rig_health(k))},
+         {"sample", nullptr}};
   const control::RigSupervision sv = d.rig_supervision(k);
   j["state"] = sv.state;
   j["latched"] = sv.latched;
@@ -151,9 +168,15 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
                    : json{{"code", sv.fault_code ? sv.fault_code : sv.latched_fault_code}, {"text", sv.fault_text}};
   const unsigned w = sv.status_word;
   namespace stb = protocols::status;
-  j["status"] = {{"word", w}, {"ready", (w & stb::ready) != 0}, {"enabled", (w & stb::enabled) != 0}, {"holding", (w & stb::holding) != 0},
-                 {"estop", (w & stb::estop) != 0}, {"limit_tripped", (w & stb::limit_tripped) != 0}, {"fault", (w & stb::fault) != 0},
-                 {"moving", (w & stb::moving) != 0}, {"known", sv.have_sample}};
+  j["status"] = {{"word", w},
+                 {"ready", (w & stb::ready) != 0},
+                 {"enabled", (w & stb::enabled) != 0},
+                 {"holding", (w & stb::holding) != 0},
+                 {"estop", (w & stb::estop) != 0},
+                 {"limit_tripped", (w & stb::limit_tripped) != 0},
+                 {"fault", (w & stb::fault) != 0},
+                 {"moving", (w & stb::moving) != 0},
+                 {"known", sv.have_sample}};
   j["resetting"] = sv.resetting;
   j["reset_refusal"] = sv.reset_refusal.empty() ? json(nullptr) : json(sv.reset_refusal);
   j["recovering"] = sv.recovering;
@@ -182,44 +205,45 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
 void add_status_routes(httplib::Server& s, ApiContext& c) {
   auto cache = std::make_shared<StatusCache>();
   s.Get("/api/status", guarded([&c, cache](const httplib::Request&, httplib::Response& res) {
-    std::lock_guard lk(cache->mu);
-    const auto now = std::chrono::steady_clock::now();
-    if (cache->body.empty() || now - cache->at > std::chrono::milliseconds(250)) {
-      json rigs = json::array();
-      for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
-        rigs.push_back({{"name", c.daemon.rig_info(k).name}, {"kind", c.daemon.rig_info(k).kind}, {"campaign", c.daemon.rig_counters(k).campaign}});
-      const control::WriterCounters w = c.daemon.writer();
-      cache->body = json{{"name", "hystlabd"}, {"version", HYSTLAB_VERSION}, {"uptime_s", c.daemon.uptime_s()},
-                         {"database", c.db_path}, {"rigs", rigs}, {"campaigns", campaigns_by_state(reader(c.db_path))},
-                         {"writer", {{"written", w.written}, {"queue_depth", w.depth}, {"dropped", w.dropped}}},
-                         {"stream_clients", c.stream_clients.load()}}
-                        .dump();
-      cache->at = now;
-    }
-    res.set_content(cache->body, "application/json");
-  }));
+          std::lock_guard lk(cache->mu);
+          const auto now = std::chrono::steady_clock::now();
+          if (cache->body.empty() || now - cache->at > std::chrono::milliseconds(250)) {
+            json rigs = json::array();
+            for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
+              rigs.push_back({{"name", c.daemon.rig_info(k).name}, {"kind", c.daemon.rig_info(k).kind}, {"campaign", c.daemon.rig_counters(k).campaign}});
+            const control::WriterCounters w = c.daemon.writer();
+            cache->body = json{{"name", "hystlabd"},
+                               {"version", HYSTLAB_VERSION},
+                               {"uptime_s", c.daemon.uptime_s()},
+                               {"database", c.db_path},
+                               {"rigs", rigs},
+                               {"campaigns", campaigns_by_state(reader(c.db_path))},
+                               {"writer", {{"written", w.written}, {"queue_depth", w.depth}, {"dropped", w.dropped}}},
+                               {"stream_clients", c.stream_clients.load()}}
+                              .dump();
+            cache->at = now;
+          }
+          res.set_content(cache->body, "application/json");
+        }));
   s.Get("/api/rigs", guarded([&c](const httplib::Request&, httplib::Response& res) {
-    json out = json::array();
-    for (std::size_t k = 0; k < c.daemon.rig_count(); ++k) out.push_back(rig_json(c.daemon, k));
-    send_json(res, out);
-  }));
-  s.Get(R"(/api/rigs/([^/]+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    send_json(res, rig_json(c.daemon, rig_of(c, req.matches[1].str())));
-  }));
+          json out = json::array();
+          for (std::size_t k = 0; k < c.daemon.rig_count(); ++k) out.push_back(rig_json(c.daemon, k));
+          send_json(res, out);
+        }));
+  s.Get(R"(/api/rigs/([^/]+))",
+        guarded([&c](const httplib::Request& req, httplib::Response& res) { send_json(res, rig_json(c.daemon, rig_of(c, req.matches[1].str()))); }));
   // The operator's e-stop and reset: straight to the rig's thread, whatever runs (or nothing).
   // recover: a load frame latched beyond its stroke, brought back into it at the safe rate.
   post_route(s, c, R"(/api/rigs/([^/]+)/(reset|estop|recover))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    const std::size_t k = rig_of(c, req.matches[1].str());
-    const std::string verb = req.matches[2].str();
-    const control::RigCommand command = verb == "reset"   ? control::RigCommand::reset
-                                        : verb == "estop" ? control::RigCommand::estop
-                                                          : control::RigCommand::recover;
-    const control::CommandOutcome o = c.daemon.rig_command(k, command);
-    send_outcome(res, json{{"rig", c.daemon.rig_info(k).name}, {"command", verb}}, o);
-  }));
-  s.Get("/metrics", guarded([&c](const httplib::Request&, httplib::Response& res) {
-    res.set_content(metrics_text(c), "text/plain; version=0.0.4");
-  }));
+               const std::size_t k = rig_of(c, req.matches[1].str());
+               const std::string verb = req.matches[2].str();
+               const control::RigCommand command = verb == "reset"   ? control::RigCommand::reset
+                                                   : verb == "estop" ? control::RigCommand::estop
+                                                                     : control::RigCommand::recover;
+               const control::CommandOutcome o = c.daemon.rig_command(k, command);
+               send_outcome(res, json{{"rig", c.daemon.rig_info(k).name}, {"command", verb}}, o);
+             }));
+  s.Get("/metrics", guarded([&c](const httplib::Request&, httplib::Response& res) { res.set_content(metrics_text(c), "text/plain; version=0.0.4"); }));
 }
 
 }  // namespace hystlab::web

@@ -49,9 +49,14 @@ double jump_threshold(const std::string& plan_text) {
 
 json resonance_json(const std::optional<models::Resonance>& r) {
   if (!r) return nullptr;
-  return {{"frequency_hz", r->frequency_hz}, {"peak_ratio", r->peak_ratio}, {"lower_hz", r->lower_hz > 0 ? json(r->lower_hz) : json()},
-          {"upper_hz", r->upper_hz > 0 ? json(r->upper_hz) : json()}, {"bandwidth_hz", r->bandwidth_hz > 0 ? json(r->bandwidth_hz) : json()},
-          {"q", r->q > 0 ? json(r->q) : json()}, {"at_edge", r->at_edge}, {"resolved", r->resolved}};
+  return {{"frequency_hz", r->frequency_hz},
+          {"peak_ratio", r->peak_ratio},
+          {"lower_hz", r->lower_hz > 0 ? json(r->lower_hz) : json()},
+          {"upper_hz", r->upper_hz > 0 ? json(r->upper_hz) : json()},
+          {"bandwidth_hz", r->bandwidth_hz > 0 ? json(r->bandwidth_hz) : json()},
+          {"q", r->q > 0 ? json(r->q) : json()},
+          {"at_edge", r->at_edge},
+          {"resolved", r->resolved}};
 }
 
 // points: point_json of each row, in the same order (each row's detail is parsed once).
@@ -66,18 +71,37 @@ json report_json(const std::vector<db::TransmissibilityInfo>& rows, const json& 
   const models::SweepReport r = models::analyse_sweep(pts, threshold);
   json curves = json::array(), jumps = json::array();
   for (const models::SweepCurve& c : r.curves)
-    curves.push_back({{"amplitude_mm", c.amplitude_mm}, {"direction", c.up ? "up" : "down"}, {"points", c.points.size()},
-                      {"resonance", resonance_json(c.resonance)}});
+    curves.push_back(
+        {{"amplitude_mm", c.amplitude_mm}, {"direction", c.up ? "up" : "down"}, {"points", c.points.size()}, {"resonance", resonance_json(c.resonance)}});
   for (const models::AmplitudeJumps& a : r.jumps)
     for (const models::Jump& j : a.jumps)
-      jumps.push_back({{"amplitude_mm", a.amplitude_mm}, {"lo_hz", j.lo_hz}, {"hi_hz", j.hi_hz}, {"max_difference", j.max_difference},
-                       {"up_jump_hz", j.up_jump_hz}, {"down_jump_hz", j.down_jump_hz}});
+      jumps.push_back({{"amplitude_mm", a.amplitude_mm},
+                       {"lo_hz", j.lo_hz},
+                       {"hi_hz", j.hi_hz},
+                       {"max_difference", j.max_difference},
+                       {"up_jump_hz", j.up_jump_hz},
+                       {"down_jump_hz", j.down_jump_hz}});
   return {{"curves", curves}, {"jumps", jumps}, {"compared", r.jumps.size()}};
 }
 
-constexpr const char* kCsvColumns[] = {"k", "pass", "amplitude_mm", "direction", "frequency_hz", "drive_mm", "base_amplitude_mm", "base_phase_rad",
-                                       "mass_amplitude_mm", "mass_phase_rad", "ratio", "phase_rad", "thd", "control_error_pct", "band",
-                                       "settle_cycles", "predicted_ratio", "predicted_phase_rad"};
+constexpr const char* kCsvColumns[] = {"k",
+                                       "pass",
+                                       "amplitude_mm",
+                                       "direction",
+                                       "frequency_hz",
+                                       "drive_mm",
+                                       "base_amplitude_mm",
+                                       "base_phase_rad",
+                                       "mass_amplitude_mm",
+                                       "mass_phase_rad",
+                                       "ratio",
+                                       "phase_rad",
+                                       "thd",
+                                       "control_error_pct",
+                                       "band",
+                                       "settle_cycles",
+                                       "predicted_ratio",
+                                       "predicted_phase_rad"};
 
 std::string points_csv(const std::vector<db::TransmissibilityInfo>& rows) {
   std::string out;
@@ -89,8 +113,10 @@ std::string points_csv(const std::vector<db::TransmissibilityInfo>& rows) {
     for (const char* c : kCsvColumns) {
       if (c != kCsvColumns[0]) line += ",";
       const json& v = p.contains(c) ? p[c] : json();
-      if (v.is_string()) line += v.get<std::string>();
-      else if (v.is_number()) line += csv_number(v.get<double>());
+      if (v.is_string())
+        line += v.get<std::string>();
+      else if (v.is_number())
+        line += csv_number(v.get<double>());
     }
     out += line + "\n";
   }
@@ -104,30 +130,33 @@ json sweep_json(db::Store& store, const db::CampaignRow& row) {
   json points = json::array();
   for (const db::TransmissibilityInfo& t : rows) points.push_back(point_json(t));
   const bool any_prediction = std::any_of(rows.begin(), rows.end(), [](const auto& t) { return std::isfinite(t.predicted_ratio); });
-  return {{"campaign", row.id}, {"jump_threshold", threshold}, {"points", points}, {"measured", report_json(rows, points, threshold, false)},
+  return {{"campaign", row.id},
+          {"jump_threshold", threshold},
+          {"points", points},
+          {"measured", report_json(rows, points, threshold, false)},
           {"predicted", any_prediction ? report_json(rows, points, threshold, true) : json()}};
 }
 
 void add_sweep_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/campaigns/(\d+)/transmissibility)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    const auto row = campaign_or_404(store, path_id(req));
-    json out = json::array();
-    for (const db::TransmissibilityInfo& t : store.transmissibility(row.id)) out.push_back(point_json(t));
-    send_json(res, out);
-  }));
+          auto& store = reader(c.db_path);
+          const auto row = campaign_or_404(store, path_id(req));
+          json out = json::array();
+          for (const db::TransmissibilityInfo& t : store.transmissibility(row.id)) out.push_back(point_json(t));
+          send_json(res, out);
+        }));
   s.Get(R"(/api/campaigns/(\d+)/sweep)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    const auto row = campaign_or_404(store, path_id(req));
-    res.set_header("Content-Disposition", "inline; filename=\"sweep-" + std::to_string(row.id) + ".json\"");
-    send_json(res, sweep_json(store, row));
-  }));
+          auto& store = reader(c.db_path);
+          const auto row = campaign_or_404(store, path_id(req));
+          res.set_header("Content-Disposition", "inline; filename=\"sweep-" + std::to_string(row.id) + ".json\"");
+          send_json(res, sweep_json(store, row));
+        }));
   s.Get(R"(/api/campaigns/(\d+)/sweep\.csv)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-    auto& store = reader(c.db_path);
-    const auto row = campaign_or_404(store, path_id(req));
-    res.set_header("Content-Disposition", "attachment; filename=\"sweep-" + std::to_string(row.id) + ".csv\"");
-    res.set_content(points_csv(store.transmissibility(row.id)), "text/csv");
-  }));
+          auto& store = reader(c.db_path);
+          const auto row = campaign_or_404(store, path_id(req));
+          res.set_header("Content-Disposition", "attachment; filename=\"sweep-" + std::to_string(row.id) + ".csv\"");
+          res.set_content(points_csv(store.transmissibility(row.id)), "text/csv");
+        }));
 }
 
 }  // namespace hystlab::web

@@ -31,8 +31,8 @@ json warnings_of(const json& q) {
     w.push_back(std::to_string(err) + " I/O errors (" + std::to_string(count(q, "timeouts")) + " timeouts, " + std::to_string(count(q, "reconnects")) +
                 " reconnects)");
   if (const auto gaps = count(q, "gaps"))
-    w.push_back(std::to_string(gaps) + (gaps == 1 ? " hole" : " holes") + " in the time axis: longest " + round_s(q.value("longest_gap_s", 0.0)) +
-                ", " + round_s(q.value("gap_total_s", 0.0)) + " in all");
+    w.push_back(std::to_string(gaps) + (gaps == 1 ? " hole" : " holes") + " in the time axis: longest " + round_s(q.value("longest_gap_s", 0.0)) + ", " +
+                round_s(q.value("gap_total_s", 0.0)) + " in all");
   // A simulator faster than real time gives the plan's rate in wall time, time_scale times less
   // in rig time: expected, said beside the rate, and no warning unless that was not kept either.
   const double rate = q.value("rate_hz", 0.0), asked = q.value("requested_rate_hz", 0.0);
@@ -51,13 +51,26 @@ json parse_or_text(const std::string& s) {
 }
 
 json node_json(const db::NodeInfo& n) {
-  return {{"id", n.id}, {"campaign", n.campaign}, {"run", n.run}, {"alpha", n.alpha}, {"beta", n.beta}, {"force_alpha", n.force_alpha},
-          {"force_alpha_beta", n.force_alpha_beta}, {"F", n.force_alpha - n.force_alpha_beta}, {"t", n.t}};
+  return {{"id", n.id},
+          {"campaign", n.campaign},
+          {"run", n.run},
+          {"alpha", n.alpha},
+          {"beta", n.beta},
+          {"force_alpha", n.force_alpha},
+          {"force_alpha_beta", n.force_alpha_beta},
+          {"F", n.force_alpha - n.force_alpha_beta},
+          {"t", n.t}};
 }
 
 json table_json(const db::TableInfo& t) {
-  return {{"id", t.id}, {"campaign", t.campaign ? json(*t.campaign) : json(nullptr)}, {"run", t.run ? json(*t.run) : json(nullptr)},
-          {"method", t.method}, {"n", t.n}, {"range_mm", {t.range_lo, t.range_hi}}, {"created_at", t.created_at}, {"accuracy", parse_or_text(t.accuracy_json)}};
+  return {{"id", t.id},
+          {"campaign", t.campaign ? json(*t.campaign) : json(nullptr)},
+          {"run", t.run ? json(*t.run) : json(nullptr)},
+          {"method", t.method},
+          {"n", t.n},
+          {"range_mm", {t.range_lo, t.range_hi}},
+          {"created_at", t.created_at},
+          {"accuracy", parse_or_text(t.accuracy_json)}};
 }
 
 json run_quality(db::Store& store, std::int64_t campaign, std::int64_t run) {

@@ -4,10 +4,14 @@ namespace hystlab::control {
 
 const char* to_string(CampaignCommand c) noexcept {
   switch (c) {
-    case CampaignCommand::pause: return "pause";
-    case CampaignCommand::resume: return "resume";
-    case CampaignCommand::abort: return "abort";
-    case CampaignCommand::estop: return "estop";
+    case CampaignCommand::pause:
+      return "pause";
+    case CampaignCommand::resume:
+      return "resume";
+    case CampaignCommand::abort:
+      return "abort";
+    case CampaignCommand::estop:
+      return "estop";
   }
   return "?";
 }
@@ -34,11 +38,16 @@ std::vector<CampaignCommand> commands_for(db::CampaignState s) {
 const char* to_string(CommandOutcome::Result r) noexcept {
   using R = CommandOutcome::Result;
   switch (r) {
-    case R::done: return "done";
-    case R::pending: return "pending";
-    case R::conflict: return "conflict";
-    case R::unreachable: return "unreachable";
-    case R::refused: return "refused";
+    case R::done:
+      return "done";
+    case R::pending:
+      return "pending";
+    case R::conflict:
+      return "conflict";
+    case R::unreachable:
+      return "unreachable";
+    case R::refused:
+      return "refused";
   }
   return "?";
 }

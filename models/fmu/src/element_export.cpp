@@ -19,8 +19,10 @@ ExportedFile export_element(std::string_view document, std::string_view format, 
   const bool looks_table = j.is_object() && j.contains("format");
   const bool table = kind ? *kind == models::ElementKind::Table : looks_table;
   if (table != looks_table) {  // not the kind named: its parser says what is missing
-    if (table) (void)models::table_from_json(document);
-    else (void)models::params_from_json(document);
+    if (table)
+      (void)models::table_from_json(document);
+    else
+      (void)models::params_from_json(document);
   }
   if (format == "fmu") return {fmu_archive(document, FmuOptions{name, created}), "application/zip", true};
   if (table) {

@@ -19,11 +19,21 @@ std::string xml_escaped(std::string_view s) {
   std::string out;
   for (const char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\n': out += "&#10;"; break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\n':
+        out += "&#10;";
+        break;
       default:
         if (static_cast<unsigned char>(c) >= 0x20 || c == '\t') out.push_back(c);  // XML 1.0 has no other control characters
     }
@@ -47,8 +57,8 @@ std::string element_summary(const models::Element& e) {
 std::string variables_xml(const models::Element& e) {
   std::string x;
   for (const Variable& v : kVariables) {
-    x += "    <ScalarVariable name=\"" + std::string(v.name) + "\" valueReference=\"" + std::to_string(v.vr) + "\" causality=\"" +
-         std::string(v.causality) + "\" variability=\"" + std::string(v.variability) + "\"";
+    x += "    <ScalarVariable name=\"" + std::string(v.name) + "\" valueReference=\"" + std::to_string(v.vr) + "\" causality=\"" + std::string(v.causality) +
+         "\" variability=\"" + std::string(v.variability) + "\"";
     if (v.causality == "parameter") x += " initial=\"exact\"";
     x += " description=\"" + xml_escaped(v.description) + "\">\n      <" + (v.type == VarType::Real ? "Real" : "Integer");
     if (!v.unit.empty()) x += " unit=\"" + std::string(v.unit) + "\"";
@@ -62,9 +72,8 @@ std::string variables_xml(const models::Element& e) {
 
 std::string model_description(const models::Element& e, const std::string& guid, const FmuOptions& o) {
   const std::string name = !o.model_name.empty() ? o.model_name : e.kind == models::ElementKind::Table ? "hystlab_table" : "hystlab_sma";
-  std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription fmiVersion=\"2.0\" modelName=\"" + xml_escaped(name) +
-                  "\" guid=\"" + guid + "\" description=\"" + xml_escaped("hysteresis element: " + element_summary(e)) +
-                  "\" generationTool=\"hystlab " HYSTLAB_VERSION "\"";
+  std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription fmiVersion=\"2.0\" modelName=\"" + xml_escaped(name) + "\" guid=\"" + guid +
+                  "\" description=\"" + xml_escaped("hysteresis element: " + element_summary(e)) + "\" generationTool=\"hystlab " HYSTLAB_VERSION "\"";
   if (!o.created.empty()) x += " generationDateAndTime=\"" + xml_escaped(o.created) + "\"";
   x += " variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">\n";
   x += "  <CoSimulation modelIdentifier=\"" + std::string(kModelIdentifier) +
@@ -89,7 +98,8 @@ std::string model_description(const models::Element& e, const std::string& guid,
 
 std::string documentation(const models::Element& e, const std::string& guid) {
   return "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>hystlab element</title></head><body>\n<h1>A calibrated hysteresis element</h1>\n<p>" +
-         xml_escaped(element_summary(e)) + ". GUID " + guid + ", written by hystlab " HYSTLAB_VERSION
+         xml_escaped(element_summary(e)) + ". GUID " + guid +
+         ", written by hystlab " HYSTLAB_VERSION
          ".</p>\n<h2>Variables</h2>\n<ul>\n<li><b>x</b> (input): the displacement; the model sees <i>x &times; x_scale_mm + x_offset_mm</i> mm "
          "(x_scale_mm = 1000 takes x in metres).</li>\n<li><b>F</b> (output, N): <i>sign &times; force_scale &times;</i> the calibrated force. F "
          "depends on x directly: read after fmi2SetReal, it is the force at the new input without taking it into the memory; fmi2DoStep takes "
@@ -103,12 +113,12 @@ std::string documentation(const models::Element& e, const std::string& guid) {
          "</body></html>\n";
 }
 
-const char* kLicence =
-    "This FMU was written by hystlab " HYSTLAB_VERSION ".\n\n"
-    "binaries/: the hystlab element runtime, built from the hystlab sources. It links the C++ standard library of the\n"
-    "system it was built on (libstdc++, GCC Runtime Library Exception).\n"
-    "resources/element.json: the calibrated data, measured or derived by the lab that exported it; its provenance is\n"
-    "inside the file. Ask that lab before passing it on.\n";
+const char* kLicence = "This FMU was written by hystlab " HYSTLAB_VERSION
+                       ".\n\n"
+                       "binaries/: the hystlab element runtime, built from the hystlab sources. It links the C++ standard library of the\n"
+                       "system it was built on (libstdc++, GCC Runtime Library Exception).\n"
+                       "resources/element.json: the calibrated data, measured or derived by the lab that exported it; its provenance is\n"
+                       "inside the file. Ask that lab before passing it on.\n";
 }  // namespace
 
 std::string fmu_archive(std::string_view element_json, const FmuOptions& options) {

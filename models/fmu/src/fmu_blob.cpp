@@ -13,7 +13,8 @@ asm(".pushsection .rodata\n"
     ".globl hystlab_fmu_runtime_start\n"
     ".hidden hystlab_fmu_runtime_start\n"
     "hystlab_fmu_runtime_start:\n"
-    ".incbin \"" HYSTLAB_FMU_RUNTIME_PATH "\"\n"
+    ".incbin \"" HYSTLAB_FMU_RUNTIME_PATH
+    "\"\n"
     ".globl hystlab_fmu_runtime_end\n"
     ".hidden hystlab_fmu_runtime_end\n"
     "hystlab_fmu_runtime_end:\n"
@@ -23,7 +24,5 @@ extern "C" const char hystlab_fmu_runtime_start[];
 extern "C" const char hystlab_fmu_runtime_end[];
 
 namespace hystlab::fmu {
-std::string_view fmu_runtime_binary() {
-  return {hystlab_fmu_runtime_start, static_cast<std::size_t>(hystlab_fmu_runtime_end - hystlab_fmu_runtime_start)};
-}
+std::string_view fmu_runtime_binary() { return {hystlab_fmu_runtime_start, static_cast<std::size_t>(hystlab_fmu_runtime_end - hystlab_fmu_runtime_start)}; }
 }  // namespace hystlab::fmu

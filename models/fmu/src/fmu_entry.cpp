@@ -66,8 +66,8 @@ const char* fmi2GetVersion(void) { return "2.0"; }
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t, const fmi2String[]) {
   return guard(c, "fmi2SetDebugLogging", [&](FmuInstance& i) { return i.set_logging(on != fmi2False), fmi2OK; });
 }
-fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
-                              const fmi2CallbackFunctions* functions, fmi2Boolean, fmi2Boolean logging) {
+fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources, const fmi2CallbackFunctions* functions, fmi2Boolean,
+                              fmi2Boolean logging) {
   fmi2CallbackFunctions cb{};
   if (functions) cb = *functions;
   const std::string who = name ? name : "";
@@ -143,8 +143,10 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference[], size_t n, 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* s) {
   return guard(c, "fmi2GetFMUstate", [&](FmuInstance& i) {
     if (!s) throw FmuError("a null FMUstate pointer");
-    if (*s) i.owned(*s) = i.save();  // a state this instance gave, to be overwritten
-    else *s = i.keep(i.save());
+    if (*s)
+      i.owned(*s) = i.save();  // a state this instance gave, to be overwritten
+    else
+      *s = i.keep(i.save());
     return fmi2OK;
   });
 }
@@ -185,12 +187,10 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size
   });
 }
 
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference[], size_t, const fmi2ValueReference[], size_t,
-                                        const fmi2Real[], fmi2Real[]) {
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference[], size_t, const fmi2ValueReference[], size_t, const fmi2Real[], fmi2Real[]) {
   return not_provided(c, "fmi2GetDirectionalDerivative");
 }
-fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer order[],
-                                       const fmi2Real v[]) {
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer order[], const fmi2Real v[]) {
   return guard(c, "fmi2SetRealInputDerivatives", [&](FmuInstance& i) {
     if (!arrays_ok(i, "fmi2SetRealInputDerivatives", n, vr, v) || (n > 0 && !order)) return fmi2Error;
     for (size_t k = 0; k < n; ++k) i.set_input_derivative(vr[k], order[k], v[k]);
@@ -206,9 +206,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean) {
   return do_step_checked(c, t, h);
 }
 fmi2Status fmi2CancelStep(fmi2Component c) { return not_provided(c, "fmi2CancelStep (doStep never runs asynchronously)"); }
-fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind, fmi2Status*) {
-  return not_provided(c, "fmi2GetStatus (doStep never returns fmi2Pending)");
-}
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind, fmi2Status*) { return not_provided(c, "fmi2GetStatus (doStep never returns fmi2Pending)"); }
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind kind, fmi2Real* v) {
   return guard(c, "fmi2GetRealStatus", [&](FmuInstance& i) {
     if (kind != fmi2LastSuccessfulTime || !v) throw FmuError("only fmi2LastSuccessfulTime is provided");

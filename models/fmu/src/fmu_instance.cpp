@@ -58,10 +58,14 @@ const Variable& variable(fmi2ValueReference vr, VarType type) {
 std::string resource_folder(const char* location) {
   if (!location || !*location) throw FmuError("no resource location was given (fmuResourceLocation is empty)");
   std::string s = location;
-  if (s.rfind("file://localhost/", 0) == 0) s = s.substr(16);
-  else if (s.rfind("file:///", 0) == 0) s = s.substr(7);
-  else if (s.rfind("file:/", 0) == 0) s = s.substr(5);
-  else if (s.find("://") != std::string::npos) throw FmuError("resource location '" + std::string(location) + "' is not a file: URI");
+  if (s.rfind("file://localhost/", 0) == 0)
+    s = s.substr(16);
+  else if (s.rfind("file:///", 0) == 0)
+    s = s.substr(7);
+  else if (s.rfind("file:/", 0) == 0)
+    s = s.substr(5);
+  else if (s.find("://") != std::string::npos)
+    throw FmuError("resource location '" + std::string(location) + "' is not a file: URI");
   s = percent_decoded(s);
   while (s.size() > 1 && s.back() == '/') s.pop_back();
   return s;
@@ -131,11 +135,20 @@ void FmuInstance::set_real(fmi2ValueReference vr, double v) {
   if (mode_ == Mode::Terminated) throw FmuError(std::string(var.name) + ": the instance is terminated");
   if (!std::isfinite(v)) throw FmuError(std::string(var.name) + ": " + text(v) + " is not a finite number");
   switch (vr) {
-    case kX: x_ = v; return;
-    case kXScale: require_parameters_settable("x_scale_mm"), x_scale_ = v; return;
-    case kXOffset: require_parameters_settable("x_offset_mm"), x_offset_ = v; return;
-    case kForceScale: require_parameters_settable("force_scale"), force_scale_ = v, refresh(); return;
-    default: throw FmuError(std::string(var.name) + " is an output: it cannot be set");
+    case kX:
+      x_ = v;
+      return;
+    case kXScale:
+      require_parameters_settable("x_scale_mm"), x_scale_ = v;
+      return;
+    case kXOffset:
+      require_parameters_settable("x_offset_mm"), x_offset_ = v;
+      return;
+    case kForceScale:
+      require_parameters_settable("force_scale"), force_scale_ = v, refresh();
+      return;
+    default:
+      throw FmuError(std::string(var.name) + " is an output: it cannot be set");
   }
 }
 
@@ -153,10 +166,14 @@ double FmuInstance::get_real(fmi2ValueReference vr) const {
     return force(element_.model->output());
   (void)variable(vr, VarType::Real);
   switch (vr) {
-    case kX: return x_;
-    case kXScale: return x_scale_;
-    case kXOffset: return x_offset_;
-    case kForceScale: return force_scale_;
+    case kX:
+      return x_;
+    case kXScale:
+      return x_scale_;
+    case kXOffset:
+      return x_offset_;
+    case kForceScale:
+      return force_scale_;
     default:  // F: direct feedthrough; an input set since the last step is read without being taken
       return force(x_ == committed_x_ ? element_.model->output() : element_.model->peek(to_mm(x_)));
   }
@@ -240,8 +257,8 @@ FmuInstance::Saved FmuInstance::save() const {
 
 void FmuInstance::restore(const Saved& s) {
   if (s.x_scale != x_scale_ || s.x_offset != x_offset_ || s.force_scale != force_scale_ || s.sign != sign_)
-    throw FmuError("the state was saved with other parameter values (x_scale_mm " + text(s.x_scale) + ", x_offset_mm " + text(s.x_offset) +
-                   ", force_scale " + text(s.force_scale) + ", sign " + std::to_string(s.sign) + ") than this instance's");
+    throw FmuError("the state was saved with other parameter values (x_scale_mm " + text(s.x_scale) + ", x_offset_mm " + text(s.x_offset) + ", force_scale " +
+                   text(s.force_scale) + ", sign " + std::to_string(s.sign) + ") than this instance's");
   element_.model = s.model->clone();
   table_ = dynamic_cast<models::PreisachModel*>(element_.model.get());
   time_ = s.time;
@@ -290,8 +307,8 @@ FmuInstance::Saved FmuInstance::deserialize(std::span<const char> bytes) const {
   for (std::size_t k = 0; k < kInstanceNumbers; ++k)  // the input taken is NaN before initialization ends
     if (!std::isfinite(n[k]) && !(k == 2 && std::isnan(n[k]))) throw FmuError("FMU state: value " + std::to_string(k) + " is not a finite number");
   if (n[5] != x_scale_ || n[6] != x_offset_ || n[7] != force_scale_ || n[8] != static_cast<double>(sign_))
-    throw FmuError("FMU state: saved with other parameter values (x_scale_mm " + text(n[5]) + ", x_offset_mm " + text(n[6]) + ", force_scale " +
-                   text(n[7]) + ", sign " + text(n[8]) + ") than this instance's");
+    throw FmuError("FMU state: saved with other parameter values (x_scale_mm " + text(n[5]) + ", x_offset_mm " + text(n[6]) + ", force_scale " + text(n[7]) +
+                   ", sign " + text(n[8]) + ") than this instance's");
   Saved s{element_.model->clone(), n[0], n[1], n[2], n[3], n[4], n[5], n[6], n[7], sign_};
   try {
     s.model->restore_state(std::span<const double>(r.numbers).subspan(kInstanceNumbers));

@@ -109,14 +109,14 @@ class FmuInstance {
   models::PreisachModel* table_ = nullptr;
   Mode mode_ = Mode::Instantiated;
   double time_ = 0.0;
-  double x_ = 0.0;               // the input as set (input units)
-  double committed_x_ = 0.0;     // the input the model was last driven to (input units)
-  double d1_ = 0.0, d2_ = 0.0;   // input derivatives for the next step (per s, per s^2)
+  double x_ = 0.0;              // the input as set (input units)
+  double committed_x_ = 0.0;    // the input the model was last driven to (input units)
+  double d1_ = 0.0, d2_ = 0.0;  // input derivatives for the next step (per s, per s^2)
   double x_scale_ = 1.0, x_offset_ = 0.0, force_scale_ = 1.0;
   int sign_ = 1;
-  bool plain_ = false;     // stepping, no input derivatives: try_step may take the step
-  double gain_ = 1.0;      // sign * force_scale
-  double force_ = 0.0;     // F at the committed input
+  bool plain_ = false;  // stepping, no input derivatives: try_step may take the step
+  double gain_ = 1.0;   // sign * force_scale
+  double force_ = 0.0;  // F at the committed input
   bool warned_saturation_ = false;
   std::unordered_map<const void*, std::unique_ptr<Saved>> states_;
 };

@@ -60,8 +60,8 @@ void ZipWriter::add(std::string_view name, std::string_view data, std::uint32_t 
 std::string ZipWriter::finish() {
   const std::uint32_t dir_start = checked32(out_.size(), "the archive");
   for (const Entry& e : entries_) {
-    u32(out_, 0x02014b50U);    // central directory header
-    u16(out_, (3U << 8) | 20); // made by: Unix, 2.0 (the mode below is Unix's)
+    u32(out_, 0x02014b50U);     // central directory header
+    u16(out_, (3U << 8) | 20);  // made by: Unix, 2.0 (the mode below is Unix's)
     u16(out_, 20);
     u16(out_, 0);
     u16(out_, 0);
@@ -71,10 +71,10 @@ std::string ZipWriter::finish() {
     u32(out_, e.size);
     u32(out_, e.size);
     u16(out_, static_cast<std::uint32_t>(e.name.size()));
-    u16(out_, 0);  // extra
-    u16(out_, 0);  // comment
-    u16(out_, 0);  // disk
-    u16(out_, 0);  // internal attributes
+    u16(out_, 0);                          // extra
+    u16(out_, 0);                          // comment
+    u16(out_, 0);                          // disk
+    u16(out_, 0);                          // internal attributes
     u32(out_, (0100000U | e.mode) << 16);  // external: a regular file with its permission bits
     u32(out_, e.offset);
     out_ += e.name;

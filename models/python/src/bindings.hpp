@@ -46,7 +46,7 @@ struct Params {
 // read as the CLI's.
 [[nodiscard]] std::string read_file(const fs::path& path);
 void write_file(const fs::path& path, const std::string& text);  // atomically: beside it, then renamed
-[[nodiscard]] std::string format_number(double v);                // shortest text that reads back exactly
+[[nodiscard]] std::string format_number(double v);               // shortest text that reads back exactly
 [[nodiscard]] std::string now_iso8601();
 
 // JSON <-> Python through the json module: the documents are small, and this keeps one notion of

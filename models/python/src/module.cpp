@@ -12,12 +12,17 @@ namespace {
 
 PyObject* os_error_type(int code) {
   switch (code) {
-    case ENOENT: return PyExc_FileNotFoundError;
+    case ENOENT:
+      return PyExc_FileNotFoundError;
     case EACCES:
-    case EPERM: return PyExc_PermissionError;
-    case EISDIR: return PyExc_IsADirectoryError;
-    case ENOTDIR: return PyExc_NotADirectoryError;
-    default: return PyExc_OSError;
+    case EPERM:
+      return PyExc_PermissionError;
+    case EISDIR:
+      return PyExc_IsADirectoryError;
+    case ENOTDIR:
+      return PyExc_NotADirectoryError;
+    default:
+      return PyExc_OSError;
   }
 }
 

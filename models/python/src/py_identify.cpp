@@ -52,8 +52,7 @@ models::Grid grid_of(const OptRange& range, const std::optional<int>& n, const O
   return refinement ? refine(lo, hi, sub, *refinement) : models::Grid::make(lo, hi, sub);
 }
 
-Table identify_virtual(const Params& p, const OptRange& range, const std::optional<int>& n, const OptNumbers& refinement,
-                       const OptNumbers& nodes) {
+Table identify_virtual(const Params& p, const OptRange& range, const std::optional<int>& n, const OptNumbers& refinement, const OptNumbers& nodes) {
   const models::Grid g = grid_of(range, n, refinement, nodes, 2000);
   models::TableProvenance prov;
   prov.created = now_iso8601();
@@ -69,8 +68,8 @@ Table identify_virtual(const Params& p, const OptRange& range, const std::option
   return make_table(std::move(t), std::move(prov));
 }
 
-py::object identify_from_nodes(const py::handle& alpha, const py::handle& beta, const py::handle& fa, const py::handle& fab,
-                               std::optional<double> noise, const std::string& origin, bool details) {
+py::object identify_from_nodes(const py::handle& alpha, const py::handle& beta, const py::handle& fa, const py::handle& fab, std::optional<double> noise,
+                               const std::string& origin, bool details) {
   const auto a = finite_vector(alpha, "alpha_mm"), b = finite_vector(beta, "beta_mm");
   const auto f1 = finite_vector(fa, "force_alpha_N"), f2 = finite_vector(fab, "force_alpha_beta_N");
   if (b.size() != a.size() || f1.size() != a.size() || f2.size() != a.size())
@@ -81,25 +80,23 @@ py::object identify_from_nodes(const py::handle& alpha, const py::handle& beta, 
   for (std::size_t k = 0; k < a.size(); ++k) fot.push_back(models::FotNode{a[k], b[k], f1[k], f2[k]});
   const models::FotIdentification id = models::identify_from_nodes(fot, noise.value_or(-1.0));
   models::TableProvenance prov{"measured FOT nodes", "fot", now_iso8601(), origin, nlohmann::json::object()};
-  prov.extra = {{"nodes", id.node_count},
-                {"drift_max_spread_N", id.drift.max_spread},
-                {"drift_pooled_std_N", id.drift.pooled_std},
-                {"violations", id.violations.size()}};
+  prov.extra = {
+      {"nodes", id.node_count}, {"drift_max_spread_N", id.drift.max_spread}, {"drift_pooled_std_N", id.drift.pooled_std}, {"violations", id.violations.size()}};
   Table table = make_table(id.table, std::move(prov));
   if (!details) return py::cast(table);
   py::list violations;
   for (const auto& c : id.violations) violations.append(py::make_tuple(c.p, c.q, c.weight));
   py::dict d;
   d["nodes"] = id.node_count;
-  d["drift"] = py::dict(py::arg("max_spread_N") = id.drift.max_spread, py::arg("pooled_std_N") = id.drift.pooled_std,
-                        py::arg("worst_row") = id.drift.worst_row, py::arg("repeated_rows") = id.drift.repeated_rows);
+  d["drift"] = py::dict(py::arg("max_spread_N") = id.drift.max_spread, py::arg("pooled_std_N") = id.drift.pooled_std, py::arg("worst_row") = id.drift.worst_row,
+                        py::arg("repeated_rows") = id.drift.repeated_rows);
   d["violation_threshold_N"] = id.violation_threshold;
   d["violations"] = violations;
   return py::make_tuple(table, d);
 }
 
-Table fit(const py::handle& x, const py::handle& f, const std::optional<int>& n, const OptRange& range, const OptNumbers& refinement,
-          const OptNumbers& nodes, const std::string& prior, std::optional<double> lambda, int folds, const std::string& origin) {
+Table fit(const py::handle& x, const py::handle& f, const std::optional<int>& n, const OptRange& range, const OptNumbers& refinement, const OptNumbers& nodes,
+          const std::string& prior, std::optional<double> lambda, int folds, const std::string& origin) {
   const auto xv = finite_vector(x, "x"), fv = finite_vector(f, "f");
   models::PreisachFitOptions fo;
   models::Grid grid;
@@ -167,8 +164,7 @@ py::object compare(const py::handle& x, const py::handle& ref, const py::handle&
   return json_to_py(j);
 }
 
-py::object loops(const py::handle& x, const py::handle& f, const std::vector<double>& plateaus, double reversal_fraction,
-                 double min_span_fraction) {
+py::object loops(const py::handle& x, const py::handle& f, const std::vector<double>& plateaus, double reversal_fraction, double min_span_fraction) {
   const auto xv = finite_vector(x, "x"), fv = finite_vector(f, "f");
   models::LoopOptions lo;
   lo.plateau_at_mm = plateaus;
@@ -184,33 +180,38 @@ void bind_identify(py::module_& m) {
   m.def("identify_virtual", &identify_virtual, arg("params"), py::kw_only(), arg("range") = py::none(), arg("subdivisions") = py::none(),
         arg("refine") = py::none(), arg("nodes") = py::none(),
         "The table of the simplified model from a virtual FOT campaign (hystlab identify --model simplified).");
-  m.def("identify_from_nodes", &identify_from_nodes, arg("alpha_mm"), arg("beta_mm"), arg("force_alpha_N"), arg("force_alpha_beta_N"),
-        py::kw_only(), arg("noise") = py::none(), arg("origin") = "hystlab Python module", arg("details") = false,
+  m.def("identify_from_nodes", &identify_from_nodes, arg("alpha_mm"), arg("beta_mm"), arg("force_alpha_N"), arg("force_alpha_beta_N"), py::kw_only(),
+        arg("noise") = py::none(), arg("origin") = "hystlab Python module", arg("details") = false,
         "A table from measured FOT nodes (hystlab identify --fot); details=True also returns the drift and violations.");
-  m.def("fit", &fit, arg("x"), arg("f"), py::kw_only(), arg("subdivisions") = py::none(), arg("range") = py::none(),
-        arg("refine") = py::none(), arg("nodes") = py::none(), arg("prior") = "auto", arg("lambda_") = py::none(), arg("folds") = 4,
-        arg("origin") = "hystlab Python module", "The least-squares table of a displacement/force record (hystlab fit).");
-  m.def("calibrate", &calibrate, arg("x"), arg("f"), py::kw_only(), arg("initial") = py::none(), arg("temperature") = py::none(),
-        arg("clausius") = py::none(), arg("origin") = "hystlab Python module", arg("details") = false,
-        "Simplified-model parameters from one measured loop (hystlab calibrate).");
+  m.def("fit", &fit, arg("x"), arg("f"), py::kw_only(), arg("subdivisions") = py::none(), arg("range") = py::none(), arg("refine") = py::none(),
+        arg("nodes") = py::none(), arg("prior") = "auto", arg("lambda_") = py::none(), arg("folds") = 4, arg("origin") = "hystlab Python module",
+        "The least-squares table of a displacement/force record (hystlab fit).");
+  m.def("calibrate", &calibrate, arg("x"), arg("f"), py::kw_only(), arg("initial") = py::none(), arg("temperature") = py::none(), arg("clausius") = py::none(),
+        arg("origin") = "hystlab Python module", arg("details") = false, "Simplified-model parameters from one measured loop (hystlab calibrate).");
 }
 
 void bind_measures(py::module_& m) {
   using py::arg;
   m.def("compare", &compare, arg("x"), arg("reference"), arg("model"),
         "Accuracy of model forces against reference forces, overall and per branch (hystlab compare).");
-  m.def("path_work", [](const py::handle& x, const py::handle& f) {
-          const auto xv = finite_vector(x, "x"), fv = finite_vector(f, "f");
-          if (xv.size() != fv.size()) throw std::invalid_argument("x and f must have the same length");
-          return models::path_work(xv, fv);
-        }, arg("x"), arg("f"), "Trapezoidal ∫ f dx along the path, N·mm.");
+  m.def(
+      "path_work",
+      [](const py::handle& x, const py::handle& f) {
+        const auto xv = finite_vector(x, "x"), fv = finite_vector(f, "f");
+        if (xv.size() != fv.size()) throw std::invalid_argument("x and f must have the same length");
+        return models::path_work(xv, fv);
+      },
+      arg("x"), arg("f"), "Trapezoidal ∫ f dx along the path, N·mm.");
   m.def("loops", &loops, arg("x"), arg("f"), py::kw_only(), arg("plateaus") = std::vector<double>{}, arg("reversal_fraction") = 0.01,
         arg("min_span_fraction") = 0.02, "The figures of every closed cycle of a record (hystlab loops --json).");
-  m.def("loop_transformation", [](const py::handle& x, const py::handle& f) -> py::object {
-          const auto xv = finite_vector(x, "x"), fv = finite_vector(f, "f");
-          const auto t = models::loop_transformation(xv, fv);
-          return t ? py::object(transitions_to_dict(*t)) : py::none();
-        }, arg("x"), arg("f"), "Ms, Mf, As, Af of one loop by tangent intersection, or None without plateaus.");
+  m.def(
+      "loop_transformation",
+      [](const py::handle& x, const py::handle& f) -> py::object {
+        const auto xv = finite_vector(x, "x"), fv = finite_vector(f, "f");
+        const auto t = models::loop_transformation(xv, fv);
+        return t ? py::object(transitions_to_dict(*t)) : py::none();
+      },
+      arg("x"), arg("f"), "Ms, Mf, As, Af of one loop by tangent intersection, or None without plateaus.");
 }
 
 }  // namespace hystlab::python

@@ -24,11 +24,11 @@ class Model {
   using Impl = std::variant<models::PreisachModel, models::SimplifiedSmaModel>;
 
   Model(const Table& t, double merge_tolerance, std::size_t max_turning_points)
-      : table_(t), impl_(std::in_place_type<models::PreisachModel>, std::shared_ptr<const models::EverettTable>(t.doc, &t.doc->table),
-                         options(merge_tolerance, max_turning_points)),
+      : table_(t),
+        impl_(std::in_place_type<models::PreisachModel>, std::shared_ptr<const models::EverettTable>(t.doc, &t.doc->table),
+              options(merge_tolerance, max_turning_points)),
         fingerprint_(fingerprint(t.table())) {}
-  explicit Model(const Params& p)
-      : params_(p), impl_(std::in_place_type<models::SimplifiedSmaModel>, p.p), fingerprint_(fingerprint(p.p)) {}
+  explicit Model(const Params& p) : params_(p), impl_(std::in_place_type<models::SimplifiedSmaModel>, p.p), fingerprint_(fingerprint(p.p)) {}
   Model(const Model& o) : table_(o.table_), params_(o.params_), impl_(o.locked_copy()), fingerprint_(o.fingerprint_) {}
 
   py::array_t<double> evaluate(const py::handle& obj, bool clamp, const py::object& out_obj);
@@ -64,8 +64,7 @@ class Model {
   static models::PreisachOptions options(double merge_tolerance, std::size_t max_turning_points) {
     if (!(merge_tolerance >= 0.0) || !std::isfinite(merge_tolerance)) throw std::invalid_argument("merge_tolerance must be a finite number >= 0");
     // The memory is preallocated: a bound keeps a typo from asking for terabytes.
-    if (max_turning_points < 3 || max_turning_points > (std::size_t{1} << 24))
-      throw std::invalid_argument("max_turning_points must be from 3 to 16777216");
+    if (max_turning_points < 3 || max_turning_points > (std::size_t{1} << 24)) throw std::invalid_argument("max_turning_points must be from 3 to 16777216");
     return models::PreisachOptions{merge_tolerance, max_turning_points};
   }
   Impl locked_copy() const {
@@ -75,8 +74,8 @@ class Model {
   [[nodiscard]] bool clamp_ok(double x) const { return !table_ || (x >= table_->table().grid().lo && x <= table_->table().grid().hi); }
   [[nodiscard]] std::string range_error(const std::string& where, double x) const {
     const models::Grid& g = table_->table().grid();
-    return where + ": displacement " + format_number(x) + " mm is outside the table's range " + format_number(g.lo) + ".." +
-           format_number(g.hi) + " mm (clamp=True clamps and counts)";
+    return where + ": displacement " + format_number(x) + " mm is outside the table's range " + format_number(g.lo) + ".." + format_number(g.hi) +
+           " mm (clamp=True clamps and counts)";
   }
 
   std::optional<Table> table_;
@@ -142,9 +141,11 @@ py::array_t<double> Model::evaluate(const py::handle& obj, bool clamp, const py:
       if (!clamp_ok(x[k])) bad = k, outside = true;
     if (bad == n) {
       std::lock_guard lock(mu_);
-      std::visit([x, f, n](auto& m) {
-        for (std::size_t k = 0; k < n; ++k) f[k] = m.step(x[k]);
-      }, impl_);
+      std::visit(
+          [x, f, n](auto& m) {
+            for (std::size_t k = 0; k < n; ++k) f[k] = m.step(x[k]);
+          },
+          impl_);
     }
   }
   if (bad < n) {
@@ -208,49 +209,63 @@ void bind_model(py::module_& m) {
       .def(py::init<const Params&>(), py::arg("params"))
       .def(py::init([](const fs::path& path, double merge_tolerance, std::size_t max_turning_points) {
              return model_from_document(read_file(path), merge_tolerance, max_turning_points, path.string());
-           }), py::arg("path"), py::kw_only(), py::arg("merge_tolerance") = 0.0, py::arg("max_turning_points") = 512,
+           }),
+           py::arg("path"), py::kw_only(), py::arg("merge_tolerance") = 0.0, py::arg("max_turning_points") = 512,
            "Model(\"T.json\") is Model.load(\"T.json\").")
-      .def_static("load", [](const fs::path& path, double merge_tolerance, std::size_t max_turning_points) {
-                    return model_from_document(read_file(path), merge_tolerance, max_turning_points, path.string());
-                  }, py::arg("path"), py::kw_only(), py::arg("merge_tolerance") = 0.0, py::arg("max_turning_points") = 512,
-                  "A table document or parameters, told apart by the table's \"format\" field.")
+      .def_static(
+          "load",
+          [](const fs::path& path, double merge_tolerance, std::size_t max_turning_points) {
+            return model_from_document(read_file(path), merge_tolerance, max_turning_points, path.string());
+          },
+          py::arg("path"), py::kw_only(), py::arg("merge_tolerance") = 0.0, py::arg("max_turning_points") = 512,
+          "A table document or parameters, told apart by the table's \"format\" field.")
       .def("evaluate", &Model::evaluate, py::arg("x"), py::arg("clamp") = true, py::arg("out") = py::none(),
            "Forces for the displacements x, in order, from the current memory (same shape as x, or written into out).")
       .def("__call__", &Model::evaluate, py::arg("x"), py::arg("clamp") = true, py::arg("out") = py::none())
       .def("step", &Model::step, py::arg("x"), py::arg("clamp") = true, "One displacement: the force (clamped and counted as evaluate).")
       .def("peek", &Model::peek, py::arg("x"), "The force step(x) would give, without moving.")
       .def("reset", &Model::reset, "Back to rest: the memory wiped, at the start of the range.")
-      .def("copy", [](const Model& self) { return Model(self); }, "An independent model in the same state (to branch a history).")
+      .def(
+          "copy", [](const Model& self) { return Model(self); }, "An independent model in the same state (to branch a history).")
       .def("__copy__", [](const Model& self) { return Model(self); })
-      .def("__deepcopy__", [](const Model& self, const py::object&) { return Model(self); }, py::arg("memo"))
+      .def(
+          "__deepcopy__", [](const Model& self, const py::object&) { return Model(self); }, py::arg("memo"))
       .def_property("state", &Model::state, &Model::set_state, "The memory as bytes; assigning restores it (same table or parameters only).")
       .def_property_readonly("kind", [](const Model& self) { return self.preisach() ? "preisach" : "simplified"; })
       .def_property_readonly("table", [](const Model& self) { return self.table() ? py::cast(*self.table()) : py::none(); })
       .def_property_readonly("params", [](const Model& self) { return self.params() ? py::cast(*self.params()) : py::none(); })
-      .def_property_readonly("range", [](const Model& self) -> py::object {
-        if (!self.table()) return py::none();
-        return py::make_tuple(self.table()->table().grid().lo, self.table()->table().grid().hi);
-      })
+      .def_property_readonly("range",
+                             [](const Model& self) -> py::object {
+                               if (!self.table()) return py::none();
+                               return py::make_tuple(self.table()->table().grid().lo, self.table()->table().grid().hi);
+                             })
       .def_property_readonly("input", [](const Model& self) { return self.read([](const auto& x) { return x.input(); }); })
       .def_property_readonly("output", [](const Model& self) { return self.read([](const auto& x) { return x.output(); }); })
-      .def_property_readonly("saturations", [](const Model& self) { return self.read([](const auto& x) { return x.saturation_count(); }); },
-                             "Inputs clamped to the table's range so far.")
-      .def_property_readonly("depth", [](const Model& self) -> py::object {
-        if (const auto* p = self.preisach()) return py::int_(p->depth());
-        return py::none();
-      }, "Turning points in the memory (a table model), else None.")
-      .def_property_readonly("merges", [](const Model& self) -> py::object {
-        if (const auto* p = self.preisach()) return py::int_(p->merge_count());
-        return py::none();
-      })
-      .def_property_readonly("martensite_fraction", [](const Model& self) -> py::object {
-        if (const auto* s = self.simplified()) return py::float_(s->martensite_fraction());
-        return py::none();
-      })
-      .def("__repr__", [](const Model& self) {
-        return self.preisach() ? "<hystlab.Model of a table, n=" + std::to_string(self.preisach()->table().grid().n) + ">"
-                               : std::string("<hystlab.Model of the simplified SMA model>");
-      })
+      .def_property_readonly(
+          "saturations", [](const Model& self) { return self.read([](const auto& x) { return x.saturation_count(); }); },
+          "Inputs clamped to the table's range so far.")
+      .def_property_readonly(
+          "depth",
+          [](const Model& self) -> py::object {
+            if (const auto* p = self.preisach()) return py::int_(p->depth());
+            return py::none();
+          },
+          "Turning points in the memory (a table model), else None.")
+      .def_property_readonly("merges",
+                             [](const Model& self) -> py::object {
+                               if (const auto* p = self.preisach()) return py::int_(p->merge_count());
+                               return py::none();
+                             })
+      .def_property_readonly("martensite_fraction",
+                             [](const Model& self) -> py::object {
+                               if (const auto* s = self.simplified()) return py::float_(s->martensite_fraction());
+                               return py::none();
+                             })
+      .def("__repr__",
+           [](const Model& self) {
+             return self.preisach() ? "<hystlab.Model of a table, n=" + std::to_string(self.preisach()->table().grid().n) + ">"
+                                    : std::string("<hystlab.Model of the simplified SMA model>");
+           })
       .def(py::pickle(&pickle_state, &unpickle));
 }
 

@@ -49,9 +49,7 @@ std::string format_number(double v) { return models::exact_text(v); }
 
 std::string now_iso8601() { return models::iso8601_utc(std::time(nullptr)); }
 
-py::object json_to_py(const nlohmann::json& j) {
-  return py::module_::import("json").attr("loads")(j.dump());
-}
+py::object json_to_py(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
 nlohmann::json py_to_json(const py::handle& obj) {
   const std::string text = py::str(py::module_::import("json").attr("dumps")(obj, py::arg("allow_nan") = false));

@@ -14,11 +14,11 @@
 #include <vector>
 
 #include "hystlab/daemon/clock.hpp"
-#include "hystlab/db/campaign_enums.hpp"
 #include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/supervisor.hpp"
+#include "hystlab/db/campaign_enums.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/drivers/rig.hpp"
 #include "hystlab/models/fot_node.hpp"
@@ -31,7 +31,19 @@ enum class Control { pause, resume, abort, estop };  // estop: the rig's e-stop,
 // What the campaign's loop is doing now, as an operator names it (the rig panel, the safety
 // matrix's states). Text only at the edges.
 enum class CampaignPhase : std::uint8_t {
-  none, arming, preamble, training, ramping, dwelling, retake, validation, paused, held, safing, shaker_control, shaker_measure
+  none,
+  arming,
+  preamble,
+  training,
+  ramping,
+  dwelling,
+  retake,
+  validation,
+  paused,
+  held,
+  safing,
+  shaker_control,
+  shaker_measure
 };
 [[nodiscard]] const char* to_string(CampaignPhase p) noexcept;
 
@@ -101,7 +113,7 @@ struct RunnerResult {
   // started a whole period late (a late wake-up); with block reads, a sample lost because the
   // controller's buffer overran before it was read. Late wake-ups are counted in both modes.
   std::uint64_t samples = 0, missed_deadlines = 0, late_wakeups = 0, dropped = 0;
-  std::uint64_t gaps = 0;          // holes in the run's time axis (each stored as an event)
+  std::uint64_t gaps = 0;  // holes in the run's time axis (each stored as an event)
   double longest_gap_s = 0, gap_total_s = 0;
   std::size_t nodes = 0;
   std::optional<std::int64_t> table_id, lsq_table_id;
@@ -115,12 +127,12 @@ struct FinishJob {
   std::int64_t campaign = 0;
   Plan plan;
   RunnerResult result;
-  std::shared_ptr<const models::OnlineTableBuilder> builder;  // every node of the campaign (fot)
-  RunSeries series;  // every sample of every campaign run of the campaign (fot, waveform)
-  std::size_t rows_begin = 0;  // series[rows_begin..] came after training (loops before it are training loops)
-  RunSeries validation;        // the validation run's samples: every table is scored on them
-  std::string training_summary;  // what training came to (empty: no training)
-  std::shared_ptr<const IsolatorModel> isolator;  // sine: predict each point with it
+  std::shared_ptr<const models::OnlineTableBuilder> builder;     // every node of the campaign (fot)
+  RunSeries series;                                              // every sample of every campaign run of the campaign (fot, waveform)
+  std::size_t rows_begin = 0;                                    // series[rows_begin..] came after training (loops before it are training loops)
+  RunSeries validation;                                          // the validation run's samples: every table is scored on them
+  std::string training_summary;                                  // what training came to (empty: no training)
+  std::shared_ptr<const IsolatorModel> isolator;                 // sine: predict each point with it
   std::vector<std::pair<std::int64_t, PredictStep>> sine_steps;  // sine: each stored point's step number and what to predict
 };
 
@@ -139,11 +151,11 @@ struct RunnerContext {
   const std::atomic<bool>* stop = nullptr;  // the daemon is shutting down: hold, interrupted
   double resume_preamble_after_s = 2.0;     // rig seconds of pause after which memory is re-wiped
   int watchdog_hold_periods = 20, watchdog_fail_periods = 500;
-  double db_timeout_s = 10.0;               // for the writer to create the run before arming
-  std::function<std::string()> now_iso;     // wall-clock stamps for the records
+  double db_timeout_s = 10.0;                        // for the writer to create the run before arming
+  std::function<std::string()> now_iso;              // wall-clock stamps for the records
   std::function<void(const std::string&)> on_state;  // observers (logs, tests)
-  RigLive* live = nullptr;                        // when set, every sample and missed deadline is shown there
-  std::vector<float>* loop_periods_us = nullptr;  // when set, every tick's period is recorded (benchmarks)
+  RigLive* live = nullptr;                           // when set, every sample and missed deadline is shown there
+  std::vector<float>* loop_periods_us = nullptr;     // when set, every tick's period is recorded (benchmarks)
   // Finishing (fits, tables, the final state) off this thread; empty: done inline, then returns.
   std::function<void(FinishJob)> finish;
   // The steady-clock second at which the rig's time began (the supervisor's deadlines run on it

@@ -11,16 +11,16 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
-#include <optional>
-#include <string_view>
-#include <utility>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
-#include "hystlab/control/values.hpp"
 #include "hystlab/control/http_config.hpp"
+#include "hystlab/control/values.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/live_feed.hpp"
@@ -45,10 +45,10 @@ struct SimulatorOptions {
   // wall-clock ms stops the frame with fault 4, as a real controller does when its host is gone.
   // The daemon writes it every 0.1 s in every state; 1 s leaves room for a frozen shared machine.
   double host_timeout_ms = 1000;
-  int cpu = -1;                     // pinned there when >= 0 (the daemon sets its acquisition CPU)
-  int realtime_priority = -1;       // > 0: SCHED_FIFO, as a controller with a CPU of its own; 0: normal;
-                                    // -1: one below the acquisition's when that is pinned and
-                                    // time_scale <= 1, else 0
+  int cpu = -1;                // pinned there when >= 0 (the daemon sets its acquisition CPU)
+  int realtime_priority = -1;  // > 0: SCHED_FIFO, as a controller with a CPU of its own; 0: normal;
+                               // -1: one below the acquisition's when that is pinned and
+                               // time_scale <= 1, else 0
 };
 
 struct RigEntry {
@@ -80,12 +80,12 @@ struct DaemonConfig {
 // beyond loopback without a token.
 void check_http_security(HttpConfig& http, const char* env_token);
 
+using control::campaign_command_from;
 using control::CampaignCommand;
 using control::CommandOutcome;
 using control::RigCommand;
 using control::RigInfo;
 using control::RigSupervision;
-using control::campaign_command_from;
 using control::to_string;
 
 // The daemon's owners: one acquisition thread per rig, the db writer thread, and the main loop

@@ -24,7 +24,7 @@ inline constexpr double kHandshakeFloor_s = 1.0;
 struct RigEnvelope {
   // load frame
   double stroke_min_mm = -10.0, stroke_max_mm = 10.0;  // the simulator trips at ±12 mm
-  double force_max_N = 2000.0;                          // the simulator's load cell: 5000 N
+  double force_max_N = 2000.0;                         // the simulator's load cell: 5000 N
   double speed_max_mm_s = 20.0;
   double accel_max_mm_s2 = 1000.0;
   // shaker
@@ -35,12 +35,12 @@ struct RigEnvelope {
 };
 
 struct SupervisionSettings {
-  double in_position_mm = 0.01;   // a target counts as reached within this (the servo's dead band)
-  double lag_s = 0.1;             // the rig's lag, added to every segment's expected duration
-  double settle_s = 1.0;          // and a settle time
-  double arm_timeout_s = 1.0;     // rig seconds for `enabled` to appear after enable
-  double reset_timeout_s = 2.0;   // rig seconds for `ready` after a reset
-  std::uint16_t mode = 1;         // written to the map's `mode` on arming (when it has one)
+  double in_position_mm = 0.01;     // a target counts as reached within this (the servo's dead band)
+  double lag_s = 0.1;               // the rig's lag, added to every segment's expected duration
+  double settle_s = 1.0;            // and a settle time
+  double arm_timeout_s = 1.0;       // rig seconds for `enabled` to appear after enable
+  double reset_timeout_s = 2.0;     // rig seconds for `ready` after a reset
+  std::uint16_t mode = 1;           // written to the map's `mode` on arming (when it has one)
   double heartbeat_period_s = 0.1;  // the host heartbeat (when the map has one)
   double safe_rate_mm_s = 1.0;      // default safe rate (a plan may set its own, slower or not)
   double safe_timeout_s = 30.0;     // beyond the expected time, a safe ramp that has not arrived holds

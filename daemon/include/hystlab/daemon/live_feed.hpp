@@ -62,8 +62,10 @@ class LiveSampleRing {
     LiveSample s;
     std::uint64_t i = from;
     for (; i < h; i += stride)
-      if (get(i, s)) out.push_back(s);
-      else if (lost) ++*lost;
+      if (get(i, s))
+        out.push_back(s);
+      else if (lost)
+        ++*lost;
     return i;
   }
 

@@ -18,9 +18,7 @@ class SafetyEnvelope {
   // answered_s: when its answer came. A polled value was taken somewhere between the two; a
   // sample timed by the controller's own clock has them equal.
   [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double asked_s, double answered_s);
-  [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double t_s) {
-    return check(displacement_mm, force_N, t_s, t_s);
-  }
+  [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double t_s) { return check(displacement_mm, force_N, t_s, t_s); }
   [[nodiscard]] const Limits& limits() const noexcept { return l_; }
 
  private:

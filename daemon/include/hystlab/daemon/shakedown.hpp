@@ -14,9 +14,9 @@ struct ShakedownStep {
   int cycle = 0;  // 1-based
   double peak_force_N = 0, energy_Nmm = 0;
   std::optional<double> peak_change_pct, energy_change_pct;  // none for the first cycle
-  int consecutive = 0;  // cycles in a row below both thresholds, this one included
-  bool stable = false;  // the rule is met: training may end
-  bool last = false;    // training ends after this cycle (stable, or the maximum reached)
+  int consecutive = 0;                                       // cycles in a row below both thresholds, this one included
+  bool stable = false;                                       // the rule is met: training may end
+  bool last = false;                                         // training ends after this cycle (stable, or the maximum reached)
 };
 
 class ShakedownRule {

@@ -28,8 +28,8 @@ struct SineControl {
   bool closed = true;
   double tolerance_pct = 5, warning_pct = 10, abort_pct = 30, gain = 0.7;
   int window_cycles = 4;
-  int max_windows = 12;         // control windows per step; then it is measured anyway, with a warning
-  double max_drive_ratio = 4;   // the drive never exceeds this times the demand
+  int max_windows = 12;        // control windows per step; then it is measured anyway, with a warning
+  double max_drive_ratio = 4;  // the drive never exceeds this times the demand
   // Each step starts at this fraction of the drive the last response learnt asks for (-6 dB):
   // from below, as controllers start a level, since the table's response can change several
   // fold between steps (it dips where the isolator resonates and loads it) and an overshoot is

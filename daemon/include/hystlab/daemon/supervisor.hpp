@@ -72,10 +72,10 @@ class Supervisor {
   enum class Arming { pending, armed, failed };
   Arming arming_step(double now, const StatusView& v, std::string& reason);
 
-  void hold(double now, const std::string& reason);  // armed/safing -> holding (the rig's hold)
-  void release(double now, const std::string& reason);  // holding -> armed (the hold released)
+  void hold(double now, const std::string& reason);          // armed/safing -> holding (the rig's hold)
+  void release(double now, const std::string& reason);       // holding -> armed (the hold released)
   void begin_safing(double now, const std::string& reason);  // -> safing (the safe ramp)
-  void disarm(double now, const std::string& reason);  // -> idle: held and disabled, verified
+  void disarm(double now, const std::string& reason);        // -> idle: held and disabled, verified
   // The e-stop, to the rig at once from any state; latched until reset. Returns the write's
   // result: on an error the latch stands here and the e-stop is re-sent the moment the rig answers.
   std::error_code estop(double now, const std::string& reason);

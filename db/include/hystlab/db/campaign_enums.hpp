@@ -8,9 +8,9 @@
 namespace hystlab::db {
 
 enum class CampaignState { queued, held, arming, running, paused, completed, aborted, failed, interrupted };
-inline constexpr std::array<CampaignState, 9> kCampaignStates{CampaignState::queued,    CampaignState::held,      CampaignState::arming,
-                                                              CampaignState::running,   CampaignState::paused,    CampaignState::completed,
-                                                              CampaignState::aborted,   CampaignState::failed,    CampaignState::interrupted};
+inline constexpr std::array<CampaignState, 9> kCampaignStates{CampaignState::queued,  CampaignState::held,   CampaignState::arming,
+                                                              CampaignState::running, CampaignState::paused, CampaignState::completed,
+                                                              CampaignState::aborted, CampaignState::failed, CampaignState::interrupted};
 [[nodiscard]] const char* to_string(CampaignState s) noexcept;
 // nullopt for any other text.
 [[nodiscard]] std::optional<CampaignState> campaign_state_from(std::string_view text) noexcept;

@@ -3,15 +3,15 @@
 // waits on the disk), and are committed in batches at most batch_window_s apart (synchronous=FULL
 // by default, so an acknowledged batch survives a power cut). A full ring is counted, not hidden.
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <future>
 #include <memory>
-#include <optional>
-#include <chrono>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 

@@ -27,9 +27,7 @@ class SpscRing {
     tail_.store(t + n, std::memory_order_release);
     return n;
   }
-  [[nodiscard]] std::size_t size() const noexcept {
-    return head_.load(std::memory_order_acquire) - tail_.load(std::memory_order_acquire);
-  }
+  [[nodiscard]] std::size_t size() const noexcept { return head_.load(std::memory_order_acquire) - tail_.load(std::memory_order_acquire); }
 
  private:
   std::vector<T> buf_;

@@ -1,6 +1,7 @@
 #pragma once
 // The hystlab store: one SQLite file holding rigs, campaigns with their events, runs, samples,
 // FOT nodes, tables and I/O statistics. One Store per thread (WAL: readers never block the writer).
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -8,7 +9,6 @@
 #include <string>
 #include <tuple>
 #include <variant>
-#include <array>
 #include <vector>
 
 #include "hystlab/db/campaign_enums.hpp"
@@ -63,22 +63,19 @@ class Store {
   [[nodiscard]] Database& database() noexcept { return db_; }
 
   std::int64_t upsert_rig(const std::string& name, const std::string& config_json, const std::string& now);
-  std::int64_t create_campaign(std::int64_t rig_id, CampaignKind kind, const std::string& plan_json,
-                               const std::string& now);
+  std::int64_t create_campaign(std::int64_t rig_id, CampaignKind kind, const std::string& plan_json, const std::string& now);
   // Updates the state and records the transition as an event, in one transaction.
   void transition(std::int64_t campaign_id, CampaignState to, const std::string& reason, const std::string& now);
-  std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s,
-                       RunRole role = RunRole::campaign);
+  std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s, RunRole role = RunRole::campaign);
   // The campaign's run and, when asked, its validation run (else 0), in one transaction.
-  std::pair<std::int64_t, std::int64_t> add_runs(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix,
-                                                 double monotonic_anchor_s, bool validation);
+  std::pair<std::int64_t, std::int64_t> add_runs(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s,
+                                                 bool validation);
   void end_run(std::int64_t run_id, CampaignState state, const std::string& now);
   std::int64_t add_event(std::int64_t campaign_id, const std::string& kind, const std::string& detail, const std::string& now);
   std::int64_t add_transmissibility(std::int64_t run_id, double f_hz, double base_mm, double mass_mm, double ratio, double phase);
   std::int64_t add_fot_node(std::int64_t run_id, double alpha, double beta, double f_alpha, double f_alpha_beta, double t);
-  std::int64_t add_table(std::optional<std::int64_t> campaign_id, std::optional<std::int64_t> run_id,
-                         const std::string& method, int n, double lo, double hi, const std::string& now,
-                         const std::string& accuracy_json, const std::string& document_json);
+  std::int64_t add_table(std::optional<std::int64_t> campaign_id, std::optional<std::int64_t> run_id, const std::string& method, int n, double lo, double hi,
+                         const std::string& now, const std::string& accuracy_json, const std::string& document_json);
   // At start-up: every campaign left arming, running or paused by a crash becomes interrupted,
   // except one whose tables were stored (finishing was done): that one is completed.
   int mark_interrupted(const std::string& now);
@@ -140,8 +137,7 @@ class Store {
   // raw samples when it is short).
   // A shaker run's buckets hold base (disp_*) and mass (force_*) displacement.
   [[nodiscard]] std::vector<Bucket> overview(std::int64_t run_id, double t0, double t1, int buckets, bool shaker = false);
-  void for_each_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1,
-                       const std::function<void(const SampleRow&)>& f);
+  void for_each_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1, const std::function<void(const SampleRow&)>& f);
   void for_each_shaker_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1, const std::function<void(const ShakerRow&)>& f);
   [[nodiscard]] std::int64_t max_shaker_seq(std::int64_t run_id);  // -1 when none
   // A sine step's result: the columns the sweep plots need, and the whole record as JSON.
@@ -151,7 +147,7 @@ class Store {
 
   // ---- reads for the API and the CLI (store_reads.cpp) ----
   [[nodiscard]] std::string rig_name(std::int64_t rig_id);
-  [[nodiscard]] std::vector<std::pair<std::int64_t, std::string>> rigs();  // id, name
+  [[nodiscard]] std::vector<std::pair<std::int64_t, std::string>> rigs();               // id, name
   [[nodiscard]] std::vector<std::pair<CampaignState, std::int64_t>> campaign_counts();  // by state
   [[nodiscard]] std::optional<RunInfo> run(std::int64_t id);
   [[nodiscard]] std::vector<RunInfo> runs(std::int64_t campaign_id);

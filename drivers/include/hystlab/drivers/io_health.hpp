@@ -14,7 +14,7 @@ inline constexpr std::size_t kLatencyBuckets = 16;  // bucket k: [2^k, 2^(k+1)) 
 
 struct IoHealthSnapshot {
   std::uint64_t reads = 0, writes = 0, reconnects = 0;
-  std::uint64_t lost_samples = 0;  // gaps in a controller's sample counter that no block read filled
+  std::uint64_t lost_samples = 0;                      // gaps in a controller's sample counter that no block read filled
   std::array<std::uint64_t, kRigErrorCount> errors{};  // index = RigError value (0 unused)
   double last_transaction_us = 0, max_transaction_us = 0, total_transaction_us = 0;
   std::array<std::uint64_t, kLatencyBuckets> latency_histogram{};

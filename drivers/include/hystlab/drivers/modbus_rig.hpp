@@ -21,12 +21,12 @@ struct ModbusRigConfig {
   int baud = 115200;
   char parity = 'N';
   int data_bits = 8, stop_bits = 1;
-  int slave = 0;                      // 0: the map's slave_id
-  double response_timeout_s = 0.05;   // whole answer
-  double byte_timeout_s = 0.01;       // between bytes of one answer
+  int slave = 0;                                         // 0: the map's slave_id
+  double response_timeout_s = 0.05;                      // whole answer
+  double byte_timeout_s = 0.01;                          // between bytes of one answer
   double reconnect_min_s = 0.05, reconnect_max_s = 2.0;  // back-off, doubling
-  double stale_after_s = 0.5;         // sample counter unchanged this long: stale_data
-  bool block_reads = false;           // read_samples() reads the map's sample_window (required then)
+  double stale_after_s = 0.5;                            // sample counter unchanged this long: stale_data
+  bool block_reads = false;                              // read_samples() reads the map's sample_window (required then)
   protocols::RegisterMap map;
   std::string name = "modbus rig";
 };
@@ -66,7 +66,7 @@ class ModbusRig final : public Rig {
   std::error_code value_of(protocols::Signal s, double& v) const noexcept;
   std::error_code ensure_connected(double now_s) noexcept;
   std::error_code fail(int err, const char* op) noexcept;  // classify errno, count, log once per episode
-  void resync() noexcept;  // after a timeout or a broken answer: no late answer may follow
+  void resync() noexcept;                                  // after a timeout or a broken answer: no late answer may follow
   void drain_line() noexcept;
   void back_off() noexcept;
   void succeed() noexcept;
@@ -81,7 +81,7 @@ class ModbusRig final : public Rig {
   double last_now_ = 0, next_attempt_ = 0, backoff_ = 0;
   std::vector<std::vector<std::uint16_t>> block_words_;
   IoHealth health_;
-  int episode_ = 0;             // RigError of the current error episode, 0 when healthy
+  int episode_ = 0;  // RigError of the current error episode, 0 when healthy
   std::uint64_t episode_count_ = 0;
   std::uint32_t last_counter_ = 0;
   double counter_changed_at_ = -1;

@@ -20,7 +20,6 @@ struct RigConfigError : std::invalid_argument {
 
 // where: the config path of this object for messages ("rigs[0]"); base: where relative map
 // paths start. Opening a CAN interface on a kernel without SocketCAN throws std::system_error.
-[[nodiscard]] std::unique_ptr<Rig> make_rig(const nlohmann::json& config, const std::string& where = "rig",
-                                            const std::filesystem::path& base = ".");
+[[nodiscard]] std::unique_ptr<Rig> make_rig(const nlohmann::json& config, const std::string& where = "rig", const std::filesystem::path& base = ".");
 
 }  // namespace hystlab::drivers

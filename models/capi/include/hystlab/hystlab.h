@@ -21,7 +21,7 @@
 extern "C" {
 #endif
 
-#define HYSTLAB_API_VERSION 2  /* 2: hystlab_model_from_table */
+#define HYSTLAB_API_VERSION 2 /* 2: hystlab_model_from_table */
 
 typedef enum hystlab_status {
   HYSTLAB_OK = 0,
@@ -47,8 +47,8 @@ HYSTLAB_API hystlab_status hystlab_model_from_json(const char* json_text, hystla
  * subdivisions of [lo_mm, hi_mm] (nodes_mm NULL), or the grid's own n + 1 nodes (NAME_NODES_MM);
  * the (n+1)(n+2)/2 values F(delta_i, delta_j) in N at index i(i+1)/2 + j (NAME_VALUES_N); and the
  * force offset. The same model as the JSON document of that table, to the last digit. */
-HYSTLAB_API hystlab_status hystlab_model_from_table(int n, double lo_mm, double hi_mm, const double* nodes_mm,
-                                                   const double* values_N, double force_offset_N, hystlab_model** out);
+HYSTLAB_API hystlab_status hystlab_model_from_table(int n, double lo_mm, double hi_mm, const double* nodes_mm, const double* values_N, double force_offset_N,
+                                                    hystlab_model** out);
 
 /* Drive to displacement x (mm); *force_N receives the force. A table clamps inputs outside
  * its range and counts them (hystlab_model_saturations). x must be finite. */

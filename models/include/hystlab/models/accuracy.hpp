@@ -8,10 +8,10 @@ namespace hystlab::models {
 
 struct ErrorStats {
   std::size_t count = 0;
-  double rms = 0.0;         // N
-  double max_abs = 0.0;     // N
-  double rms_norm = 0.0;    // rms / reference force range
-  double max_norm = 0.0;    // max_abs / reference force range
+  double rms = 0.0;       // N
+  double max_abs = 0.0;   // N
+  double rms_norm = 0.0;  // rms / reference force range
+  double max_norm = 0.0;  // max_abs / reference force range
 };
 
 struct AccuracyReport {
@@ -22,8 +22,7 @@ struct AccuracyReport {
 };
 
 // Sizes must match; throws std::invalid_argument otherwise.
-[[nodiscard]] AccuracyReport compare(std::span<const double> input, std::span<const double> reference,
-                                     std::span<const double> model);
+[[nodiscard]] AccuracyReport compare(std::span<const double> input, std::span<const double> reference, std::span<const double> model);
 
 // Trapezoidal ∫ f dδ along the path (the dissipated energy of the closed loops it contains), N·mm.
 [[nodiscard]] double path_work(std::span<const double> input, std::span<const double> force) noexcept;

@@ -24,10 +24,10 @@ inline constexpr int kTableVersionNodes = 2;
 inline constexpr std::string_view kParamsModel = "simplified-sma";
 
 struct TableProvenance {
-  std::string source;   // what was measured or simulated
-  std::string method;   // "fot", "virtual-fot", "lsq", ...
-  std::string created;  // ISO 8601 time, supplied by the caller
-  std::string from;     // input file, run id, ...
+  std::string source;                               // what was measured or simulated
+  std::string method;                               // "fot", "virtual-fot", "lsq", ...
+  std::string created;                              // ISO 8601 time, supplied by the caller
+  std::string from;                                 // input file, run id, ...
   nlohmann::json extra = nlohmann::json::object();  // accuracy, drift, fit figures
 };
 

@@ -11,9 +11,9 @@
 namespace hystlab::models {
 
 struct DriftReport {
-  double max_spread = 0.0;   // N, largest max-min of f_α at one α
-  double pooled_std = 0.0;   // N, pooled standard deviation of repeated f_α (0 without repeats)
-  int worst_row = 0;         // grid row i of max_spread
+  double max_spread = 0.0;  // N, largest max-min of f_α at one α
+  double pooled_std = 0.0;  // N, pooled standard deviation of repeated f_α (0 without repeats)
+  int worst_row = 0;        // grid row i of max_spread
   std::size_t repeated_rows = 0;
 };
 
@@ -41,10 +41,8 @@ struct FotIdentification {
 // Throws std::invalid_argument naming the node or value when the nodes do not form a complete
 // uniform grid.
 [[nodiscard]] Grid infer_grid(const std::vector<FotNode>& nodes);
-[[nodiscard]] FotIdentification identify_from_nodes(const std::vector<FotNode>& nodes, double noise_std = -1.0,
-                                                    double force_offset = 0.0);
-[[nodiscard]] FotIdentification identify_from_nodes(const Grid& grid, const std::vector<FotNode>& nodes,
-                                                    double noise_std = -1.0, double force_offset = 0.0);
+[[nodiscard]] FotIdentification identify_from_nodes(const std::vector<FotNode>& nodes, double noise_std = -1.0, double force_offset = 0.0);
+[[nodiscard]] FotIdentification identify_from_nodes(const Grid& grid, const std::vector<FotNode>& nodes, double noise_std = -1.0, double force_offset = 0.0);
 
 // MODELS.md §3: the table of a model, from its response to the identification input.
 [[nodiscard]] EverettTable identify_virtual(HysteresisModel& model, const Grid& grid);

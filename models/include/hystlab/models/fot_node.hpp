@@ -22,8 +22,8 @@ struct FotNode {
 [[nodiscard]] std::vector<double> ramp_through(const std::vector<double>& turning_points, double max_step);
 
 struct VirtualCampaign {
-  std::vector<FotNode> nodes;   // every (δ_i, δ_j), j <= i, in the order the campaign meets them
-  double force_at_min = 0.0;    // the model's force when it first reaches δmin
+  std::vector<FotNode> nodes;  // every (δ_i, δ_j), j <= i, in the order the campaign meets them
+  double force_at_min = 0.0;   // the model's force when it first reaches δmin
 };
 
 // Runs the identification input on a model (from reset), stepping through every grid node.

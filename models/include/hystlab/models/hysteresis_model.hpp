@@ -28,12 +28,8 @@ class HysteresisModel {
   // restore_state checks what it can (sizes, kinds, ranges, finiteness) and throws
   // std::invalid_argument naming what is wrong; it cannot tell two tables of one grid apart, so a
   // caller that stores states keeps the table's fingerprint beside them (the FMU does).
-  [[nodiscard]] virtual std::vector<double> save_state() const {
-    throw std::invalid_argument("this model's state cannot be saved");
-  }
-  virtual void restore_state(std::span<const double> /*state*/) {
-    throw std::invalid_argument("this model's state cannot be restored");
-  }
+  [[nodiscard]] virtual std::vector<double> save_state() const { throw std::invalid_argument("this model's state cannot be saved"); }
+  virtual void restore_state(std::span<const double> /*state*/) { throw std::invalid_argument("this model's state cannot be restored"); }
 
   // out[k] = step(in[k]); out must be at least as long as in.
   void evaluate(std::span<const double> in, std::span<double> out) noexcept {

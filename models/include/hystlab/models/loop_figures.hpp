@@ -41,11 +41,11 @@ struct LoopFigures {
   // start. ASTM F2516's residual elongation after unloading, in displacement for a spring. NaN for
   // a cycle from a maximum (it does not unload to a start).
   double residual_mm = 0;
-  double energy_Nmm = 0;                  // ∮ f dδ, the energy dissipated in the cycle
-  double secant_stiffness_N_mm = 0;       // (f(max) - f(min)) / (max - min)
-  double strain_energy_Nmm = 0;           // E_s = ½ k a², a = (max - min) / 2 (the loop about its centre)
-  double damping_ratio = 0;               // ζ = E_d / (4π E_s); 0 when E_s is 0
-  std::vector<PlateauForce> plateaus;     // those of the options inside [min, max]
+  double energy_Nmm = 0;               // ∮ f dδ, the energy dissipated in the cycle
+  double secant_stiffness_N_mm = 0;    // (f(max) - f(min)) / (max - min)
+  double strain_energy_Nmm = 0;        // E_s = ½ k a², a = (max - min) / 2 (the loop about its centre)
+  double damping_ratio = 0;            // ζ = E_d / (4π E_s); 0 when E_s is 0
+  std::vector<PlateauForce> plateaus;  // those of the options inside [min, max]
   std::optional<BranchKnees> loading, unloading;
   // Ms, Mf (loading) and As, Af (unloading) when both branches show a plateau.
   std::optional<SmaTransitions> transformation;
@@ -56,12 +56,11 @@ struct LoopFigures {
 // band). A cycle nested in another is reported once, and its samples are left out of its host's
 // figures. Cycles closed only by the record's end count when they return to their minimum.
 // Reported in the order they close. Sizes must match and be finite (std::invalid_argument otherwise).
-[[nodiscard]] std::vector<LoopFigures> find_loops(std::span<const double> displacement, std::span<const double> force,
-                                                  const LoopOptions& options = {});
+[[nodiscard]] std::vector<LoopFigures> find_loops(std::span<const double> displacement, std::span<const double> force, const LoopOptions& options = {});
 
 // The figures of one cycle of samples begin..end, turning at `turn` (begin < turn < end).
-[[nodiscard]] LoopFigures loop_figures(std::span<const double> displacement, std::span<const double> force, std::size_t begin,
-                                       std::size_t turn, std::size_t end, const LoopOptions& options = {});
+[[nodiscard]] LoopFigures loop_figures(std::span<const double> displacement, std::span<const double> force, std::size_t begin, std::size_t turn,
+                                       std::size_t end, const LoopOptions& options = {});
 
 // Transformation points of one loop (loading up to its largest displacement, unloading after it),
 // or nullopt when a branch shows no plateau. The starting guess of calibrate_simplified_sma.

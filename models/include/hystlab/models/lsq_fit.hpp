@@ -22,12 +22,12 @@ struct LsqFitOptions {
 
 struct LsqFitResult {
   EverettTable table;
-  double lambda = 0.0;          // relative to the data term (both scaled to unit trace)
+  double lambda = 0.0;  // relative to the data term (both scaled to unit trace)
   double gcv = 0.0;
   double effective_parameters = 0.0;
-  double rms_residual = 0.0;    // N
-  double max_residual = 0.0;    // N
-  double force_offset = 0.0;    // N
+  double rms_residual = 0.0;        // N
+  double max_residual = 0.0;        // N
+  double force_offset = 0.0;        // N
   std::vector<double> cell_weight;  // N, Grid::cell_index order
   std::vector<double> cell_sigma;   // N, 1-σ uncertainty; 0 for cells held at the bound w = 0
   std::size_t cells_at_bound = 0;
@@ -40,11 +40,9 @@ struct RegressorTerm {
   std::size_t node;
   double weight;
 };
-[[nodiscard]] std::vector<std::vector<RegressorTerm>> preisach_regressors(const Grid& grid,
-                                                                          std::span<const double> input);
+[[nodiscard]] std::vector<std::vector<RegressorTerm>> preisach_regressors(const Grid& grid, std::span<const double> input);
 
 // Throws std::invalid_argument on mismatched sizes, non-finite data, too few samples, or n > 64.
-[[nodiscard]] LsqFitResult fit_preisach_lsq(std::span<const double> input, std::span<const double> force,
-                                            const Grid& grid, const LsqFitOptions& options = {});
+[[nodiscard]] LsqFitResult fit_preisach_lsq(std::span<const double> input, std::span<const double> force, const Grid& grid, const LsqFitOptions& options = {});
 
 }  // namespace hystlab::models

@@ -35,10 +35,10 @@ enum class FitPrior { signed_masses, monotone, automatic };
 
 struct PreisachFitOptions {
   FitPrior prior = FitPrior::automatic;
-  double lambda = -1.0;      // smoothing weight (relative: data and smoothing both scaled to unit trace); < 0: by CV
-  int folds = 4;             // contiguous held-out blocks for the cross-validation
+  double lambda = -1.0;        // smoothing weight (relative: data and smoothing both scaled to unit trace); < 0: by CV
+  int folds = 4;               // contiguous held-out blocks for the cross-validation
   int uncertainty_probes = 8;  // random probes for the per-cell σ (0: none)
-  double tolerance = 1e-7;   // relative residual of the final solve
+  double tolerance = 1e-7;     // relative residual of the final solve
   int max_subdivisions = 200;
 };
 
@@ -50,15 +50,15 @@ struct PriorFit {
   double heldout_rms = 0.0;       // N, cross-validated error at the chosen (or given) λ
   std::vector<double> cv_lambda;  // the λ tried, and their held-out RMS (N)
   std::vector<double> cv_rms;
-  double rms_residual = 0.0;      // N, on the whole record, by running the fitted table
-  double max_residual = 0.0;      // N
-  double force_offset = 0.0;      // N
+  double rms_residual = 0.0;        // N, on the whole record, by running the fitted table
+  double max_residual = 0.0;        // N
+  double force_offset = 0.0;        // N
   std::vector<double> cell_weight;  // N, Grid::cell_index order
   std::vector<double> cell_sigma;   // N, 1-σ, estimated from random probes; 0 at the bound w = 0
   std::size_t cells_at_bound = 0;
   std::size_t negative_cells = 0;
-  int iterations = 0;               // conjugate-gradient steps of all its solves
-  bool converged = true;            // the final solve met its tolerance (else the reason warns)
+  int iterations = 0;     // conjugate-gradient steps of all its solves
+  bool converged = true;  // the final solve met its tolerance (else the reason warns)
 };
 
 struct PreisachFitResult {
@@ -66,9 +66,9 @@ struct PreisachFitResult {
   std::vector<PriorFit> candidates;  // every prior fitted (two for automatic), chosen among them
   std::string reason;                // why `chosen` won, in the user's words
   double seconds = 0.0;
-  std::size_t operator_bytes = 0;    // the record's operator: the largest allocation of the fit
+  std::size_t operator_bytes = 0;  // the record's operator: the largest allocation of the fit
   std::size_t selection_samples = 0;
-  std::size_t peak_bytes = 0;        // operator + solver vectors, estimated from their sizes
+  std::size_t peak_bytes = 0;  // operator + solver vectors, estimated from their sizes
   // Samples λ and the prior were chosen on: all of them, or above 200,000 the record thinned to
   // about that many with every turning point kept (the chosen prior is then fitted on every
   // sample; the other candidate's figures are from the thinned record, σ scaled from it).
@@ -76,7 +76,7 @@ struct PreisachFitResult {
 
 // Throws std::invalid_argument on mismatched sizes, non-finite data, too few samples for the
 // unknowns, n above options.max_subdivisions, or fewer than 2 folds; messages name the field.
-[[nodiscard]] PreisachFitResult fit_preisach(std::span<const double> input, std::span<const double> force,
-                                             const Grid& grid, const PreisachFitOptions& options = {});
+[[nodiscard]] PreisachFitResult fit_preisach(std::span<const double> input, std::span<const double> force, const Grid& grid,
+                                             const PreisachFitOptions& options = {});
 
 }  // namespace hystlab::models

@@ -8,8 +8,8 @@
 // Bounded memory: a reversal within merge_tolerance of the previous turning point is merged
 // (that tiny excursion is forgotten); when max_turning_points are stored, a new reversal is
 // merged the same way. Both are counted (merge_count) so the approximation is never silent.
-#include <cstddef>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -29,15 +29,12 @@ struct PreisachOptions {
 class PreisachModel final : public HysteresisModel {
  public:
   explicit PreisachModel(std::shared_ptr<const EverettTable> table, PreisachOptions options = {});
-  explicit PreisachModel(EverettTable table, PreisachOptions options = {})
-      : PreisachModel(std::make_shared<const EverettTable>(std::move(table)), options) {}
+  explicit PreisachModel(EverettTable table, PreisachOptions options = {}) : PreisachModel(std::make_shared<const EverettTable>(std::move(table)), options) {}
 
   void reset() noexcept override;
   double step(double x) noexcept override { return advance(*this, x); }
   [[nodiscard]] double peek(double x) const noexcept override { return advance(*this, x); }
-  [[nodiscard]] std::unique_ptr<HysteresisModel> clone() const override {
-    return std::make_unique<PreisachModel>(*this);
-  }
+  [[nodiscard]] std::unique_ptr<HysteresisModel> clone() const override { return std::make_unique<PreisachModel>(*this); }
   [[nodiscard]] double input() const noexcept override { return x_; }
   [[nodiscard]] double output() const noexcept override { return f_ + table_->force_offset(); }
   [[nodiscard]] std::uint64_t saturation_count() const noexcept override { return saturations_; }
@@ -93,8 +90,7 @@ double PreisachModel::advance(Self& self, double x) noexcept {
   // because for a random input it is a coin toss; merging is rare and branches.
   const bool rev = up != static_cast<bool>(len & 1U);
   // The rare condition first, so the common path has no branch on rev.
-  const bool merge = rev && (len >= self.options_.max_turning_points ||
-                      (len > 1 && std::fabs(self.x_ - last) <= self.options_.merge_tolerance));
+  const bool merge = rev && (len >= self.options_.max_turning_points || (len > 1 && std::fabs(self.x_ - last) <= self.options_.merge_tolerance));
   if (merge) {
     --len;  // forget the excursion since the last turning point (counted)
     changed = true;

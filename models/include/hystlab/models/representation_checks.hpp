@@ -14,9 +14,9 @@ struct RepresentationOptions {
 };
 
 struct WipingOutReport {
-  std::size_t events = 0;       // minor loops closed by returning to an earlier turning point
-  double max_deviation = 0.0;   // N, |force on return - force at that turning point|
-  double rms_deviation = 0.0;   // N
+  std::size_t events = 0;           // minor loops closed by returning to an earlier turning point
+  double max_deviation = 0.0;       // N, |force on return - force at that turning point|
+  double rms_deviation = 0.0;       // N
   double max_deviation_norm = 0.0;  // / force range
 };
 

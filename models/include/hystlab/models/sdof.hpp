@@ -27,12 +27,12 @@ struct SdofOptions {
   double dt_s = 1e-4;
 };
 
-struct SdofEnergy {  // N·mm, since the start
-  double input = 0;       // work done by the base on the springs and the damper
-  double spring = 0;      // work done on the springs (stored + dissipated by hysteresis)
-  double damper = 0;      // dissipated by the damper
-  double kinetic = 0;     // of the mass, now
-  double gravity = 0;     // weight × rise of the mass, now
+struct SdofEnergy {    // N·mm, since the start
+  double input = 0;    // work done by the base on the springs and the damper
+  double spring = 0;   // work done on the springs (stored + dissipated by hysteresis)
+  double damper = 0;   // dissipated by the damper
+  double kinetic = 0;  // of the mass, now
+  double gravity = 0;  // weight × rise of the mass, now
   [[nodiscard]] double residual() const noexcept { return input - spring - damper - kinetic - gravity; }
 };
 
@@ -76,8 +76,7 @@ struct SteadyResponse {
   double frequency_hz = 0, base_amplitude_mm = 0, mass_amplitude_mm = 0, ratio = 0, phase_rad = 0;
   double peak_to_peak_ratio = 0;  // (max − min of x) / (max − min of y): what a non-sinusoidal response does
 };
-[[nodiscard]] SteadyResponse steady_response(SdofSystem& system, double amplitude_mm, double frequency_hz, int settle_cycles,
-                                             int measured_cycles);
+[[nodiscard]] SteadyResponse steady_response(SdofSystem& system, double amplitude_mm, double frequency_hz, int settle_cycles, int measured_cycles);
 
 // |X/Y| of a linear mass-spring-damper under base excitation, at frequency ratio r and damping ratio ζ.
 [[nodiscard]] double linear_transmissibility(double r, double zeta) noexcept;

@@ -44,9 +44,7 @@ class SimplifiedSmaModel final : public HysteresisModel {
     SimplifiedSmaModel copy(*this);
     return copy.step(x);
   }
-  [[nodiscard]] std::unique_ptr<HysteresisModel> clone() const override {
-    return std::make_unique<SimplifiedSmaModel>(*this);
-  }
+  [[nodiscard]] std::unique_ptr<HysteresisModel> clone() const override { return std::make_unique<SimplifiedSmaModel>(*this); }
   [[nodiscard]] double input() const noexcept override { return d_; }
   [[nodiscard]] double output() const noexcept override { return f_; }
   // [kind 2, phase, d, f, xi, anchor_d, anchor_f, k, entry_d, entry_xi].
@@ -58,21 +56,15 @@ class SimplifiedSmaModel final : public HysteresisModel {
   [[nodiscard]] const SmaParameters& parameters() const noexcept { return p_; }
   [[nodiscard]] const SmaTransitions& transition_points() const noexcept { return tr_; }
   // Reuss stiffness of the elastic line at fraction xi (Eqs. 28, 34).
-  [[nodiscard]] double elastic_stiffness(double xi) const noexcept {
-    return p_.KA * p_.KM / (xi * (p_.KA - p_.KM) + p_.KM);
-  }
+  [[nodiscard]] double elastic_stiffness(double xi) const noexcept { return p_.KA * p_.KM / (xi * (p_.KA - p_.KM) + p_.KM); }
 
  private:
   void enter_elastic(double anchor_d, double anchor_f, double xi) noexcept;
   void enter_transformation(Phase phase, double d) noexcept;
   [[nodiscard]] double forward_meet() const noexcept;  // where loading on the elastic line meets the forward line
   [[nodiscard]] double reverse_meet() const noexcept;  // where unloading meets the reverse line
-  [[nodiscard]] double forward_force(double d) const noexcept {
-    return tr_.Ms.force + tr_.forward_slope() * (d - tr_.Ms.displacement);
-  }
-  [[nodiscard]] double reverse_force(double d) const noexcept {
-    return tr_.Af.force + tr_.reverse_slope() * (d - tr_.Af.displacement);
-  }
+  [[nodiscard]] double forward_force(double d) const noexcept { return tr_.Ms.force + tr_.forward_slope() * (d - tr_.Ms.displacement); }
+  [[nodiscard]] double reverse_force(double d) const noexcept { return tr_.Af.force + tr_.reverse_slope() * (d - tr_.Af.displacement); }
   bool advance_elastic(double x) noexcept;  // true when x is reached
   bool advance_forward(double x) noexcept;
   bool advance_reverse(double x) noexcept;

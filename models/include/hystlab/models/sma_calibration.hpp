@@ -18,17 +18,16 @@ struct SmaCalibrationOptions {
 
 struct SmaCalibration {
   SmaParameters parameters;
-  SmaTransitions transitions;     // fitted transition points
-  SmaParameters initial_guess;    // from piecewise-linear fits of each branch
-  double rms_residual = 0.0;      // N
-  double max_residual = 0.0;      // N
+  SmaTransitions transitions;   // fitted transition points
+  SmaParameters initial_guess;  // from piecewise-linear fits of each branch
+  double rms_residual = 0.0;    // N
+  double max_residual = 0.0;    // N
   int iterations = 0;
 };
 
 // The loop must load past the end of the forward transformation and unload below the end of
 // the reverse one; throws std::invalid_argument when the data cannot determine the parameters.
-[[nodiscard]] SmaCalibration calibrate_simplified_sma(std::span<const double> displacement,
-                                                      std::span<const double> force,
+[[nodiscard]] SmaCalibration calibrate_simplified_sma(std::span<const double> displacement, std::span<const double> force,
                                                       const SmaCalibrationOptions& options = {});
 
 }  // namespace hystlab::models

@@ -28,10 +28,10 @@ struct Resonance {
 [[nodiscard]] std::optional<Resonance> find_resonance(std::span<const SweepPoint> points);
 
 struct Jump {
-  double lo_hz = 0, hi_hz = 0;   // the frequencies between which up and down differ by more than the threshold
-  double max_difference = 0;     // the largest |up − down| / max(up, down) there
-  double up_jump_hz = 0;         // where the up sweep's ratio changes most between neighbouring points (geometric midpoint)
-  double down_jump_hz = 0;       // and the down sweep's
+  double lo_hz = 0, hi_hz = 0;  // the frequencies between which up and down differ by more than the threshold
+  double max_difference = 0;    // the largest |up − down| / max(up, down) there
+  double up_jump_hz = 0;        // where the up sweep's ratio changes most between neighbouring points (geometric midpoint)
+  double down_jump_hz = 0;      // and the down sweep's
 };
 
 // Up and down at one amplitude, each in any order; down is interpolated (log-log) at up's

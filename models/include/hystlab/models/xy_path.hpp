@@ -24,8 +24,7 @@ struct PathReduction {
 
 // budget: points wanted (the reversals are kept beyond it when there are more). reversal_fraction:
 // a turn of x counts when x comes back by this fraction of its range (noise below it is no turn).
-[[nodiscard]] PathReduction reduce_path(std::span<const float> x, std::span<const float> y, std::size_t budget,
-                                        double reversal_fraction = 0.01);
+[[nodiscard]] PathReduction reduce_path(std::span<const float> x, std::span<const float> y, std::size_t budget, double reversal_fraction = 0.01);
 
 // The reversals of x alone (indices of the turning points), with the same rule.
 [[nodiscard]] std::vector<std::size_t> reversals_of(std::span<const float> x, double threshold);

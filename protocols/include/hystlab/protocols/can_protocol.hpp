@@ -11,8 +11,8 @@
 
 namespace hystlab::protocols::can {
 
-inline constexpr std::uint32_t kCommand = 0x200, kStatusA = 0x180, kStatusB = 0x280, kStatusC = 0x380,
-                               kShakerCommand = 0x300, kShakerStatus = 0x480, kHeartbeat = 0x700;
+inline constexpr std::uint32_t kCommand = 0x200, kStatusA = 0x180, kStatusB = 0x280, kStatusC = 0x380, kShakerCommand = 0x300, kShakerStatus = 0x480,
+                               kHeartbeat = 0x700;
 inline constexpr int kMaxMode = 3;
 
 struct Command {  // hystlab -> rig

@@ -2,8 +2,8 @@
 // A Modbus register map as data: which table, address, type, word order and scaling carry each
 // signal. Real controllers differ, so the map is a JSON file (docs: protocols/MODBUS.md).
 #include <array>
-#include <map>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -27,10 +27,10 @@ struct MapEntry {
   std::uint16_t address = 0;
   ValueType type = ValueType::uint16;
   WordOrder word_order = WordOrder::big;
-  double scale = 1.0;   // engineering = raw * scale + offset
+  double scale = 1.0;  // engineering = raw * scale + offset
   double offset = 0.0;
   std::string unit;
-  std::optional<double> min, max;  // engineering limits; a decoded value outside is out_of_range
+  std::optional<double> min, max;            // engineering limits; a decoded value outside is out_of_range
   [[nodiscard]] int width() const noexcept;  // registers (or bits) used: 1 or 2
 };
 
@@ -39,11 +39,11 @@ struct MapEntry {
 // and every sample carries the controller's time (sample_counter x period_s). Optional.
 struct SampleWindow {
   ModbusTable table = ModbusTable::input_register;
-  std::uint16_t address = 0;        // record 0 (the newest) starts here
-  int records = 0;                  // depth of the window
-  double period_s = 0;              // the controller's sample period
-  std::vector<Signal> fields;       // one record: these signals, each encoded as its entry says
-  int record_width = 0;             // registers per record
+  std::uint16_t address = 0;   // record 0 (the newest) starts here
+  int records = 0;             // depth of the window
+  double period_s = 0;         // the controller's sample period
+  std::vector<Signal> fields;  // one record: these signals, each encoded as its entry says
+  int record_width = 0;        // registers per record
   [[nodiscard]] int records_per_read() const noexcept { return 125 / record_width; }
 };
 

@@ -47,7 +47,7 @@ struct CommandOutcome {
   bool confirmed = false;  // the rig's status word shows it (the e-stop bit; ready and clear)
   std::string state;       // the rig's supervision state (rig commands) or the campaign's
   std::string reason;
-  double waited_s = 0;     // from the request to the answer
+  double waited_s = 0;  // from the request to the answer
 };
 [[nodiscard]] const char* to_string(CommandOutcome::Result r) noexcept;
 
@@ -66,10 +66,10 @@ struct RigSupervision {
   std::string state = "disconnected";  // the supervisor's RigState, as text at this edge
   bool latched = false, resetting = false, recovering = false, have_sample = false;
   std::string latch_reason, reset_refusal;
-  std::string recovery_result;  // the last limit recovery's outcome, in words
-  std::uint16_t latched_fault_code = 0;  // the code that latched (0: an e-stop or none)
+  std::string recovery_result;                    // the last limit recovery's outcome, in words
+  std::uint16_t latched_fault_code = 0;           // the code that latched (0: an e-stop or none)
   std::uint16_t status_word = 0, fault_code = 0;  // the last sample's
-  std::string fault_text;                          // the map's text for fault_code
+  std::string fault_text;                         // the map's text for fault_code
   double position_mm = 0, force_N = 0;
   std::uint64_t link_losses = 0, transitions = 0;
   std::vector<nlohmann::json> recent;  // the last transitions: at, t, from, to, reason
@@ -78,7 +78,7 @@ struct RigSupervision {
 
 // One live sample of a rig, as its acquisition thread saw it.
 struct LiveSample {
-  double mono_s = 0;  // host steady clock when acquired (the same clock in every process here)
+  double mono_s = 0;                           // host steady clock when acquired (the same clock in every process here)
   double t = 0, cmd = 0, disp = 0, force = 0;  // shakers: base displacement, mass displacement, mass acceleration
   std::int64_t run = 0;                        // 0: the rig is idle (a sample read between campaigns)
   std::uint32_t status = 0;
@@ -87,7 +87,7 @@ struct LiveSample {
 // The rig link's I/O health.
 struct LinkHealth {
   std::uint64_t reads = 0, writes = 0, reconnects = 0;
-  std::uint64_t lost_samples = 0;  // gaps in a controller's sample counter that no block read filled
+  std::uint64_t lost_samples = 0;                             // gaps in a controller's sample counter that no block read filled
   std::vector<std::pair<std::string, std::uint64_t>> errors;  // by kind: "timeout", "crc_error", ...
   double last_transaction_us = 0, max_transaction_us = 0, total_transaction_us = 0;
   std::vector<std::uint64_t> latency_histogram_us;  // bucket k: [2^k, 2^(k+1)) µs; the last is open
@@ -109,12 +109,12 @@ struct WriterCounters {
 // What a plan will do, before it is submitted.
 struct PlanPreview {
   db::CampaignKind kind = db::CampaignKind::fot;
-  double duration_s = 0;       // rig seconds, from the rig at the range's bottom
-  std::size_t nodes = 0;       // FOT nodes measured (fot), frequencies (sine)
-  double peak_speed_mm_s = 0;  // commanded
-  double peak_force_N = 0;     // predicted by the model on the plan's input (load frames)
-  double peak_accel_m_s2 = 0;  // of the base (shakers)
-  double samples = 0;          // duration × sample rate
+  double duration_s = 0;                         // rig seconds, from the rig at the range's bottom
+  std::size_t nodes = 0;                         // FOT nodes measured (fot), frequencies (sine)
+  double peak_speed_mm_s = 0;                    // commanded
+  double peak_force_N = 0;                       // predicted by the model on the plan's input (load frames)
+  double peak_accel_m_s2 = 0;                    // of the base (shakers)
+  double samples = 0;                            // duration × sample rate
   double sample_rate_hz = 0, force_limit_N = 0;  // the plan's
   // Rig seconds per wall second (a simulator faster than real time): the campaign then takes
   // duration_s / time_scale of wall time, and the host, sampling at sample_rate_hz of wall time,

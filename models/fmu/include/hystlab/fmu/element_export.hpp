@@ -26,7 +26,7 @@ inline constexpr std::string_view kExportFormats = "json, csv, m, h or fmu";
 // user named, when they named one (a document of the other kind is then refused by its parser,
 // naming the missing field). name: the C header's prefix and the FMU's model name.
 // Throws std::invalid_argument for an unknown format ("'x' is not json, csv, m, h or fmu").
-[[nodiscard]] ExportedFile export_element(std::string_view document, std::string_view format, const std::string& name,
-                                          const std::string& created = {}, std::optional<models::ElementKind> kind = {});
+[[nodiscard]] ExportedFile export_element(std::string_view document, std::string_view format, const std::string& name, const std::string& created = {},
+                                          std::optional<models::ElementKind> kind = {});
 
 }  // namespace hystlab::fmu
