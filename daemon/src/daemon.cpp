@@ -136,17 +136,21 @@ struct Daemon::Impl {
     return nullptr;
   }
 
+  // The envelope in force when the campaign was handed to its rig (the HDF5 export's
+  // /campaign/envelope): the rig's config row is rewritten at every start and holds none. A
+  // record, not a condition of the run: a busy database here never keeps a job from its rig.
+  void record_envelope(const RigWorker& w, std::int64_t id) noexcept {
+    try {
+      store.add_event(id, "envelope", envelope_json(w.entry.envelope, w.info.kind == "shaker").dump(), now_iso());
+    } catch (const std::exception& e) {
+      spdlog::warn("campaign {}: the envelope in force was not recorded ({})", id, e.what());
+    }
+  }
+
   // A campaign just submitted: its plan, parsed once by submit() and checked against the rig's
   // envelope, goes to the rig's thread as it is (no second parse, no database round trip: the
   // row is the record, and the source only at a restart or a resume).
-  // The envelope in force when the campaign was handed to its rig (the HDF5 export's
-  // /campaign/envelope): the rig's config row is rewritten at every start and holds none.
-  void record_envelope(const RigWorker& w, std::int64_t id) {
-    store.add_event(id, "envelope", envelope_json(w.entry.envelope, w.info.kind == "shaker").dump(), now_iso());
-  }
-
   void dispatch_new(RigWorker& w, std::int64_t id, Plan plan, double submitted_mono) {
-    record_envelope(w, id);
     CampaignJob job;
     job.isolator = w.entry.isolator;
     job.id = id;
@@ -154,6 +158,7 @@ struct Daemon::Impl {
     job.plan = std::move(plan);
     dispatched.insert(id);
     w.push_job(std::move(job));
+    record_envelope(w, id);
   }
 
   // Hands queued campaigns to their rigs' threads, once each, with the plan checked against the
