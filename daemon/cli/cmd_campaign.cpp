@@ -12,8 +12,8 @@
 #include "event_text.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/db/campaign_record.hpp"
-#include "hystlab/db/signals.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/domain/signals.hpp"
 #include "hystlab/fmu/element_export.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
@@ -219,9 +219,9 @@ void show_json(db::Store& store, const db::CampaignRow& row) {
   const auto plan = nlohmann::json::parse(row.plan, nullptr, false);
   const std::string why = store.state_reason(row.id, row.state);
   nlohmann::json j{{"id", row.id},
-                   {"kind", db::to_string(row.kind)},
+                   {"kind", domain::to_string(row.kind)},
                    {"rig", store.rig_name(row.rig_id)},
-                   {"state", db::to_string(row.state)},
+                   {"state", domain::to_string(row.state)},
                    {"reason", why.empty() ? nlohmann::json() : nlohmann::json(why)},
                    {"created_at", row.created_at},
                    {"updated_at", row.updated_at},
@@ -252,7 +252,7 @@ void show_json(db::Store& store, const db::CampaignRow& row) {
 // the lab recorded with it (with the plan, or changed since: db/campaign_record.hpp).
 void print_heading(db::Store& store, const db::CampaignRow& row) {
   const std::string why = store.state_reason(row.id, row.state);
-  std::cout << "campaign " << row.id << ": " << db::to_string(row.kind) << " on " << store.rig_name(row.rig_id) << ", " << db::to_string(row.state)
+  std::cout << "campaign " << row.id << ": " << domain::to_string(row.kind) << " on " << store.rig_name(row.rig_id) << ", " << domain::to_string(row.state)
             << (why.empty() ? "" : ": " + why) << "\n"
             << "  created " << utc_time(row.created_at) << ", updated " << utc_time(row.updated_at) << "\n";
   const db::CampaignRecord record = db::campaign_record(store, row);
@@ -288,17 +288,14 @@ int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
   for (const auto& r : store.runs(row.id))
     std::cout << "  run " << r.id << (r.role == "validation" ? " (validation)" : "") << ": " << r.state << ", " << r.samples << " samples, " << r.nodes
               << " FOT nodes\n";
-  for (const std::string& d : store.event_details(row.id, "training"))
-    std::cout << "  training: " << nlohmann::json::parse(d, nullptr, false).value("why", std::string("?")) << "\n";
+  for (const domain::TrainingEvent& t : db::events_of<domain::TrainingEvent>(store, row.id)) std::cout << "  training: " << t.why << "\n";
   for (const auto& t : store.tables(row.id)) {
     const std::string acc = accuracy_line(t.accuracy_json), held = heldout_line(t.accuracy_json);
     std::cout << "  table " << t.id << ": " << t.method << ", n = " << t.n << ", " << round_g(t.range_lo) << "–" << round_g(t.range_hi) << " mm"
               << (acc.empty() ? "" : ", own samples " + acc) << (held.empty() ? "" : "; held-out " + held) << "\n";
   }
-  for (const std::string& d : store.event_details(row.id, "recommendation")) {
-    const auto r = nlohmann::json::parse(d, nullptr, false);
-    std::cout << "  recommended: table " << r.value("table", std::int64_t{0}) << ": " << r.value("why", std::string()) << "\n";
-  }
+  for (const domain::RecommendationEvent& r : db::events_of<domain::RecommendationEvent>(store, row.id))
+    std::cout << "  recommended: table " << r.table << ": " << r.why << "\n";
   if (const auto loops = store.loops(row.id); !loops.empty())
     std::cout << "  " << loops.size() << " closed cycle(s) with their figures (--json, or hystlab loops on a run's CSV)\n";
   print_sweep(store, row);
@@ -345,7 +342,8 @@ int run_campaign_cmd(const Args& args) {
     const Options opt(rest(args, 1), {"db"}, {});
     db::Store store = open_store(opt);
     std::vector<std::vector<std::string>> rows;
-    for (const auto& c : store.campaigns()) rows.push_back({std::to_string(c.id), db::to_string(c.kind), db::to_string(c.state), utc_time(c.updated_at)});
+    for (const auto& c : store.campaigns())
+      rows.push_back({std::to_string(c.id), domain::to_string(c.kind), domain::to_string(c.state), utc_time(c.updated_at)});
     std::cout << aligned_table({{"id", true}, {"kind"}, {"state"}, {"updated"}}, rows);
     return 0;
   }

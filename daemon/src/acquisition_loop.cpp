@@ -11,23 +11,23 @@
 namespace hystlab::daemon {
 using nlohmann::json;
 
-db::CampaignState state_of(CampaignEnd e) noexcept {
+domain::CampaignState state_of(CampaignEnd e) noexcept {
   switch (e) {
     case CampaignEnd::completed:
-      return db::CampaignState::completed;
+      return domain::CampaignState::completed;
     case CampaignEnd::failed:
-      return db::CampaignState::failed;
+      return domain::CampaignState::failed;
     case CampaignEnd::aborted:
-      return db::CampaignState::aborted;
+      return domain::CampaignState::aborted;
     case CampaignEnd::interrupted:
-      return db::CampaignState::interrupted;
+      return domain::CampaignState::interrupted;
     case CampaignEnd::none:
       break;
   }
-  return db::CampaignState::running;
+  return domain::CampaignState::running;
 }
 
-const char* to_string(CampaignEnd e) noexcept { return db::to_string(state_of(e)); }
+const char* to_string(CampaignEnd e) noexcept { return domain::to_string(state_of(e)); }
 
 const char* to_string(CampaignPhase p) noexcept {
   using P = CampaignPhase;
@@ -66,22 +66,22 @@ Loop::Loop(const CampaignJob& j, RunnerContext& c)
     : job(j),
       plan(j.plan),
       ctx(c),
-      shaker(j.plan.kind == db::CampaignKind::sine),
+      shaker(j.plan.kind == domain::CampaignKind::sine),
       safety(j.plan.limits),
       watchdog(c.watchdog_hold_periods, c.watchdog_fail_periods),
       health0(c.rig.health()) {}
 
-void Loop::state(db::CampaignState to, const std::string& reason) {
+void Loop::state(domain::CampaignState to, const std::string& reason) {
   const std::string now = ctx.now_iso();
   const auto id = job.id;
   ctx.writer.post([id, to, reason, now](db::Store& s) { s.transition(id, to, reason, now); });
-  if (ctx.on_state) ctx.on_state(db::to_string(to));
+  if (ctx.on_state) ctx.on_state(domain::to_string(to));
 }
 
-void Loop::event(const std::string& kind, const json& detail) {
-  const std::string now = ctx.now_iso(), text = detail.dump();
+void Loop::event(const domain::CampaignEvent& e) {
+  const std::string now = ctx.now_iso();
   const auto id = job.id;
-  ctx.writer.post([id, kind, text, now](db::Store& s) { s.add_event(id, kind, text, now); });
+  ctx.writer.post([id, e, now](db::Store& s) { s.add_event(id, e, now); });
 }
 
 void Loop::publish(double t, double a, double b, double c, std::uint16_t status) {
@@ -126,7 +126,7 @@ void Loop::check_gap(double t) {
   result.gap_total_s += hole;
   result.longest_gap_s = std::max(result.longest_gap_s, hole);
   mark.longest_gap_s = std::max(mark.longest_gap_s, hole);
-  if (hole > 0.02) event("gap", {{"from_s", t - dt}, {"to_s", t}, {"length_ms", hole * 1e3}});
+  if (hole > 0.02) event(domain::GapEvent{t - dt, t, hole * 1e3});
 }
 
 void Loop::begin_safing(double t, CampaignEnd e, const std::string& reason, double x) {
@@ -211,7 +211,7 @@ bool arm(Loop& L) {
     }
     if (ec == drivers::RigError::unsupported)
       return L.end(CampaignEnd::failed,
-                   std::string("a ") + db::to_string(L.plan.kind) + " campaign needs a " + (L.shaker ? "shaker" : "load frame") + "; this rig is not one"),
+                   std::string("a ") + domain::to_string(L.plan.kind) + " campaign needs a " + (L.shaker ? "shaker" : "load frame") + "; this rig is not one"),
              false;
     if (ec) {
       c.supervisor.on_link_error(t, ec);
@@ -236,7 +236,7 @@ void pause_now(Loop& L, Strategy& strategy, double t) {
   strategy.on_pause(L, t);
   L.paused = true;
   L.pause_started = t;
-  L.state(db::CampaignState::paused, "operator");
+  L.state(domain::CampaignState::paused, "operator");
 }
 
 // The rig's latch ends the campaign at once, whatever it was doing: a safe ramp under way keeps
@@ -285,7 +285,7 @@ bool safing_step(Loop& L, double t, double x) {
   const Limits& l = L.plan.limits;
   const double tol = L.ctx.supervisor.settings().in_position_mm;
   if (std::fabs(x - l.safe_position_mm) <= tol) {
-    L.event("safe", {{"position_mm", x}, {"target_mm", l.safe_position_mm}, {"seconds", t - L.safe_started}});
+    L.event(domain::SafeEvent{x, l.safe_position_mm, t - L.safe_started});
     return false;
   }
   if (t > L.safe_deadline + (L.stalled - L.safe_stalled)) {
@@ -467,7 +467,7 @@ void hand_off(Loop& L, Strategy& strategy, bool drove = true) {
   strategy.fill_finish(L, fj);  // first: the last descent's bottom node is counted there
   if (fj.validation.x.empty() && !L.job.prior_validation.x.empty()) fj.validation = L.job.prior_validation;
   fj.result = L.result;
-  if (L.result.gaps > 0) L.event("gaps", {{"count", L.result.gaps}, {"total_ms", L.result.gap_total_s * 1e3}, {"longest_ms", L.result.longest_gap_s * 1e3}});
+  if (L.result.gaps > 0) L.event(domain::GapsEvent{static_cast<std::int64_t>(L.result.gaps), L.result.gap_total_s * 1e3, L.result.longest_gap_s * 1e3});
   if (drove) record_quality(L);
   if (L.ctx.finish) {
     L.ctx.finish(std::move(fj));
@@ -483,7 +483,7 @@ bool create_run(Loop& L) {
   const auto id = L.job.id;
   const std::string now = L.ctx.now_iso();
   const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(), mono = L.wall0;
-  const bool validation = L.plan.kind == db::CampaignKind::fot && L.plan.validation.enabled;
+  const bool validation = L.plan.kind == domain::CampaignKind::fot && L.plan.validation.enabled;
   const auto runs = L.ctx.writer.call<std::pair<std::int64_t, std::int64_t>>(
       [id, now, wall, mono, validation](db::Store& s) { return s.add_runs(id, now, wall, mono, validation); }, L.ctx.db_timeout_s);
   if (!runs) return L.end(CampaignEnd::failed, "the database did not take the new run in time: the rig was not armed"), false;
@@ -500,22 +500,22 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
   ctx.supervisor.set_time_scale(ctx.time_scale);
   ctx.supervisor.set_time_offset(std::isnan(ctx.epoch) ? 0.0 : (L.wall0 - ctx.epoch) * ctx.time_scale);
   const Limits& l = job.plan.limits;
-  L.event("limits", {{"displacement_mm", {l.displacement_min_mm, l.displacement_max_mm}},
-                     {"force_N", l.force_max_N},
-                     {"rate_mm_s", l.rate_max_mm_s},
-                     {"safe_position_mm", l.safe_position_mm},
-                     {"safe_rate_mm_s", l.safe_rate_mm_s},
-                     {"in_position_mm", ctx.supervisor.settings().in_position_mm}});
+  L.event(domain::LimitsEvent{{l.displacement_min_mm, l.displacement_max_mm},
+                              l.force_max_N,
+                              l.rate_max_mm_s,
+                              l.safe_position_mm,
+                              l.safe_rate_mm_s,
+                              ctx.supervisor.settings().in_position_mm});
   if (!strategy->has_work()) {  // a resume with every node measured: finish without moving
     L.end(CampaignEnd::completed, "every node was measured by earlier runs: finished without driving the rig");
     L.result.run_id = job.prior_run;  // the tables belong to the last run that measured (it exists)
     hand_off(L, *strategy, false);
     return L.result;
   }
-  L.state(db::CampaignState::arming, "started by the daemon");
+  L.state(domain::CampaignState::arming, "started by the daemon");
   L.dropped_before = ctx.writer.stats().dropped_full;
   if (create_run(L) && (mark_run(L, L.result.run_id), arm(L))) {
-    L.state(db::CampaignState::running, "armed");
+    L.state(domain::CampaignState::running, "armed");
     run_ticks(L, *strategy);
   }
   L.show_phase(CampaignPhase::none);

@@ -74,8 +74,8 @@ struct Loop {
     result.end = e;
     result.reason = reason;
   }
-  void state(db::CampaignState to, const std::string& reason);
-  void event(const std::string& kind, const nlohmann::json& detail);
+  void state(domain::CampaignState to, const std::string& reason);
+  void event(const domain::CampaignEvent& e);
   // The safe ramp (abort or trip): the loop keeps sampling, storing and publishing until the
   // rig is within the in-position tolerance of the safe position, or holds where it stopped.
   void begin_safing(double t, CampaignEnd e, const std::string& reason, double position_mm);

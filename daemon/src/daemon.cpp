@@ -73,15 +73,12 @@ struct Daemon::Impl {
   // A campaign's command that its rig's thread carries out now; false when it is not running.
   bool direct(std::int64_t campaign, CampaignCommand cmd) {
     const std::string verb = to_string(cmd);
-    const Control c = cmd == CampaignCommand::pause    ? Control::pause
-                      : cmd == CampaignCommand::resume ? Control::resume
-                      : cmd == CampaignCommand::estop  ? Control::estop
-                                                       : Control::abort;
+    const Control c = cmd;
     for (auto& w : workers)
       if (w->running_campaign == campaign) {
         w->push_control(c);
         const std::string now = now_iso();
-        writer->post([campaign, verb, now](db::Store& s) { s.add_event(campaign, "command", verb, now); });
+        writer->post([campaign, verb, now](db::Store& s) { s.add_event(campaign, domain::CommandEvent{verb}, now); });
         return true;
       }
     return false;
@@ -101,9 +98,9 @@ struct Daemon::Impl {
               "campaign " + std::to_string(campaign) + " no longer moves the rig: its tables are being built, '" + to_string(cmd) + "' does not apply",
               0};
     using C = CampaignCommand;
-    using S = db::CampaignState;
+    using S = domain::CampaignState;
     RigWorker* w = worker_of(row->rig_id);
-    const std::string state = db::to_string(row->state);
+    const std::string state = domain::to_string(row->state);
     if (cmd == C::resume && (row->state == S::interrupted || row->state == S::paused || row->state == S::held)) {
       dispatched.erase(campaign);
       store.transition(campaign, S::queued,
@@ -112,7 +109,7 @@ struct Daemon::Impl {
       redispatch = true;  // to its rig on this loop's next pass (its earlier samples read there, not in this call)
       return {R::done, false, false, "queued", "queued to resume", 0};
     }
-    if ((cmd == C::abort || cmd == C::estop) && !db::is_final(row->state)) {
+    if ((cmd == C::abort || cmd == C::estop) && !domain::is_final(row->state)) {
       if (w && w->has_queued(campaign) && !w->cancel_queued(campaign)) {  // it just started: stop it there
         (void)direct(campaign, cmd);
         return {R::pending, false, false, "running", "taken by the campaign that had just started", 0};
@@ -122,7 +119,7 @@ struct Daemon::Impl {
       return {R::done, false, false, "aborted", why, 0};
     }
     const std::string why = "campaign " + std::to_string(campaign) + " is " + state + ": '" + to_string(cmd) + "' does not apply";
-    store.add_event(campaign, "command", std::string("'") + to_string(cmd) + "' refused: the campaign is " + state, now_iso());
+    store.add_event(campaign, domain::CommandEvent{std::string("'") + to_string(cmd) + "' refused: the campaign is " + state}, now_iso());
     return {R::conflict, false, false, state, why, 0};
   }
 
@@ -141,7 +138,7 @@ struct Daemon::Impl {
   // record, not a condition of the run: a busy database here never keeps a job from its rig.
   void record_envelope(const RigWorker& w, std::int64_t id) noexcept {
     try {
-      store.add_event(id, "envelope", envelope_json(w.entry.envelope, w.info.kind == "shaker").dump(), now_iso());
+      store.add_event(id, envelope_event(w.entry.envelope, w.info.kind == domain::RigKind::shaker), now_iso());
     } catch (const std::exception& e) {
       spdlog::warn("campaign {}: the envelope in force was not recorded ({})", id, e.what());
     }
@@ -182,21 +179,21 @@ struct Daemon::Impl {
     job.id = id;
     try {
       job.plan = parse_plan(json::parse(row->plan));
-      job.plan.limits = check_plan_against(job.plan, w.entry.envelope, w.entry.supervision, w.info.kind == "shaker");
+      job.plan.limits = check_plan_against(job.plan, w.entry.envelope, w.entry.supervision, w.info.kind == domain::RigKind::shaker);
     } catch (const std::exception& e) {  // a plan stored by an older or foreign tool: fail it, say why
-      store.transition(id, db::CampaignState::failed, e.what(), now_iso());
+      store.transition(id, domain::CampaignState::failed, e.what(), now_iso());
       return std::nullopt;
     }
     record_envelope(w, id);
     for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) job.prior_nodes.push_back({a, b, fa, fab});
-    if (job.plan.kind == db::CampaignKind::fot && !job.prior_nodes.empty()) {             // the fits after a resume use every run
-      for (const std::int64_t run : store.runs_of_campaign(id, db::RunRole::campaign)) {  // never the validation runs
+    if (job.plan.kind == domain::CampaignKind::fot && !job.prior_nodes.empty()) {             // the fits after a resume use every run
+      for (const std::int64_t run : store.runs_of_campaign(id, domain::RunRole::campaign)) {  // never the validation runs
         store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(), [&job](const db::SampleRow& r) { job.prior_series.add(r.disp, r.force); });
         job.prior_run = run;
       }
       // The last validation run that holds samples: a resume with every node measured scores its
       // tables on it (an interruption during the validation run or the finishing left it there).
-      const std::vector<std::int64_t> vruns = store.runs_of_campaign(id, db::RunRole::validation);
+      const std::vector<std::int64_t> vruns = store.runs_of_campaign(id, domain::RunRole::validation);
       const auto last = std::find_if(vruns.rbegin(), vruns.rend(), [this](std::int64_t run) { return store.sample_count(run) > 0; });
       if (last != vruns.rend()) {
         store.for_each_sample(*last, 0, std::numeric_limits<std::int64_t>::max(),
@@ -375,16 +372,17 @@ double Daemon::uptime_s() const noexcept { return std::chrono::duration<double>(
 std::size_t Daemon::rig_index(const std::string& name, std::string_view plan_kind) const {
   const auto& ws = impl_->workers;
   std::string names;
-  for (const auto& w : ws) names += (names.empty() ? "'" : ", '") + w->info.name + "' (" + w->info.kind + ")";
+  for (const auto& w : ws) names += (names.empty() ? "'" : ", '") + w->info.name + "' (" + domain::to_string(w->info.kind) + ")";
   if (name.empty()) {
     if (ws.size() == 1) return 0;
-    const std::string want = plan_kind.empty() ? "" : plan_kind == "sine" ? "shaker" : "load_frame";
+    const std::optional<domain::RigKind> want =
+        plan_kind.empty() ? std::nullopt : std::optional(plan_kind == "sine" ? domain::RigKind::shaker : domain::RigKind::load_frame);
     std::vector<std::size_t> fit;
     for (std::size_t k = 0; k < ws.size(); ++k)
-      if (!want.empty() && ws[k]->info.kind == want) fit.push_back(k);
+      if (want && ws[k]->info.kind == *want) fit.push_back(k);
     if (fit.size() == 1) return fit[0];
-    throw std::invalid_argument("rig: several rigs " + (want.empty() ? std::string("are configured") : "can run a " + std::string(plan_kind) + " plan") + " (" +
-                                names + "); name one with \"rig\" (--rig NAME)");
+    throw std::invalid_argument("rig: several rigs " + (want ? "can run a " + std::string(plan_kind) + " plan" : std::string("are configured")) + " (" + names +
+                                "); name one with \"rig\" (--rig NAME)");
   }
   for (std::size_t k = 0; k < ws.size(); ++k)
     if (ws[k]->info.name == name) return k;
@@ -393,19 +391,19 @@ std::size_t Daemon::rig_index(const std::string& name, std::string_view plan_kin
 
 std::pair<Plan, std::size_t> Daemon::check_plan(const std::string& rig_name, const json& plan_json) const {
   Plan plan = parse_plan(plan_json);  // PlanError names the field
-  const std::size_t k = rig_index(rig_name, db::to_string(plan.kind));
+  const std::size_t k = rig_index(rig_name, domain::to_string(plan.kind));
   const RigWorker& rig = *impl_->workers.at(k);
-  const bool shaker = rig.info.kind == "shaker";
-  if ((plan.kind == db::CampaignKind::sine) != shaker)
-    throw std::invalid_argument(std::string("plan.kind: a ") + db::to_string(plan.kind) + " plan cannot run on rig '" + rig.info.name + "', a " +
-                                rig.info.kind);
+  const bool shaker = rig.info.kind == domain::RigKind::shaker;
+  if ((plan.kind == domain::CampaignKind::sine) != shaker)
+    throw std::invalid_argument(std::string("plan.kind: a ") + domain::to_string(plan.kind) + " plan cannot run on rig '" + rig.info.name + "', a " +
+                                domain::to_string(rig.info.kind));
   (void)check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, shaker);  // PlanError names the field
   return {std::move(plan), k};
 }
 
 Limits Daemon::applied_limits(const Plan& plan, std::size_t k) const {
   const RigWorker& rig = *impl_->workers.at(k);
-  return check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, rig.info.kind == "shaker");
+  return check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, rig.info.kind == domain::RigKind::shaker);
 }
 
 std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) {
@@ -415,7 +413,7 @@ std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) 
   if (const RigSupervision s = rig.snapshot(); s.latched)
     throw std::invalid_argument("rig: '" + rig.info.name + "' is " + s.state + " (" + s.latch_reason + "): reset it first");
   const std::int64_t rig_id = rig.info.id;
-  const db::CampaignKind kind = plan.kind;
+  const domain::CampaignKind kind = plan.kind;
   const std::string text = plan_json.dump();
   Plan checked = plan;
   checked.limits = applied_limits(plan, k);
@@ -431,7 +429,7 @@ void Daemon::set_record(std::int64_t campaign_id, const json& changes) {
   if (!changes.is_object() || changes.empty()) throw control::PlanError("", "record: give the specimen, the notes or both");
   for (const auto& [field, value] : changes.items()) {
     const auto problem =
-        value.is_string() ? db::record_field_problem(field, value.get<std::string>()) : db::record_field_problem(field, "").value_or("must be text");
+        value.is_string() ? domain::record_field_problem(field, value.get<std::string>()) : domain::record_field_problem(field, "").value_or("must be text");
     if (problem) throw control::PlanError(field, field + " " + *problem);
   }
   impl_->on_main<bool>([this, campaign_id, changes] {
@@ -441,7 +439,7 @@ void Daemon::set_record(std::int64_t campaign_id, const json& changes) {
     db::CampaignRecord r = db::campaign_record(store, *row);
     if (changes.contains("specimen")) r.specimen = changes["specimen"].get<std::string>();
     if (changes.contains("notes")) r.notes = changes["notes"].get<std::string>();
-    (void)store.add_event(campaign_id, "record", db::record_detail(r), now_iso());
+    (void)store.add_event(campaign_id, domain::RecordEvent{r.specimen, r.notes}, now_iso());
     return true;
   });
 }
@@ -453,7 +451,7 @@ CommandOutcome Daemon::command(std::int64_t campaign_id, CampaignCommand cmd) {
     if (!w)
       w = d.on_main<RigWorker*>([&d, campaign_id]() -> RigWorker* {
         const auto row = d.store.campaign(campaign_id);
-        return row && !db::is_final(row->state) ? d.worker_of(row->rig_id) : nullptr;
+        return row && !domain::is_final(row->state) ? d.worker_of(row->rig_id) : nullptr;
       });
     if (w) {
       CommandOutcome rig = d.rig_command(*w, RigCommand::estop, 2.0);

@@ -65,7 +65,7 @@ class DaemonControl final : public control::DaemonInterface {
   }
   std::optional<control::FotGrid> fot_grid(const nlohmann::json& stored_plan) const override {
     const Plan p = parse_plan(stored_plan);
-    if (p.kind != db::CampaignKind::fot) return std::nullopt;
+    if (p.kind != domain::CampaignKind::fot) return std::nullopt;
     return control::FotGrid{p.lo_mm, p.hi_mm, p.subdivisions, p.nodes_mm};
   }
   control::CommandOutcome command(std::int64_t campaign, control::CampaignCommand c) override { return d_.command(campaign, c); }

@@ -80,14 +80,19 @@ SupervisionSettings parse_supervision(const json& j, const std::string& where) {
   return s;
 }
 
-json envelope_json(const RigEnvelope& e, bool shaker) {
-  if (shaker)
-    return {{"displacement_mm", e.shaker_displacement_max_mm},
-            {"velocity_mm_s", e.shaker_velocity_max_mm_s},
-            {"accel_g", e.shaker_accel_max_g},
-            {"frequency_hz", {e.shaker_freq_min_hz, e.shaker_freq_max_hz}}};
-  return {{"stroke_mm", {e.stroke_min_mm, e.stroke_max_mm}}, {"force_N", e.force_max_N}, {"speed_mm_s", e.speed_max_mm_s}, {"accel_mm_s2", e.accel_max_mm_s2}};
+domain::EnvelopeEvent envelope_event(const RigEnvelope& e, bool shaker) {
+  domain::EnvelopeEvent v;
+  if (shaker) {
+    v.displacement_mm = e.shaker_displacement_max_mm, v.velocity_mm_s = e.shaker_velocity_max_mm_s, v.accel_g = e.shaker_accel_max_g;
+    v.frequency_hz = {e.shaker_freq_min_hz, e.shaker_freq_max_hz};
+  } else {
+    v.stroke_mm = {e.stroke_min_mm, e.stroke_max_mm};
+    v.force_N = e.force_max_N, v.speed_mm_s = e.speed_max_mm_s, v.accel_mm_s2 = e.accel_max_mm_s2;
+  }
+  return v;
 }
+
+json envelope_json(const RigEnvelope& e, bool shaker) { return domain::detail_json(envelope_event(e, shaker)); }
 
 json supervision_json(const SupervisionSettings& s) {
   return {{"in_position_mm", s.in_position_mm},
@@ -124,7 +129,7 @@ void check_shaker(const Plan& p, const RigEnvelope& e) {
 
 void check_frame(const Plan& p, const RigEnvelope& e) {
   const std::string stroke = "[" + num(e.stroke_min_mm) + ", " + num(e.stroke_max_mm) + "] mm";
-  if (p.kind == db::CampaignKind::fot && (p.lo_mm < e.stroke_min_mm || p.hi_mm > e.stroke_max_mm))
+  if (p.kind == domain::CampaignKind::fot && (p.lo_mm < e.stroke_min_mm || p.hi_mm > e.stroke_max_mm))
     refuse("range_mm", "[" + num(p.lo_mm) + ", " + num(p.hi_mm) + "] exceeds the rig's stroke " + stroke);
   for (std::size_t k = 0; k < p.points_mm.size(); ++k)
     if (p.points_mm[k] < e.stroke_min_mm || p.points_mm[k] > e.stroke_max_mm)

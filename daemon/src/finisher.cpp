@@ -43,7 +43,7 @@ void Finisher::run() {
     } catch (const std::exception& e) {  // a fit that throws fails the campaign; the thread goes on
       spdlog::error("campaign {}: finishing failed: {}", id, e.what());
       const std::string now = now_iso(), reason = std::string("finishing failed: ") + e.what();
-      writer_.post([id, reason, now](db::Store& s) { s.transition(id, db::CampaignState::failed, reason, now); });
+      writer_.post([id, reason, now](db::Store& s) { s.transition(id, domain::CampaignState::failed, reason, now); });
     }
     // The fits' working memory (the whole record, the solver's matrices) goes back to the system:
     // glibc keeps freed heap of its threads' arenas otherwise, and the daemon's resident size

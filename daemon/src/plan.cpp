@@ -1,6 +1,6 @@
 #include "hystlab/daemon/plan.hpp"
 
-#include "hystlab/db/campaign_record.hpp"
+#include "hystlab/domain/record.hpp"
 #include "plan_fields.hpp"
 
 #include <cmath>
@@ -154,7 +154,7 @@ Plan parse_plan(const json& j) {
   p.source = j;
   if (!j.contains("kind") || !j["kind"].is_string()) fail("kind", "is required: \"fot\", \"waveform\" or \"sine\"");
   const std::string kind = j["kind"].get<std::string>();
-  const auto parsed_kind = db::campaign_kind_from(kind);
+  const auto parsed_kind = domain::campaign_kind_from(kind);
   if (!parsed_kind) fail("kind", "must be \"fot\", \"waveform\" or \"sine\" (got \"" + kind + "\")");
   p.kind = *parsed_kind;
   static const char* common[] = {"kind", "ramp_rate_mm_s", "dwell_s", "sample_rate_hz", "limits", "name", "specimen", "notes"};
@@ -162,19 +162,19 @@ Plan parse_plan(const json& j) {
   for (const char* field : {"specimen", "notes"}) {  // checked as a later change is (db/campaign_record.hpp)
     if (!j.contains(field)) continue;
     if (!j[field].is_string()) fail(field, "must be text");
-    if (const auto problem = db::record_field_problem(field, j[field].get<std::string>())) fail(field, *problem);
+    if (const auto problem = domain::record_field_problem(field, j[field].get<std::string>())) fail(field, *problem);
   }
   auto known = [&](const std::vector<std::string>& extra) {
     for (const auto& [k, _] : j.items()) {
       bool ok = std::find(std::begin(common), std::end(common), k) != std::end(common);
       for (const auto& e : extra) ok = ok || e == k;
-      if (!ok) fail(k, std::string("is not a field of a ") + db::to_string(p.kind) + " plan");
+      if (!ok) fail(k, std::string("is not a field of a ") + domain::to_string(p.kind) + " plan");
     }
   };
   p.ramp_rate_mm_s = number(j, "ramp_rate_mm_s", 0.5, 1e-4, 1e3);
   p.dwell_s = number(j, "dwell_s", 0.0, 0.0, 3600.0);
   p.sample_rate_hz = number(j, "sample_rate_hz", 1000.0, 1.0, 10000.0);
-  if (p.kind == db::CampaignKind::fot) {
+  if (p.kind == domain::CampaignKind::fot) {
     known({"range_mm", "subdivisions", "nodes_mm", "repeats", "training_cycles", "training", "validation", "plateaus_mm"});
     if (j.contains("nodes_mm")) {
       parse_nodes(j, p);
@@ -191,7 +191,7 @@ Plan parse_plan(const json& j) {
     if (p.lo_mm < p.limits.displacement_min_mm || p.hi_mm > p.limits.displacement_max_mm) fail("range_mm", "must lie inside limits.displacement_mm");
     p.validation = parse_validation(j, p);
     p.plateaus_mm = parse_plateaus(j, p);
-  } else if (p.kind == db::CampaignKind::waveform) {
+  } else if (p.kind == domain::CampaignKind::waveform) {
     known({"points_mm"});
     if (!j.contains("points_mm") || !j["points_mm"].is_array() || j["points_mm"].size() < 2)
       fail("points_mm", "must be an array of at least two displacements");

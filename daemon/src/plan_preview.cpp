@@ -21,10 +21,10 @@ PlanPreview preview_sine(const Plan& p) {
 
 PlanPreview preview_plan(const Plan& plan, models::HysteresisModel* model) {
   PlanPreview v;
-  if (plan.kind == db::CampaignKind::sine) {
+  if (plan.kind == domain::CampaignKind::sine) {
     v = preview_sine(plan);
   } else {
-    const std::vector<Segment> segs = plan.kind == db::CampaignKind::fot ? fot_schedule(plan) : waveform_schedule(plan);
+    const std::vector<Segment> segs = plan.kind == domain::CampaignKind::fot ? fot_schedule(plan) : waveform_schedule(plan);
     double x = segs.empty() ? 0.0 : segs.front().target_mm;  // the preamble's end: the rig starts there
     if (model) model->reset(), v.peak_force_N = std::abs(model->step(x));
     for (const Segment& s : segs) {
@@ -37,7 +37,7 @@ PlanPreview preview_plan(const Plan& plan, models::HysteresisModel* model) {
       }
       x = s.target_mm;
     }
-    if (plan.kind == db::CampaignKind::fot)
+    if (plan.kind == domain::CampaignKind::fot)
       v.nodes = static_cast<std::size_t>(plan.subdivisions) * static_cast<std::size_t>(plan.subdivisions + 1) / 2 *
                 static_cast<std::size_t>(std::max(plan.repeats, 1));
   }

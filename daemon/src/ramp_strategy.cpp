@@ -28,7 +28,7 @@ class RampStrategy final : public Strategy {
     series_ = L.job.prior_series;
     rows_begin_ = series_.x.size();
     halvings_seen_ = series_.halvings;
-    if (plan_.kind != db::CampaignKind::fot) return;
+    if (plan_.kind != domain::CampaignKind::fot) return;
     const models::Grid g = fot_grid(plan_);
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
     for (const models::FotNode& n : L.job.prior_nodes) (void)builder_->add(n);
@@ -85,16 +85,16 @@ class RampStrategy final : public Strategy {
 
   void on_resume(Loop& L, double t, bool after_link_loss) override {
     const Segment* cur = seq_.current();
-    if (!after_link_loss && plan_.kind == db::CampaignKind::fot && cur && t - L.pause_started > L.ctx.resume_preamble_after_s) {
+    if (!after_link_loss && plan_.kind == domain::CampaignKind::fot && cur && t - L.pause_started > L.ctx.resume_preamble_after_s) {
       // Memory-aware resume: the specimen drifted while held; wipe its memory at δmin and
       // re-take the row that was in progress.
       const std::size_t k = cur->kind == SegmentKind::descent ? seq_.index() - 1 : seq_.index();
       seq_.restart_at(k);
       seq_.insert_before_current({{plan_.lo_mm, plan_.ramp_rate_mm_s, plan_.dwell_s, SegmentKind::preamble, 0}});
-      L.state(db::CampaignState::running, "resumed after a long pause: wipe-out preamble to δmin, row re-taken");
+      L.state(domain::CampaignState::running, "resumed after a long pause: wipe-out preamble to δmin, row re-taken");
     } else {
       seq_.restart_at(seq_.index());  // re-issue the current segment's command
-      L.state(db::CampaignState::running, after_link_loss ? "link back: segment taken again" : "resumed");
+      L.state(domain::CampaignState::running, after_link_loss ? "link back: segment taken again" : "resumed");
     }
     deadline_ = 1e300;
   }
@@ -115,7 +115,7 @@ class RampStrategy final : public Strategy {
   }
 
  private:
-  static std::vector<Segment> schedule(const Plan& p) { return p.kind == db::CampaignKind::fot ? fot_schedule(p) : waveform_schedule(p); }
+  static std::vector<Segment> schedule(const Plan& p) { return p.kind == domain::CampaignKind::fot ? fot_schedule(p) : waveform_schedule(p); }
 
   // A resumed campaign drives only the rows not yet complete (no training), then the validation.
   void resume_rows_only(Loop& L) {
@@ -165,18 +165,14 @@ class RampStrategy final : public Strategy {
     if (!(b < top && top < e)) return false;
     const models::LoopFigures fig = models::loop_figures(x, f, b, top, e);
     const ShakedownStep st = shakedown_.add(fig.peak_force_N, fig.energy_Nmm);
-    nlohmann::json ev{{"cycle", st.cycle},
-                      {"peak_force_N", st.peak_force_N},
-                      {"energy_Nmm", st.energy_Nmm},
-                      {"consecutive", st.consecutive},
-                      {"stable", st.stable},
-                      {"damping_ratio", fig.damping_ratio},
-                      {"secant_stiffness_N_mm", fig.secant_stiffness_N_mm}};
-    if (st.peak_change_pct) ev["peak_change_pct"] = *st.peak_change_pct;
-    if (st.energy_change_pct) ev["energy_change_pct"] = *st.energy_change_pct;
-    L.event("shakedown", ev);
+    domain::ShakedownEvent ev;
+    ev.cycle = st.cycle, ev.consecutive = st.consecutive, ev.stable = st.stable;
+    ev.peak_force_N = st.peak_force_N, ev.energy_Nmm = st.energy_Nmm, ev.damping_ratio = fig.damping_ratio,
+    ev.secant_stiffness_N_mm = fig.secant_stiffness_N_mm;
+    ev.peak_change_pct = st.peak_change_pct, ev.energy_change_pct = st.energy_change_pct;
+    L.event(ev);
     if (!st.last) return false;
-    L.event("training", {{"cycles", st.cycle}, {"stable", st.stable}, {"until", plan_.training.until}, {"why", shakedown_.summary()}});
+    L.event(domain::TrainingEvent{st.cycle, st.stable, plan_.training.until, shakedown_.summary()});
     rows_begin_ = e;
     return st.cycle < plan_.training.max_cycles;  // cycles left to skip
   }
@@ -196,11 +192,8 @@ class RampStrategy final : public Strategy {
       L.result.run_id = L.result.validation_run_id;
       L.next_seq = 0;
     }
-    L.event("validation", {{"run", L.result.run_id},
-                           {"reversals", plan_.validation.reversals},
-                           {"seed", plan_.validation.seed},
-                           {"points_mm", validation_points(plan_.validation)},
-                           {"why", "a seeded random input after the rows, not used to build any table: every table is scored on it"}});
+    L.event(domain::ValidationEvent{L.result.run_id, plan_.validation.reversals, plan_.validation.seed, validation_points(plan_.validation),
+                                    "a seeded random input after the rows, not used to build any table: every table is scored on it"});
   }
 
   // Motion is supervised: distance / rate, plus the rig's lag, a settle time and the dwell.
@@ -239,7 +232,9 @@ class RampStrategy final : public Strategy {
     if (again.empty()) return;
     ++rounds_;
     seq_.insert_before_current(again);
-    L.event("retake", {{"rows", rows}, {"round", rounds_}, {"why", "a node of each was missing (a hole in the data)"}});
+    domain::RetakeEvent ev;
+    ev.rows.emplace(rows.begin(), rows.end()), ev.round = rounds_, ev.why = "a node of each was missing (a hole in the data)";
+    L.event(ev);
   }
 
   [[nodiscard]] bool row_complete(int row) const {

@@ -13,18 +13,6 @@
 namespace hystlab::daemon {
 using nlohmann::json;
 
-std::string now_iso() {
-  const auto t = std::chrono::system_clock::now();
-  const std::time_t s = std::chrono::system_clock::to_time_t(t);
-  std::tm tm{};
-  gmtime_r(&s, &tm);
-  char buf[96];
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count() % 1000;
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec,
-                static_cast<int>(ms));
-  return buf;
-}
-
 void RigWorker::build_rig(const std::string& base) {
   json cfg = entry.driver;
   if (entry.simulated) {
@@ -40,9 +28,11 @@ void RigWorker::build_rig(const std::string& base) {
   rig = drivers::make_rig(cfg, "rig '" + entry.name + "'", base);
   info.name = entry.name;
   info.simulated = entry.simulated;
-  info.kind = cfg.value("rig", std::string("load_frame"));
+  const auto kind = domain::rig_kind_from(cfg.value("rig", std::string("load_frame")));  // make_rig refused any other
+  if (!kind) throw ConfigError("rig '" + entry.name + "': rig must be \"load_frame\" or \"shaker\"");
+  info.kind = *kind;
   info.description = rig->describe();
-  const bool shaker = info.kind == "shaker";
+  const bool shaker = info.kind == domain::RigKind::shaker;
   if (supervisor)
     supervisor->rebind(*rig);
   else
@@ -169,7 +159,7 @@ bool RigWorker::settled(const PendingCommand& c) {
   if (sup.resetting()) return false;
   if (!sup.latched()) return answer(c, R::done, "reset: the rig reports ready"), true;
   std::string why = sup.reset_refusal().empty() ? "the rig is still latched" : sup.reset_refusal();
-  if (info.kind != "shaker" && (sup.last_status().status & protocols::status::limit_tripped))
+  if (info.kind != domain::RigKind::shaker && (sup.last_status().status & protocols::status::limit_tripped))
     why += "; a frame beyond its stroke is brought back with POST /api/rigs/NAME/recover (hystlab rig recover)";
   answer(c, R::refused, why);
   return true;
@@ -272,7 +262,7 @@ void idle_tick(RigWorker& w, double t, const std::string& base, double host_s) {
   StatusView v;
   double x = 0, f = 0;
   std::error_code ec;
-  if (w.info.kind == "shaker") {
+  if (w.info.kind == domain::RigKind::shaker) {
     drivers::ShakerSample s;
     ec = w.rig->read_shaker(t, s);
     v = {s.status_word, s.fault_code, 0.0};
@@ -312,7 +302,7 @@ void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, do
   }
   if (const std::int64_t id = w.running_campaign.exchange(0)) {
     const std::string now = now_iso(), reason = "error on the acquisition thread: " + what + "; the rig is held";
-    writer.post([id, reason, now](db::Store& s) { s.transition(id, db::CampaignState::failed, reason, now); });
+    writer.post([id, reason, now](db::Store& s) { s.transition(id, domain::CampaignState::failed, reason, now); });
   }
   w.live.campaign = 0;
   w.live.phase = 0;

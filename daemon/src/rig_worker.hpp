@@ -13,8 +13,9 @@
 #include <string>
 #include <thread>
 
+#include "hystlab/control/values.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
-#include "hystlab/daemon/daemon.hpp"
+#include "hystlab/daemon/config.hpp"
 #include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/supervisor.hpp"
@@ -24,7 +25,10 @@
 
 namespace hystlab::daemon {
 
-[[nodiscard]] std::string now_iso();
+using control::CommandOutcome;
+using control::RigCommand;
+using control::RigInfo;
+using control::RigSupervision;
 
 struct RigWorker {
   RigEntry entry;

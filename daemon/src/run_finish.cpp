@@ -34,8 +34,9 @@ void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const mode
   // heap over a long campaign (fragments of ever larger copies); the final tables are scored on all.
   RunSeries few = series.thinned(kEvaluationSamples);
   writer.post([campaign, table = std::move(table), x = std::move(few.x), f = std::move(few.f), known, needed, now](db::Store& s) {
-    const json detail{{"nodes", known}, {"required", needed}, {"accuracy", models::accuracy_json(models::score_table(table, x, f))}};
-    s.add_event(campaign, "fit", detail.dump(), now);
+    s.add_event(campaign,
+                domain::FitEvent{static_cast<std::int64_t>(known), static_cast<std::int64_t>(needed), models::accuracy_json(models::score_table(table, x, f))},
+                now);
   });
 }
 
@@ -48,11 +49,11 @@ std::vector<db::Store::LoopRecord> loop_records(const FinishJob& j, std::int64_t
   o.plateau_at_mm = j.plan.plateaus_mm;
   int k = 0;
   for (const models::LoopFigures& L : models::find_loops(j.series.x, j.series.f, o))
-    out.push_back({run, k++, L.begin < j.rows_begin ? db::LoopPhase::training : db::LoopPhase::rows, models::loop_json(L).dump()});
+    out.push_back({run, k++, L.begin < j.rows_begin ? domain::LoopPhase::training : domain::LoopPhase::rows, models::loop_json(L).dump()});
   if (vrun > 0 && !j.validation.x.empty()) {
     k = 0;
     for (const models::LoopFigures& L : models::find_loops(j.validation.x, j.validation.f, o))
-      out.push_back({vrun, k++, db::LoopPhase::validation, models::loop_json(L).dump()});
+      out.push_back({vrun, k++, domain::LoopPhase::validation, models::loop_json(L).dump()});
   }
   return out;
 }
@@ -153,7 +154,7 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
       end.recommendation = recommendation;
     }
   }
-  if (j.plan.kind == db::CampaignKind::sine && j.isolator && !j.sine_steps.empty()) {
+  if (j.plan.kind == domain::CampaignKind::sine && j.isolator && !j.sine_steps.empty()) {
     try {  // the isolator model at the measured amplitudes, in the order the rig took them
       std::vector<PredictStep> steps;
       for (const auto& [k, step] : j.sine_steps) steps.push_back(step);
@@ -163,7 +164,7 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
       note += std::string("; no prediction: ") + e.what();
     }
   }
-  if (j.plan.kind != db::CampaignKind::sine) {
+  if (j.plan.kind != domain::CampaignKind::sine) {
     try {
       end.loops = loop_records(j, r.run_id, r.validation_run_id);
     } catch (const std::exception& e) {  // figures are extra: they never cost the campaign its end
@@ -229,7 +230,7 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   const auto id = j.campaign;
   const auto last = writer.call<int>(
       [id, reason, now](db::Store& s) {
-        s.transition(id, db::CampaignState::failed, reason, now);
+        s.transition(id, domain::CampaignState::failed, reason, now);
         return 0;
       },
       10.0);

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "hystlab/daemon/daemon.hpp"
+#include "hystlab/daemon/config.hpp"
 
 namespace hystlab::daemon {
 

@@ -59,12 +59,8 @@ class SineStrategy final : public Strategy {
     fj.isolator = L.job.isolator;
     fj.sine_steps = steps_;
     if (points_ > 0)
-      L.event("sweep_done", {{"points", points_},
-                             {"of", total_},
-                             {"seconds", last_t_ - t0_},
-                             {"nominal_seconds", nominal_duration_s(s_)},
-                             {"warnings", warnings_},
-                             {"predicted_with", L.job.isolator ? L.job.isolator->describe : ""}});
+      L.event(domain::SweepDoneEvent{points_, static_cast<std::int64_t>(total_), warnings_, last_t_ - t0_, nominal_duration_s(s_),
+                                     L.job.isolator ? L.job.isolator->describe : ""});
   }
 
  private:
@@ -81,15 +77,8 @@ class SineStrategy final : public Strategy {
     control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false, established_ = !s_.control.closed;
     prev_mass_ = NAN;
     if (!L.command_drive(t, f_, drive_)) return false;
-    L.event("sine_step", {{"k", points_ + 1},
-                          {"of", total_},
-                          {"pass", pass_ + 1},
-                          {"passes", passes_.size()},
-                          {"frequency_hz", f_},
-                          {"amplitude_mm", demand()},
-                          {"direction", up() ? "up" : "down"},
-                          {"drive_mm", drive_},
-                          {"eta_s", eta(t)}});
+    L.event(domain::SineStepEvent{points_ + 1, static_cast<std::int64_t>(total_), static_cast<std::int64_t>(pass_) + 1,
+                                  static_cast<std::int64_t>(passes_.size()), f_, demand(), drive_, eta(t), up() ? "up" : "down"});
     if (s_.control.closed) return open(Mode::control, 1, s_.control.window_cycles);
     return to_settle();
   }
@@ -155,7 +144,7 @@ class SineStrategy final : public Strategy {
       char buf[240];
       std::snprintf(buf, sizeof buf, "control abort: the base amplitude was %.4g mm against the demand %.4g mm (error %+.1f %%, abort band ±%g %%) at %.4g Hz",
                     base, demand(), v.error_pct, s_.control.abort_pct, f_);
-      L.event("control_abort", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"base_mm", base}, {"error_pct", v.error_pct}, {"drive_mm", drive_}});
+      L.event(domain::ControlAbortEvent{f_, demand(), base, v.error_pct, drive_});
       L.ctx.supervisor.hold(t, "control abort: no drive");
       L.drive_mm = 0;
       L.end(CampaignEnd::aborted, buf);
@@ -165,7 +154,7 @@ class SineStrategy final : public Strategy {
     if (counts && (v.band == ControlBand::warning || v.band == ControlBand::abort) && !warned_) {
       warned_ = true;
       ++warnings_;
-      L.event("control_warning", {{"frequency_hz", f_}, {"demand_mm", demand()}, {"base_mm", base}, {"error_pct", v.error_pct}, {"band", to_string(v.band)}});
+      L.event(domain::ControlWarningEvent{f_, demand(), base, v.error_pct, to_string(v.band)});
     }
     return true;
   }
@@ -185,13 +174,7 @@ class SineStrategy final : public Strategy {
       return redrive(L, t, v);
     }
     if (s_.control.closed && v.band != ControlBand::within)  // measured anyway: said
-      L.event("control_unreached", {{"frequency_hz", f_},
-                                    {"demand_mm", demand()},
-                                    {"error_pct", v.error_pct},
-                                    {"windows", control_windows_},
-                                    {"drive_mm", drive_},
-                                    {"limited", v.limited},
-                                    {"while", "measuring"}});
+      L.event(domain::ControlUnreachedEvent{f_, demand(), v.error_pct, drive_, control_windows_, v.limited, "measuring"});
     store_point(L, t, b, m, v);
     ++step_;
     return next_step(L, t);
@@ -200,12 +183,7 @@ class SineStrategy final : public Strategy {
   bool after_control(Loop& L, double t, const ControlVerdict& v) {
     if (v.band == ControlBand::within) return to_settle();
     if (++control_windows_ >= s_.control.max_windows) {
-      L.event("control_unreached", {{"frequency_hz", f_},
-                                    {"demand_mm", demand()},
-                                    {"error_pct", v.error_pct},
-                                    {"windows", control_windows_},
-                                    {"drive_mm", drive_},
-                                    {"limited", v.limited}});
+      L.event(domain::ControlUnreachedEvent{f_, demand(), v.error_pct, drive_, control_windows_, v.limited, std::nullopt});
       return to_settle();
     }
     return redrive(L, t, v);
@@ -225,7 +203,7 @@ class SineStrategy final : public Strategy {
     prev_mass_ = mass;
     if (stable_ >= s_.settle.consecutive) return to_measure();
     if (settled_cycles_ >= s_.settle.max_cycles) {
-      L.event("unsettled", {{"frequency_hz", f_}, {"cycles", settled_cycles_}, {"change_pct", change}});
+      L.event(domain::UnsettledEvent{f_, change, settled_cycles_});
       return to_measure();
     }
     return open(Mode::settle, 0, s_.control.window_cycles);
@@ -270,7 +248,9 @@ class SineStrategy final : public Strategy {
       L.end(CampaignEnd::failed, buf);
       return false;
     }
-    L.event("retake", {{"frequency_hz", f_}, {"why", hole}, {"attempt", retakes_ + 1}});
+    domain::RetakeEvent ev;
+    ev.frequency_hz = f_, ev.attempt = retakes_ + 1, ev.why = hole;
+    L.event(ev);
     w_.reopen();
     return true;
   }
@@ -281,34 +261,21 @@ class SineStrategy final : public Strategy {
     const double f = s_.continuous ? w_.mean_frequency() : f_;
     ++points_;
     if (!s_.continuous) nominal_done_ += step_nominal_s(s_, f_);
-    const nlohmann::json rec{{"k", points_},
-                             {"of", total_},
-                             {"pass", pass_ + 1},
-                             {"frequency_hz", f},
-                             {"amplitude_mm", demand()},
-                             {"direction", up() ? "up" : "down"},
-                             {"drive_mm", drive_},
-                             {"base_amplitude_mm", b.fundamental.amplitude},
-                             {"base_phase_rad", b.fundamental.phase_rad},
-                             {"mass_amplitude_mm", m.fundamental.amplitude},
-                             {"mass_phase_rad", m.fundamental.phase_rad},
-                             {"ratio", ratio},
-                             {"phase_rad", phase},
-                             {"thd", m.thd},
-                             {"harmonics", m.harmonics},
-                             {"control_error_pct", v.error_pct},
-                             {"band", to_string(v.band)},
-                             {"control_windows", control_windows_},
-                             {"settle_cycles", s_.settle.until ? settled_cycles_ : s_.settle.cycles},
-                             {"t_s", t},
-                             {"eta_s", eta(t)}};
+    domain::TransmissibilityEvent rec;
+    rec.k = points_, rec.of = static_cast<std::int64_t>(total_), rec.pass = static_cast<std::int64_t>(pass_) + 1;
+    rec.frequency_hz = f, rec.amplitude_mm = demand(), rec.direction = up() ? "up" : "down", rec.drive_mm = drive_;
+    rec.base_amplitude_mm = b.fundamental.amplitude, rec.base_phase_rad = b.fundamental.phase_rad;
+    rec.mass_amplitude_mm = m.fundamental.amplitude, rec.mass_phase_rad = m.fundamental.phase_rad;
+    rec.ratio = ratio, rec.phase_rad = phase, rec.thd = m.thd, rec.harmonics = m.harmonics;
+    rec.control_error_pct = v.error_pct, rec.band = to_string(v.band), rec.control_windows = control_windows_;
+    rec.settle_cycles = s_.settle.until ? settled_cycles_ : s_.settle.cycles, rec.t_s = t, rec.eta_s = eta(t);
     steps_.push_back({points_, PredictStep{f, b.fundamental.amplitude, settled_cycles_ + s_.settle.cycles, s_.measured_cycles}});
-    db::SinePointRow row{points_, f, demand(), b.fundamental.amplitude, m.fundamental.amplitude, ratio, phase, up() ? "up" : "down", rec.dump()};
+    db::SinePointRow row{points_, f, demand(), b.fundamental.amplitude, m.fundamental.amplitude, ratio, phase, rec.direction, domain::encode(rec)};
     const auto run = L.result.run_id, id = L.job.id;
-    const std::string now = L.ctx.now_iso(), text = rec.dump();
-    L.ctx.writer.post([run, row, id, now, text](db::Store& st) {
+    const std::string now = L.ctx.now_iso();
+    L.ctx.writer.post([run, row, id, now, rec = domain::CampaignEvent(std::move(rec))](db::Store& st) {
       st.add_sine_point(run, row);
-      st.add_event(id, "transmissibility", text, now);
+      st.add_event(id, rec, now);
     });
   }
 

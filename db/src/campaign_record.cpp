@@ -18,15 +18,15 @@ CampaignRecord campaign_record(Store& store, const CampaignRow& row) {
   r.notes = text_of(plan, "notes");
   for (const EventRow& e : store.events(row.id)) {  // oldest first: the newest change wins
     if (e.kind != "record") continue;
-    const json d = json::parse(e.detail, nullptr, false);
-    if (!d.is_object()) continue;  // a record this version cannot read: the one before stands
-    r.specimen = text_of(d, "specimen");
-    r.notes = text_of(d, "notes");
+    std::string error;
+    const auto d = domain::decode_event(e.kind, e.detail, error);
+    if (!d) continue;  // a record this version cannot read: the one before stands
+    const auto& rec = std::get<domain::RecordEvent>(*d);
+    r.specimen = rec.specimen;
+    r.notes = rec.notes;
     r.changed_at = e.at;
   }
   return r;
 }
-
-std::string record_detail(const CampaignRecord& r) { return json{{"specimen", r.specimen}, {"notes", r.notes}}.dump(); }
 
 }  // namespace hystlab::db

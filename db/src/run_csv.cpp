@@ -1,7 +1,7 @@
 #include "hystlab/db/run_csv.hpp"
 
-#include "hystlab/db/signals.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/domain/signals.hpp"
 #include "hystlab/models/text_forms.hpp"
 
 namespace hystlab::db {
@@ -11,7 +11,7 @@ RunSamples run_samples(Store& store, std::int64_t run) {
   return store.max_shaker_seq(run) >= 0 ? RunSamples::shaker : RunSamples::none;
 }
 
-std::string run_csv_header(bool shaker) { return shaker ? csv_header(kShakerSignals) : csv_header(kFrameSignals); }
+std::string run_csv_header(bool shaker) { return shaker ? domain::csv_header(domain::kShakerSignals) : domain::csv_header(domain::kFrameSignals); }
 
 namespace {
 void number(std::string& out, double v) {

@@ -13,8 +13,8 @@
 
 #include "h5_file.hpp"
 #include "h5_layout.hpp"
-#include "hystlab/db/signals.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/domain/signals.hpp"
 #include "hystlab/models/text_forms.hpp"
 
 namespace hystlab::db {
@@ -52,7 +52,7 @@ struct SampleColumns {
 };
 
 template <std::size_t N>
-SampleColumns make_columns(hid_t group, const std::array<SignalName, N>& signals, double wall_anchor, const H5ExportOptions& opt) {
+SampleColumns make_columns(hid_t group, const std::array<domain::SignalName, N>& signals, double wall_anchor, const H5ExportOptions& opt) {
   const auto chunk = static_cast<std::size_t>(opt.rows_per_read);
   SampleColumns c;
   c.v.resize(N + 1);
@@ -61,7 +61,7 @@ SampleColumns make_columns(hid_t group, const std::array<SignalName, N>& signals
   h5::attr_text(c.out.back().id(), "units", "s");
   h5::attr_text(c.out.back().id(), "label", "rig time (s)");
   h5::attr_double(c.out.back().id(), "wall_anchor_unix", wall_anchor);
-  for (const SignalName& s : signals) {
+  for (const domain::SignalName& s : signals) {
     c.out.emplace_back(group, s.name, h5::Column::Type::f64, chunk, opt.deflate_level);
     h5::attr_text(c.out.back().id(), "units", unit_of(s.label));
     h5::attr_text(c.out.back().id(), "label", s.label);
@@ -73,8 +73,8 @@ SampleColumns make_columns(hid_t group, const std::array<SignalName, N>& signals
 // Every sample of the run, in seq order; returns how many.
 std::int64_t write_samples(Store& store, hid_t group, const RunInfo& run, RigKind kind, const H5ExportOptions& opt) {
   const std::int64_t last = kind == RigKind::frame ? store.max_seq(run.id) : store.max_shaker_seq(run.id), step = opt.rows_per_read;
-  SampleColumns c =
-      kind == RigKind::frame ? make_columns(group, kFrameSignals, run.wall_anchor_unix, opt) : make_columns(group, kShakerSignals, run.wall_anchor_unix, opt);
+  SampleColumns c = kind == RigKind::frame ? make_columns(group, domain::kFrameSignals, run.wall_anchor_unix, opt)
+                                           : make_columns(group, domain::kShakerSignals, run.wall_anchor_unix, opt);
   std::int64_t n = 0;
   for (std::int64_t s0 = 0; s0 <= last; s0 += step) {
     if (kind == RigKind::frame) {

@@ -65,7 +65,7 @@ CREATE TABLE loops(
   run_id INTEGER NOT NULL REFERENCES runs(id), k INTEGER NOT NULL, phase TEXT NOT NULL, figures TEXT NOT NULL,
   PRIMARY KEY(run_id, k)) WITHOUT ROWID;
 )sql",
-    // 5: a shaker's samples in its own terms (the columns are kShakerSignals' names; before, the
+    // 5: a shaker's samples in its own terms (the columns are domain::kShakerSignals' names; before, the
     // load frame's columns held base and mass displacement and the mass's acceleration), and a
     // sine step's place in its sweep, its whole record, and the isolator model's prediction.
     R"sql(

@@ -8,7 +8,7 @@
 #include <map>
 
 #include "hystlab/db/schema.hpp"
-#include "hystlab/db/signals.hpp"
+#include "hystlab/domain/signals.hpp"
 
 namespace hystlab::db {
 namespace {
@@ -65,7 +65,7 @@ std::int64_t Store::upsert_rig(const std::string& name, const std::string& confi
   return st.column_int(0);
 }
 
-std::int64_t Store::create_campaign(std::int64_t rig, CampaignKind kind, const std::string& plan, const std::string& now) {
+std::int64_t Store::create_campaign(std::int64_t rig, domain::CampaignKind kind, const std::string& plan, const std::string& now) {
   Transaction tx(db_);
   Statement st(db_, "INSERT INTO campaigns(rig_id, kind, plan, state, created_at, updated_at) VALUES(?,?,?,'queued',?,?)");
   st.bind(1, rig).bind(2, std::string_view(to_string(kind))).bind(3, plan).bind(4, now).bind(5, now);
@@ -79,14 +79,14 @@ std::int64_t Store::create_campaign(std::int64_t rig, CampaignKind kind, const s
   return id;
 }
 
-void Store::transition(std::int64_t id, CampaignState to, const std::string& reason, const std::string& now) {
+void Store::transition(std::int64_t id, domain::CampaignState to, const std::string& reason, const std::string& now) {
   Transaction tx(db_);
   transition_in(id, to, reason, now);
   tx.commit();
   records_changed();
 }
 
-void Store::transition_in(std::int64_t id, CampaignState to, const std::string& reason, const std::string& now) {
+void Store::transition_in(std::int64_t id, domain::CampaignState to, const std::string& reason, const std::string& now) {
   Statement cur(db_, "SELECT state FROM campaigns WHERE id = ?");
   cur.bind(1, id);
   if (!cur.step()) throw DbError("no campaign " + std::to_string(id), 0);
@@ -99,7 +99,7 @@ void Store::transition_in(std::int64_t id, CampaignState to, const std::string& 
   ev.step();
 }
 
-std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, double wall, double mono, RunRole role) {
+std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, double wall, double mono, domain::RunRole role) {
   Statement st(db_, "INSERT INTO runs(campaign_id, started_at, wall_anchor_unix, monotonic_anchor_s, state, role) VALUES(?,?,?,?,'running',?)");
   st.bind(1, campaign).bind(2, now).bind(3, wall).bind(4, mono).bind(5, std::string_view(to_string(role)));
   st.step();
@@ -109,18 +109,22 @@ std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, doubl
 std::pair<std::int64_t, std::int64_t> Store::add_runs(std::int64_t campaign, const std::string& now, double wall, double mono, bool validation) {
   Transaction tx(db_);
   const std::int64_t run = add_run(campaign, now, wall, mono);
-  const std::int64_t vrun = validation ? add_run(campaign, now, wall, mono, RunRole::validation) : 0;
+  const std::int64_t vrun = validation ? add_run(campaign, now, wall, mono, domain::RunRole::validation) : 0;
   tx.commit();
   return {run, vrun};
 }
 
-void Store::end_run(std::int64_t run, CampaignState state, const std::string& now) {
+void Store::end_run(std::int64_t run, domain::CampaignState state, const std::string& now) {
   Statement st(db_, "UPDATE runs SET state = ?, ended_at = ? WHERE id = ?");
   st.bind(1, std::string_view(to_string(state))).bind(2, now).bind(3, run);
   st.step();
 }
 
-std::int64_t Store::add_event(std::int64_t campaign, const std::string& kind, const std::string& detail, const std::string& now) {
+std::int64_t Store::add_event(std::int64_t campaign, const domain::CampaignEvent& event, const std::string& now) {
+  return add_raw_event(campaign, std::string(domain::kind_of(event)), domain::encode(event), now);
+}
+
+std::int64_t Store::add_raw_event(std::int64_t campaign, const std::string& kind, const std::string& detail, const std::string& now) {
   Statement st(db_, "INSERT INTO events(campaign_id, at, kind, detail) VALUES(?,?,?,?)");
   st.bind(1, campaign).bind(2, now).bind(3, kind).bind(4, detail);
   st.step();
@@ -185,9 +189,9 @@ int Store::mark_interrupted(const std::string& now) {
   }
   for (auto id : ids)
     if (table_count(id) > 0)
-      transition(id, CampaignState::completed, "its tables were stored before the daemon stopped", now);
+      transition(id, domain::CampaignState::completed, "its tables were stored before the daemon stopped", now);
     else
-      transition(id, CampaignState::interrupted, "the daemon stopped without finishing it", now);
+      transition(id, domain::CampaignState::interrupted, "the daemon stopped without finishing it", now);
   Statement runs(db_, "UPDATE runs SET state = 'interrupted', ended_at = ? WHERE state = 'running'");
   runs.bind(1, now);
   runs.step();
@@ -237,7 +241,7 @@ void Store::insert_rows(std::span<const AnyRow> rows) {
     for (std::size_t k = 0; k < r.v.size(); ++k) insert_shaker_.bind(static_cast<int>(k) + 4, r.v[k]);
     insert_shaker_.bind(10, r.status);
     insert_shaker_.step();
-    blocks[{r.run_id, r.seq / kBlockSize}].add(r.t, r.v[shaker_signal::base_displacement], r.v[shaker_signal::mass_displacement]);
+    blocks[{r.run_id, r.seq / kBlockSize}].add(r.t, r.v[domain::shaker_signal::base_displacement], r.v[domain::shaker_signal::mass_displacement]);
   }
   for (const auto& [key, b] : blocks) {
     upsert_block_.reset();
@@ -254,8 +258,8 @@ CampaignRow campaign_row(Statement& st) {
   r.id = st.column_int(0);
   r.rig_id = st.column_int(1);
   const std::string kind = st.column_text(2), state = st.column_text(4);
-  const auto k = campaign_kind_from(kind);
-  const auto s = campaign_state_from(state);
+  const auto k = domain::campaign_kind_from(kind);
+  const auto s = domain::campaign_state_from(state);
   if (!k) throw DbError("campaign " + std::to_string(r.id) + ": unknown kind '" + kind + "' in the database", 0);
   if (!s) throw DbError("campaign " + std::to_string(r.id) + ": unknown state '" + state + "' in the database", 0);
   r.kind = *k;
@@ -342,8 +346,9 @@ std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int 
     if (t >= t0 && t <= t1) merge(out[slot(t)], t, t, d, d, f, f, 1);
   };
   if (shaker)
-    for_each_shaker_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1,
-                           [&](const ShakerRow& r) { take(r.t, r.v[shaker_signal::base_displacement], r.v[shaker_signal::mass_displacement]); });
+    for_each_shaker_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const ShakerRow& r) {
+      take(r.t, r.v[domain::shaker_signal::base_displacement], r.v[domain::shaker_signal::mass_displacement]);
+    });
   else
     for_each_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const SampleRow& r) { take(r.t, r.disp, r.force); });
   std::erase_if(out, [](const Bucket& b) { return b.n == 0; });

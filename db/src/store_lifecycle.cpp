@@ -13,7 +13,7 @@ int Store::hold_queued(const std::string& now) {
     Statement st(db_, "SELECT id FROM campaigns WHERE state = 'queued' ORDER BY id");
     while (st.step()) ids.push_back(st.column_int(0));
   }
-  for (auto id : ids) transition(id, CampaignState::held, "held after restart: nothing moves until an operator releases it (resume)", now);
+  for (auto id : ids) transition(id, domain::CampaignState::held, "held after restart: nothing moves until an operator releases it (resume)", now);
   return static_cast<int>(ids.size());
 }
 
@@ -24,7 +24,7 @@ std::int64_t Store::table_count(std::int64_t campaign) {
   return st.column_int(0);
 }
 
-std::vector<std::int64_t> Store::runs_of_campaign(std::int64_t campaign, std::optional<RunRole> role) {
+std::vector<std::int64_t> Store::runs_of_campaign(std::int64_t campaign, std::optional<domain::RunRole> role) {
   std::vector<std::int64_t> out;
   Statement st(db_, role ? "SELECT id FROM runs WHERE campaign_id = ? AND role = ? ORDER BY id" : "SELECT id FROM runs WHERE campaign_id = ? ORDER BY id");
   st.bind(1, campaign);
@@ -45,16 +45,7 @@ std::vector<std::int64_t> Store::finish_run(const RunEnd& e) {
     for (const TableRecord& t : e.tables) ids.push_back(add_table(e.campaign, e.run, t.method, t.n, t.lo, t.hi, e.now, t.accuracy_json, t.document_json));
     if (e.recommended && *e.recommended < ids.size()) {
       const TableRecord& t = e.tables[*e.recommended];
-      // JSON by hand: db/ has no JSON library; the reason is escaped for its quotes and backslashes.
-      std::string why;
-      for (const char ch : e.recommendation) {
-        if (ch == '"' || ch == '\\') why += '\\';
-        if (static_cast<unsigned char>(ch) >= 0x20) why += ch;
-      }
-      add_event(
-          e.campaign, "recommendation",
-          "{\"table\":" + std::to_string(ids[*e.recommended]) + ",\"method\":\"" + t.method + "\",\"n\":" + std::to_string(t.n) + ",\"why\":\"" + why + "\"}",
-          e.now);
+      add_event(e.campaign, domain::RecommendationEvent{ids[*e.recommended], t.n, t.method, e.recommendation}, e.now);
     }
   }
   for (const LoopRecord& l : e.loops) {

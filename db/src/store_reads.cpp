@@ -48,11 +48,11 @@ std::vector<std::pair<std::int64_t, std::string>> Store::rigs() {
   return all<std::pair<std::int64_t, std::string>>(st, [](Statement& s) { return std::make_pair(s.column_int(0), s.column_text(1)); });
 }
 
-std::vector<std::pair<CampaignState, std::int64_t>> Store::campaign_counts() {
+std::vector<std::pair<domain::CampaignState, std::int64_t>> Store::campaign_counts() {
   Statement st(db_, "SELECT state, count(*) FROM campaigns GROUP BY state");
-  return all<std::pair<CampaignState, std::int64_t>>(st, [](Statement& s) {
+  return all<std::pair<domain::CampaignState, std::int64_t>>(st, [](Statement& s) {
     const std::string text = s.column_text(0);
-    const auto state = campaign_state_from(text);
+    const auto state = domain::campaign_state_from(text);
     if (!state) throw DbError("unknown campaign state '" + text + "' in the database", 0);
     return std::make_pair(*state, s.column_int(1));
   });
@@ -145,7 +145,7 @@ std::vector<std::string> Store::event_details(std::int64_t campaign, const std::
   return all<std::string>(st, [](Statement& s) { return s.column_text(0); });
 }
 
-std::string Store::state_reason(std::int64_t campaign, CampaignState state) {
+std::string Store::state_reason(std::int64_t campaign, domain::CampaignState state) {
   Statement st(db_, "SELECT coalesce(detail, '') FROM events WHERE campaign_id = ? AND kind = 'state' AND to_state = ? ORDER BY id DESC LIMIT 1");
   st.bind(1, campaign);
   st.bind(2, std::string_view(to_string(state)));

@@ -66,7 +66,7 @@ daemon::RunnerResult acquire(bool blocks, int port, double seconds, db::Store& s
                                         {"ramp_rate_mm_s", 2.0},
                                         {"sample_rate_hz", 1000},
                                         {"limits", {{"displacement_mm", {-1, 4}}, {"force_N", 400}, {"rate_mm_s", 50}}}});
-  const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), hystlab::db::CampaignKind::waveform, plan.source.dump(), "t");
+  const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), hystlab::domain::CampaignKind::waveform, plan.source.dump(), "t");
   std::vector<float> periods;
   periods.reserve(static_cast<std::size_t>(seconds * 1100));
   daemon::SteadyClock clock;

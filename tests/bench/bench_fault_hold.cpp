@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
       daemon::CampaignJob job;
       job.plan = daemon::parse_plan(plan_json);
       job.plan.limits = daemon::check_plan_against(job.plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, false);
-      job.id = store.create_campaign(rig_id, hystlab::db::CampaignKind::waveform, plan_json.dump(), "t");
+      job.id = store.create_campaign(rig_id, hystlab::domain::CampaignKind::waveform, plan_json.dump(), "t");
       daemon::RunnerContext ctx(rig, sup, writer, clock);
       ctx.now_iso = [] { return std::string("t"); };
       ctx.loop_periods_us = &loop_periods;

@@ -42,7 +42,7 @@ double fill(const std::string& path, std::int64_t n) {
   hystlab::db::Store store(path, false);
   const std::string now = "2026-01-01T00:00:00Z";
   const auto rig = store.upsert_rig("sim frame", "{}", now);
-  const auto c = store.create_campaign(rig, hystlab::db::CampaignKind::waveform, R"({"kind":"waveform","points_mm":[0,4,0],"ramp_rate_mm_s":1})", now);
+  const auto c = store.create_campaign(rig, hystlab::domain::CampaignKind::waveform, R"({"kind":"waveform","points_mm":[0,4,0],"ramp_rate_mm_s":1})", now);
   const auto run = store.add_run(c, now, 1.7e9, 0);
   std::vector<hystlab::db::SampleRow> rows;
   rows.reserve(200'000);
@@ -56,8 +56,8 @@ double fill(const std::string& path, std::int64_t n) {
       rows.clear();
     }
   }
-  store.end_run(run, hystlab::db::CampaignState::completed, now);
-  store.transition(c, hystlab::db::CampaignState::completed, "stored by bench_h5_export", now);
+  store.end_run(run, hystlab::domain::CampaignState::completed, now);
+  store.transition(c, hystlab::domain::CampaignState::completed, "stored by bench_h5_export", now);
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

@@ -27,7 +27,7 @@ std::string fresh(const fs::path& dir, const char* name) {
   for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(p.string() + suffix);
   Store s(p.string());  // same schema, migrated
   const auto rig = s.upsert_rig("bench", "{}", "t");
-  s.add_run(s.create_campaign(rig, hystlab::db::CampaignKind::fot, "{}", "t"), "t", 0, 0);
+  s.add_run(s.create_campaign(rig, hystlab::domain::CampaignKind::fot, "{}", "t"), "t", 0, 0);
   return p.string();
 }
 

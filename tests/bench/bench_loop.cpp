@@ -29,7 +29,7 @@ void fill(const std::string& path, std::int64_t n) {
   const std::string now = "2026-01-01T00:00:00Z";
   const auto rig = store.upsert_rig("sim frame", "{}", now);
   const auto campaign =
-      store.create_campaign(rig, hystlab::db::CampaignKind::fot, R"({"kind":"fot","range_mm":[0,14],"subdivisions":12,"ramp_rate_mm_s":0.5})", now);
+      store.create_campaign(rig, hystlab::domain::CampaignKind::fot, R"({"kind":"fot","range_mm":[0,14],"subdivisions":12,"ramp_rate_mm_s":0.5})", now);
   const auto run = store.add_run(campaign, now, 0, 0);
   hystlab::models::SimplifiedSmaModel m(hystlab::models::table1_parameters());
   double total = 0;
@@ -56,8 +56,8 @@ void fill(const std::string& path, std::int64_t n) {
   }
   rows.push_back({run, seq, static_cast<double>(seq) * 1e-3, 0, 0, m.step(0), 5});
   flush();
-  store.end_run(run, hystlab::db::CampaignState::completed, now);
-  store.transition(campaign, hystlab::db::CampaignState::completed, "stored by bench_loop", now);
+  store.end_run(run, hystlab::domain::CampaignState::completed, now);
+  store.transition(campaign, hystlab::domain::CampaignState::completed, "stored by bench_loop", now);
   std::printf("stored run %lld: %lld samples\n", static_cast<long long>(run), static_cast<long long>(seq + 1));
 }
 

@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
                                         {"measured_cycles", 10},
                                         {"sample_rate_hz", 1000}});
   auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", bench.sim.modbus_port}, {"rig", "shaker"}});
-  const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), db::CampaignKind::sine, plan.source.dump(), "t");
+  const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), domain::CampaignKind::sine, plan.source.dump(), "t");
   daemon::SteadyClock clock;
   daemon::Supervisor supervisor(*rig, daemon::SupervisionSettings{}, true);
   daemon::RunnerContext ctx(*rig, supervisor, writer, clock);

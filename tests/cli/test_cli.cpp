@@ -308,7 +308,8 @@ TEST_CASE("cli: the daemon's records, read from its file with no daemon running"
   {
     hystlab::db::Store daemons((w / "d.db").string());
     const auto rig = daemons.upsert_rig("sim frame", "{}", "2026-01-01T00:00:00Z");
-    (void)daemons.create_campaign(rig, hystlab::db::CampaignKind::waveform, R"({"kind": "waveform", "points_mm": [0, 2.5, 1, 3, 0]})", "2026-01-01T00:00:01Z");
+    (void)daemons.create_campaign(rig, hystlab::domain::CampaignKind::waveform, R"({"kind": "waveform", "points_mm": [0, 2.5, 1, 3, 0]})",
+                                  "2026-01-01T00:00:01Z");
   }
   const Result list = w.run("campaign list --db d.db");
   CHECK(list.out.find("queued") != std::string::npos);
@@ -340,7 +341,7 @@ TEST_CASE("cli: a validation run re-scored against a stored table, as the campai
   {
     hystlab::db::Store s((w / "d.db").string());
     const auto rig = s.upsert_rig("sim frame", "{}", "t");
-    const auto c = s.create_campaign(rig, hystlab::db::CampaignKind::fot, R"({"kind": "fot"})", "t");
+    const auto c = s.create_campaign(rig, hystlab::domain::CampaignKind::fot, R"({"kind": "fot"})", "t");
     const auto [run, vrun] = s.add_runs(c, "t", 0, 0, true);
     std::vector<hystlab::db::SampleRow> rows;
     for (std::size_t k = 0; k < vx.size(); ++k) rows.push_back({vrun, static_cast<std::int64_t>(k), 0.01 * static_cast<double>(k), vx[k], vx[k], vf[k], 0});

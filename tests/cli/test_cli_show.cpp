@@ -112,7 +112,7 @@ TEST_CASE("cli: tables list: every column at one offset in every row, numbers ri
   {
     hystlab::db::Store s((w / "d.db").string());
     const auto rig = s.upsert_rig("sim frame", "{}", "2026-01-01T00:00:00Z");
-    const auto c = s.create_campaign(rig, hystlab::db::CampaignKind::fot, R"({"kind": "fot"})", "2026-01-01T00:00:01Z");
+    const auto c = s.create_campaign(rig, hystlab::domain::CampaignKind::fot, R"({"kind": "fot"})", "2026-01-01T00:00:01Z");
     const std::string doc = R"({"format": "hystlab-everett-table"})";  // listed, never read here
     for (int k = 0; k < 11; ++k) {                                     // ids 1..11 (one and two digits), every width of figure
       const bool own = k != 4, held = k % 3 == 0, campaign = k != 7;
@@ -159,9 +159,9 @@ TEST_CASE("cli: campaign show: every kind of event as a sentence under its date,
   {
     hystlab::db::Store s((w / "d.db").string());
     const auto rig = s.upsert_rig("sim shaker", "{}", "2026-11-25T23:59:00Z");
-    const auto c = s.create_campaign(rig, hystlab::db::CampaignKind::sine, R"({"kind": "sine", "specimen": "isolator 7"})", "2026-11-25T23:59:58.5Z");
-    for (const auto& [kind, detail] : kEvents) (void)s.add_event(c, kind, detail, "2026-11-26T04:41:08.25Z");
-    s.transition(c, hystlab::db::CampaignState::failed, "the measurement window at 12.5 Hz was incomplete 4 times", "2026-11-26T04:41:09Z");
+    const auto c = s.create_campaign(rig, hystlab::domain::CampaignKind::sine, R"({"kind": "sine", "specimen": "isolator 7"})", "2026-11-25T23:59:58.5Z");
+    for (const auto& [kind, detail] : kEvents) (void)s.add_raw_event(c, kind, detail, "2026-11-26T04:41:08.25Z");
+    s.transition(c, hystlab::domain::CampaignState::failed, "the measurement window at 12.5 Hz was incomplete 4 times", "2026-11-26T04:41:09Z");
   }
   const Result r = w.run("campaign show 1 --db d.db");
   REQUIRE(r.code == 0);
@@ -222,7 +222,7 @@ TEST_CASE("cli: a campaign on hystlabd shown for people; its runs' CSV the same 
   std::vector<hystlab::db::EventRow> events;
   {
     hystlab::db::Store s(db);
-    reason = s.state_reason(1, hystlab::db::CampaignState::completed);
+    reason = s.state_reason(1, hystlab::domain::CampaignState::completed);
     events = s.events(1);
   }
   std::erase_if(events, [](const hystlab::db::EventRow& e) { return e.kind == "gap"; });  // each hole: said by the "gaps" summary

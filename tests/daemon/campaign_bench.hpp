@@ -97,7 +97,7 @@ daemon::RunnerResult run(std::int64_t id, const daemon::Plan& plan, daemon::Runn
   daemon::CampaignJob j;
   j.id = id;
   j.plan = plan;
-  j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, plan.kind == db::CampaignKind::sine);
+  j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, plan.kind == domain::CampaignKind::sine);
   return daemon::run_campaign(j, ctx);
 }
 std::string end_of(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }

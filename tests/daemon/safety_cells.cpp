@@ -103,8 +103,8 @@ void Cell::run_idle_state() {
   std::int64_t held_id = 0;
   std::optional<daemon::CampaignJob> job;
   if (state == State::held_after_restart) {
-    held_id = world.store->create_campaign(world.rig_id, db::CampaignKind::fot, fot_plan().dump(), "t");
-    world.store->transition(held_id, db::CampaignState::held, "held after the restart", "t");
+    held_id = world.store->create_campaign(world.rig_id, domain::CampaignKind::fot, fot_plan().dump(), "t");
+    world.store->transition(held_id, domain::CampaignState::held, "held after the restart", "t");
   }
   if (state == State::queued || state == State::finishing) job = world.job(fot_plan());
   if (state == State::finishing) {  // the loop has handed its end to the finisher; the event comes now
@@ -131,7 +131,7 @@ void Cell::run_idle_state() {
     ran = true;
   }
   world.idle(3);
-  if (held_id && world.store->campaign(held_id)->state != db::CampaignState::held) fail("the held campaign left 'held' without an operator");
+  if (held_id && world.store->campaign(held_id)->state != domain::CampaignState::held) fail("the held campaign left 'held' without an operator");
   check_after(r, ran, job ? job->id : 0);
 }
 
@@ -210,7 +210,8 @@ void Cell::check_after(const daemon::RunnerResult& r, bool ran, std::int64_t id)
   if (ran) {
     if (r.end == CampaignEnd::none) fail("the campaign did not end");
     const auto row = world.store->campaign(id);
-    if (!row || !db::is_final(row->state)) fail("the stored campaign is not in a terminal state: " + std::string(row ? db::to_string(row->state) : "none"));
+    if (!row || !domain::is_final(row->state))
+      fail("the stored campaign is not in a terminal state: " + std::string(row ? domain::to_string(row->state) : "none"));
     if (r.end != CampaignEnd::completed && r.reason.empty()) fail("the campaign ended without a reason");
   }
   // The event's own outcome.

@@ -36,7 +36,7 @@ struct SafetyWorld {
     w.rig = std::move(r);
     w.entry.name = "fake";
     w.info.name = "fake";
-    w.info.kind = shaker ? "shaker" : "load_frame";
+    w.info.kind = shaker ? domain::RigKind::shaker : domain::RigKind::load_frame;
     w.supervisor = std::make_unique<daemon::Supervisor>(*w.rig, settings, shaker, [this](const daemon::RigTransition& t) { w.record(t); });
     t0 = clock.now();
   }
@@ -109,7 +109,7 @@ struct SafetyWorld {
       return daemon::finish_campaign(std::move(f), *writer, [] { return std::string("2026-11-25T00:00:01Z"); });
     } catch (const std::exception& e) {  // as the Finisher thread does
       const std::string reason = std::string("finishing failed: ") + e.what();
-      writer->post([id, reason](db::Store& s) { s.transition(id, db::CampaignState::failed, reason, "t"); });
+      writer->post([id, reason](db::Store& s) { s.transition(id, domain::CampaignState::failed, reason, "t"); });
       daemon::RunnerResult r;
       r.end = daemon::CampaignEnd::failed;
       r.reason = reason;

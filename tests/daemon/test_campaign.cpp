@@ -79,7 +79,7 @@ TEST_CASE("fot campaign n = 12: the online table equals the offline one and the 
   CHECK(r.nodes >= 78);  // 78 nodes, and the nodes of rows taken again after a hole in the data
   REQUIRE(r.table_id);
   CHECK(r.lsq_table_id);
-  CHECK(b.store->campaign(id)->state == db::CampaignState::completed);
+  CHECK(b.store->campaign(id)->state == domain::CampaignState::completed);
   // Offline: the same identification over the samples as stored.
   const models::Grid g = models::Grid::make(0, 4, 12);
   models::OnlineTableBuilder offline(g);

@@ -43,8 +43,8 @@ TEST_CASE("contain: an exception on the acquisition thread holds the rig, fails 
     world.writer->flush();
     const auto row = world.store->campaign(first.id);
     REQUIRE(row);
-    CHECK(row->state == db::CampaignState::failed);
-    CHECK(world.store->state_reason(first.id, db::CampaignState::failed) == "error on the acquisition thread: injected: a strategy's bug; the rig is held");
+    CHECK(row->state == domain::CampaignState::failed);
+    CHECK(world.store->state_reason(first.id, domain::CampaignState::failed) == "error on the acquisition thread: injected: a strategy's bug; the rig is held");
     // The worker goes on: idle ticks, then a campaign to its end.
     world.idle(5);
     const int setpoints_before = static_cast<int>(world.rig->log.setpoints.size());
@@ -57,7 +57,7 @@ TEST_CASE("contain: an exception on the acquisition thread holds the rig, fails 
     CHECK(done->end == daemon::CampaignEnd::completed);
     CHECK(r2.end == daemon::CampaignEnd::completed);
     world.writer->flush();
-    CHECK(world.store->campaign(second.id)->state == db::CampaignState::completed);
+    CHECK(world.store->campaign(second.id)->state == domain::CampaignState::completed);
     CHECK(world.rig->log.setpoints_while_latched == 0);
   }
 }

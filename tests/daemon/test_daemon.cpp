@@ -74,7 +74,7 @@ std::string daemon_at(const fs::path& log) {
   return " --daemon http://127.0.0.1:" + std::to_string(port);
 }
 
-std::string state_of(const std::string& db, std::int64_t id) { return db::to_string(db::Store(db).campaign(id)->state); }
+std::string state_of(const std::string& db, std::int64_t id) { return domain::to_string(db::Store(db).campaign(id)->state); }
 // The daemon is up once its rig is registered: after it held what was queued before it started
 // (a campaign submitted when only the file exists may be held as left over from a restart).
 bool daemon_ready(const std::string& db) { return fs::exists(db) && db::Store(db).rig_names().size() == 1; }
@@ -150,8 +150,8 @@ TEST_CASE("hystlabd: kill -9 mid-campaign, restart: intact, interrupted, and res
     db::Store s(d.db());
     CHECK(s.integrity_check() == "ok");
     CHECK(s.max_seq(1) >= committed);
-    CHECK(s.sample_count(1) == s.max_seq(1) + 1);               // no holes
-    CHECK(s.campaign(1)->state == db::CampaignState::running);  // as the crash left it
+    CHECK(s.sample_count(1) == s.max_seq(1) + 1);                   // no holes
+    CHECK(s.campaign(1)->state == domain::CampaignState::running);  // as the crash left it
   }
   pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log2");
   REQUIRE(eventually([&] { return state_of(d.db(), 1) == "interrupted"; }));

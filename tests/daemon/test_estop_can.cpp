@@ -28,7 +28,7 @@ TEST_CASE("operator e-stop over CAN in every phase: written within two periods, 
   close(sv[1]);
   daemon::RigWorker w;
   w.rig = std::make_unique<drivers::CanRig>(std::make_unique<drivers::FdCanChannel>(sv[0], "socketpair"), drivers::CanRigConfig{});
-  w.info.kind = "load_frame";
+  w.info.kind = domain::RigKind::load_frame;
   w.entry.name = "can frame";
   w.supervisor = std::make_unique<daemon::Supervisor>(*w.rig, daemon::SupervisionSettings{}, false, [&w](const daemon::RigTransition& t) { w.record(t); });
   Bench b;

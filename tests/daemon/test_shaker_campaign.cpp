@@ -10,7 +10,7 @@
 #include "../drivers/sim_process.hpp"
 #include "campaign_bench.hpp"
 #include "hystlab/daemon/isolator.hpp"
-#include "hystlab/db/signals.hpp"
+#include "hystlab/domain/signals.hpp"
 #include "hystlab/models/sdof.hpp"
 
 using namespace hystlab;
@@ -94,7 +94,7 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   CHECK(rows_in(*b.store, "samples", r.run_id) == 0);
   double drive_min = 1;  // the drive column: what the loop commanded (below the demand: the table gains above 1 here)
   b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30,
-                                  [&](const db::ShakerRow& row) { drive_min = std::min(drive_min, row.v[db::shaker_signal::drive_amplitude]); });
+                                  [&](const db::ShakerRow& row) { drive_min = std::min(drive_min, row.v[domain::shaker_signal::drive_amplitude]); });
   CHECK(drive_min < 0.005 * 0.95);
 }
 

@@ -60,7 +60,7 @@ struct Harness {
     writer->flush();
     return r;
   }
-  std::string state_of(std::int64_t id) { return db::to_string(store->campaign(id)->state); }
+  std::string state_of(std::int64_t id) { return domain::to_string(store->campaign(id)->state); }
   bool saw(RigState to) const {
     for (const auto& t : transitions)
       if (t.to == to) return true;

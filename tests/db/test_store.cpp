@@ -20,6 +20,7 @@
 extern char** environ;
 namespace fs = std::filesystem;
 using namespace hystlab::db;
+using namespace hystlab::domain;
 
 namespace {
 struct TempDb {

@@ -17,7 +17,7 @@ class FakeDaemon final : public control::DaemonInterface {
  public:
   explicit FakeDaemon(std::string db) : db_(std::move(db)) {}
   std::size_t rig_count() const noexcept override { return 1; }
-  control::RigInfo rig_info(std::size_t) const override { return {7, "fake frame", "load_frame", "a fake", true}; }
+  control::RigInfo rig_info(std::size_t) const override { return {7, "fake frame", "a fake", domain::RigKind::load_frame, true}; }
   control::RigSupervision rig_supervision(std::size_t) const override {
     control::RigSupervision s;
     s.state = estopped ? "estopped" : "idle";
@@ -49,7 +49,7 @@ class FakeDaemon final : public control::DaemonInterface {
   std::int64_t submit(const std::string&, const nlohmann::json& plan) override {
     if (!plan.contains("kind")) throw control::PlanError("kind", "plan: kind is required");
     db::Store s(db_);
-    return s.create_campaign(s.upsert_rig("fake frame", "{}", "t"), db::CampaignKind::fot, plan.dump(), "t");
+    return s.create_campaign(s.upsert_rig("fake frame", "{}", "t"), domain::CampaignKind::fot, plan.dump(), "t");
   }
   control::PlanPreview preview(const std::string&, const nlohmann::json&, models::HysteresisModel*) const override { return {}; }
   std::optional<control::FotGrid> fot_grid(const nlohmann::json&) const override { return control::FotGrid{0, 4, 2, {}}; }
@@ -63,8 +63,7 @@ class FakeDaemon final : public control::DaemonInterface {
     if (changes.contains("colour")) throw control::PlanError("colour", "colour is not part of a campaign's record (specimen, notes)");
     std::lock_guard lk(mu);
     records.emplace_back(campaign, changes);
-    db::Store(db_).add_event(campaign, "record", nlohmann::json{{"specimen", changes.value("specimen", "")}, {"notes", changes.value("notes", "")}}.dump(),
-                             "2026-01-01T00:00:00.000Z");
+    db::Store(db_).add_event(campaign, domain::RecordEvent{changes.value("specimen", ""), changes.value("notes", "")}, "2026-01-01T00:00:00.000Z");
   }
   control::WriterCounters writer() const override { return {99, 0, 0, 1}; }
   double uptime_s() const noexcept override { return 12.5; }
@@ -188,14 +187,14 @@ TEST_CASE("the web layer runs on the daemon's interface alone: snapshots, comman
 
 TEST_CASE("the commands a campaign's state admits are those the daemon carries out") {
   using C = control::CampaignCommand;
-  using S = db::CampaignState;
+  using S = domain::CampaignState;
   CHECK(control::commands_for(S::running) == std::vector<C>{C::pause, C::abort, C::estop});
   CHECK(control::commands_for(S::paused) == std::vector<C>{C::resume, C::abort, C::estop});
   CHECK(control::commands_for(S::held) == std::vector<C>{C::resume, C::abort, C::estop});
   CHECK(control::commands_for(S::interrupted) == std::vector<C>{C::resume, C::abort, C::estop});
   for (const S s : {S::completed, S::aborted, S::failed}) CHECK(control::commands_for(s).empty());
-  for (const S s : db::kCampaignStates) {
-    CAPTURE(db::to_string(s));
-    for (const C c : control::commands_for(s)) CHECK(control::campaign_command_from(control::to_string(c)) == c);
+  for (const S s : domain::kCampaignStates) {
+    CAPTURE(domain::to_string(s));
+    for (const C c : control::commands_for(s)) CHECK(control::campaign_command_from(domain::to_string(c)) == c);
   }
 }

@@ -3,7 +3,7 @@
 #include <doctest/doctest.h>
 
 #include "api_fixture.hpp"
-#include "hystlab/db/signals.hpp"
+#include "hystlab/domain/signals.hpp"
 
 using namespace hystlab;
 using nlohmann::json;
@@ -61,7 +61,7 @@ TEST_CASE("a sweep through the API: points, prediction, resonance report, CSVs w
   const std::string run = std::to_string(camp["runs"][0]["id"].get<std::int64_t>());
   r = c.Get(("/api/runs/" + run + "/samples.csv").c_str());
   REQUIRE(r->status == 200);
-  CHECK(r->body.rfind(db::csv_header(db::kShakerSignals), 0) == 0);
+  CHECK(r->body.rfind(domain::csv_header(domain::kShakerSignals), 0) == 0);
   CHECK(r->body.rfind("seq,t_s,drive_frequency_hz,drive_amplitude_mm,base_displacement_mm,mass_displacement_mm,base_accel_m_s2,mass_accel_m_s2,status\n", 0) ==
         0);
   CHECK(std::count(r->body.begin(), r->body.end(), '\n') > 500);

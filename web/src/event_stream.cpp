@@ -5,8 +5,8 @@
 #include <memory>
 #include <thread>
 
-#include "hystlab/db/signals.hpp"
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/domain/signals.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
@@ -39,12 +39,12 @@ std::string records(db::Store& store, StreamCursor& cur) {
   std::string out;
   for (const db::EventInfo& e : store.events_after(cur.event, 500)) {
     cur.event = e.id;
-    json j{{"id", e.id}, {"campaign", e.campaign}, {"at", e.at}, {"kind", e.kind}, {"detail", e.detail.empty() ? json("") : parse_or_text(e.detail)}};
+    json j{{"id", e.id}, {"campaign", e.campaign}, {"at", e.at}, {"kind", e.kind}, {"detail", e.detail.empty() ? json("") : event_detail(e.kind, e.detail)}};
     if (e.kind == "state") {
       j["from"] = e.from_state, j["to"] = e.to_state;
-      const auto to = db::campaign_state_from(e.to_state);
-      j["active"] = to && db::is_active(*to);
-      j["final"] = to && db::is_final(*to);
+      const auto to = domain::campaign_state_from(e.to_state);
+      j["active"] = to && domain::is_active(*to);
+      j["final"] = to && domain::is_final(*to);
     }
     out += frame(e.kind == "state" ? "campaign" : e.kind, j, cur.id());
   }
@@ -73,7 +73,7 @@ std::string samples(const control::DaemonInterface& d, StreamState& st) {
     json t, cmd, disp, force;
     for (const auto& s : got) t.push_back(s.t), cmd.push_back(s.cmd), disp.push_back(s.disp), force.push_back(s.force);
     const control::RigInfo info = d.rig_info(st.rigs[k]);
-    const auto& names = info.kind == "shaker" ? db::kLiveShakerSignals : db::kLiveFrameSignals;  // what cmd, disp, force hold
+    const auto& names = info.kind == domain::RigKind::shaker ? domain::kLiveShakerSignals : domain::kLiveFrameSignals;  // what cmd, disp, force hold
     out += frame("samples", {{"rig", info.name},
                              {"run", got.back().run},
                              {"t", t},

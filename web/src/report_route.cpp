@@ -37,11 +37,11 @@ json report_document(ApiContext& c, db::Store& store, const db::CampaignRow& row
   const std::string rig = doc["campaign"].value("rig", "");
   for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
     if (c.daemon.rig_info(k).name == rig) doc["rig"] = rig_json(c.daemon, k);
-  if (row.kind == db::CampaignKind::sine) {
+  if (row.kind == domain::CampaignKind::sine) {
     doc["sweep"] = sweep_json(store, row);
     return doc;
   }
-  if (row.kind == db::CampaignKind::fot) doc["nodes"] = nodes_json(c.daemon, store, row);
+  if (row.kind == domain::CampaignKind::fot) doc["nodes"] = nodes_json(c.daemon, store, row);
   json provenance = json::object();  // each table's own account of how it was made (method, prior, folds, ...)
   for (const json& t : doc["campaign"]["tables"])
     if (const auto text = store.table_document(t.value("id", std::int64_t{0}))) {

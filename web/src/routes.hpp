@@ -4,8 +4,10 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "api_support.hpp"
+#include "hystlab/domain/events.hpp"
 
 namespace hystlab::web {
 
@@ -22,6 +24,10 @@ json campaign_json(const control::DaemonInterface& d, db::Store& store, const db
 json node_json(const db::NodeInfo& n);
 json table_json(const db::TableInfo& t);
 json parse_or_text(const std::string& s);  // stored JSON text as JSON (or as the text itself)
+// A stored event's detail as the API shows it: read through its type (domain/events.hpp), so that
+// the page gets the schema's fields; a kind this version does not know (a "state" event's
+// reason) or a detail that does not fit its type, as stored (kept, never dropped).
+json event_detail(const std::string& kind, const std::string& detail);
 
 // What the report (report_route.cpp) shares with the routes that serve the same JSON.
 json rig_json(const control::DaemonInterface& d, std::size_t k);                                   // GET /api/rigs/NAME

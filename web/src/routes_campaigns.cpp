@@ -54,8 +54,8 @@ json tables_of(db::Store& store, std::int64_t campaign, const json& runs) {
 
 // The newest online evaluation of the partial table ("fit" event), if any.
 json last_fit(db::Store& store, std::int64_t campaign) {
-  const auto fits = store.event_details(campaign, "fit");
-  return fits.empty() ? json(nullptr) : parse_or_text(fits.back());
+  const auto fits = db::events_of<domain::FitEvent>(store, campaign);
+  return fits.empty() ? json(nullptr) : domain::detail_json(fits.back());
 }
 
 }  // namespace
@@ -64,7 +64,7 @@ json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::C
   json nodes = json::array();
   for (const db::NodeInfo& n : store.nodes(row.id)) nodes.push_back(node_json(n));
   json out{{"campaign", row.id}, {"nodes", nodes}};
-  const auto grid = row.kind == db::CampaignKind::fot ? d.fot_grid(json::parse(row.plan)) : std::nullopt;
+  const auto grid = row.kind == domain::CampaignKind::fot ? d.fot_grid(json::parse(row.plan)) : std::nullopt;
   if (!grid) return out;
   const models::Grid g = grid->nodes_mm.empty() ? models::Grid::make(grid->lo_mm, grid->hi_mm, grid->subdivisions) : models::Grid::from_nodes(grid->nodes_mm);
   std::set<std::pair<int, int>> seen;  // a resumed campaign may measure a node twice
@@ -84,7 +84,7 @@ json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::C
 json events_json(db::Store& store, std::int64_t campaign) {
   json out = json::array();
   for (const auto& e : store.events(campaign))
-    out.push_back({{"id", e.id}, {"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", parse_or_text(e.detail)}});
+    out.push_back({{"id", e.id}, {"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", event_detail(e.kind, e.detail)}});
   return out;
 }
 
@@ -104,16 +104,16 @@ json loops_json(db::Store& store, std::int64_t campaign) {
 json campaign_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row, bool details) {
   json j{{"id", row.id},
          {"rig", store.rig_name(row.rig_id)},
-         {"kind", db::to_string(row.kind)},
-         {"state", db::to_string(row.state)},
+         {"kind", domain::to_string(row.kind)},
+         {"state", domain::to_string(row.state)},
          {"created_at", row.created_at},
          {"updated_at", row.updated_at}};
   // What the state means, so that a page needs no list of states of its own.
   json commands = json::array();
-  for (const control::CampaignCommand cmd : control::commands_for(row.state)) commands.push_back(control::to_string(cmd));
+  for (const control::CampaignCommand cmd : control::commands_for(row.state)) commands.push_back(domain::to_string(cmd));
   j["commands"] = commands;
-  j["active"] = db::is_active(row.state);
-  j["final"] = db::is_final(row.state);
+  j["active"] = domain::is_active(row.state);
+  j["final"] = domain::is_final(row.state);
   // What the lab records with it: at submission, or changed since (POST .../record).
   const db::CampaignRecord record = db::campaign_record(store, row);
   j["specimen"] = record.specimen.empty() ? json(nullptr) : json(record.specimen);
@@ -133,13 +133,13 @@ json campaign_json(const control::DaemonInterface& d, db::Store& store, const db
   // Training (each cycle's figures: the shakedown curve, and what it came to) and the table the
   // campaign recommends, with the reason.
   json shakedown = json::array();
-  for (const std::string& cycle : store.event_details(row.id, "shakedown")) shakedown.push_back(parse_or_text(cycle));
+  for (const domain::ShakedownEvent& cycle : db::events_of<domain::ShakedownEvent>(store, row.id)) shakedown.push_back(domain::detail_json(cycle));
   j["shakedown"] = shakedown;
-  const auto training = store.event_details(row.id, "training");
-  j["training"] = training.empty() ? json(nullptr) : parse_or_text(training.back());
-  const auto rec = store.event_details(row.id, "recommendation");
-  j["recommendation"] = rec.empty() ? json(nullptr) : parse_or_text(rec.back());
-  if (row.kind == db::CampaignKind::fot) {
+  const auto training = db::events_of<domain::TrainingEvent>(store, row.id);
+  j["training"] = training.empty() ? json(nullptr) : domain::detail_json(training.back());
+  const auto rec = db::events_of<domain::RecommendationEvent>(store, row.id);
+  j["recommendation"] = rec.empty() ? json(nullptr) : domain::detail_json(rec.back());
+  if (row.kind == domain::CampaignKind::fot) {
     const json nodes = nodes_json(d, store, row);
     j["progress"] = {{"nodes", nodes["identified"]}, {"required", nodes["required"]}};
   }
@@ -150,14 +150,14 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
   s.Get("/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
           auto& store = reader(c.db_path);
           const std::string state = req.has_param("state") ? req.get_param_value("state") : "";
-          if (!state.empty() && !db::campaign_state_from(state)) {
+          if (!state.empty() && !domain::campaign_state_from(state)) {
             std::string known;
-            for (const db::CampaignState k : db::kCampaignStates) known += (known.empty() ? "" : ", ") + std::string(db::to_string(k));
+            for (const domain::CampaignState k : domain::kCampaignStates) known += (known.empty() ? "" : ", ") + std::string(domain::to_string(k));
             throw ApiError(400, "invalid parameter", "state: '" + state + "' is not a campaign state (" + known + ")", "state");
           }
           json out = json::array();
           for (const auto& row : store.campaigns())
-            if (state.empty() || db::to_string(row.state) == state) out.push_back(campaign_json(c.daemon, store, row, false));
+            if (state.empty() || domain::to_string(row.state) == state) out.push_back(campaign_json(c.daemon, store, row, false));
           send_json(res, out);
         }));
   post_route(s, c, "/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
@@ -192,9 +192,9 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
                const auto applies = control::commands_for(row.state);
                if (std::find(applies.begin(), applies.end(), *cmd) == applies.end()) {
                  std::string which;
-                 for (const auto a : applies) which += std::string(which.empty() ? "" : ", ") + control::to_string(a);
+                 for (const auto a : applies) which += std::string(which.empty() ? "" : ", ") + domain::to_string(a);
                  throw ApiError(409, "conflict",
-                                "campaign " + std::to_string(row.id) + " is " + db::to_string(row.state) + ": '" + verb + "' does not apply" +
+                                "campaign " + std::to_string(row.id) + " is " + domain::to_string(row.state) + ": '" + verb + "' does not apply" +
                                     (which.empty() ? std::string() : " (" + which + " do)"));
                }
                send_outcome(res, json{{"campaign", row.id}, {"command", verb}}, c.daemon.command(row.id, *cmd));

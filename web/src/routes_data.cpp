@@ -68,7 +68,7 @@ void stream_csv(httplib::Response& res, const std::string& db_path, std::int64_t
 // A shaker's run (its campaign is a sine sweep).
 bool shaker_run(db::Store& store, const db::RunInfo& r) {
   const auto c = store.campaign(r.campaign);
-  return c && c->kind == db::CampaignKind::sine;
+  return c && c->kind == domain::CampaignKind::sine;
 }
 }  // namespace
 

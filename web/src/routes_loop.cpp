@@ -63,7 +63,7 @@ json loop_json(db::Store& store, XYCache& cache, std::int64_t run_id, std::size_
   const auto run = store.run(run_id);
   if (!run) throw ApiError(404, "not found", "no run " + std::to_string(run_id));
   const auto campaign = store.campaign(run->campaign);
-  const bool shaker = campaign && campaign->kind == db::CampaignKind::sine;
+  const bool shaker = campaign && campaign->kind == domain::CampaignKind::sine;
   const auto xy = cache.get(run_id);
   std::lock_guard lk(xy->mu);
   if (!xy->complete) {
@@ -74,7 +74,7 @@ json loop_json(db::Store& store, XYCache& cache, std::int64_t run_id, std::size_
   json xs = json::array(), ys = json::array();
   for (const std::size_t k : r.index) xs.push_back(rounded(xy->x[k])), ys.push_back(rounded(xy->y[k]));
   json out{{"run", run_id},
-           {"kind", campaign ? db::to_string(campaign->kind) : ""},
+           {"kind", campaign ? domain::to_string(campaign->kind) : ""},
            {"x_label", shaker ? "base displacement (mm)" : "displacement (mm)"},
            {"y_label", shaker ? "mass displacement (mm)" : "force (N)"},
            {"samples", xy->x.size()},
@@ -102,14 +102,14 @@ json preview_json(ApiContext& c, const PlanRequest& req) {
   const control::RigInfo rig = c.daemon.rig_info(c.daemon.rig_index(req.rig, kind));
   std::unique_ptr<models::HysteresisModel> model;
   std::string source;
-  if (rig.kind != "shaker") {
+  if (rig.kind != domain::RigKind::shaker) {
     if (const auto t = reader(c.db_path).newest_table_of_rig(rig.id, "fot"))
       model = table_model(reader(c.db_path), t->id), source = "table #" + std::to_string(t->id);
     if (!model) model = std::make_unique<models::SimplifiedSmaModel>(models::table1_parameters()), source = "the simplified model (the paper's Table 1)";
   }
   const control::PlanPreview v = c.daemon.preview(req.rig, req.plan, model.get());
   json out{{"rig", rig.name},
-           {"kind", db::to_string(v.kind)},
+           {"kind", domain::to_string(v.kind)},
            {"duration_s", v.duration_s},
            {"nodes", v.nodes},
            {"peak_speed_mm_s", v.peak_speed_mm_s},

@@ -4,7 +4,7 @@
 #include <mutex>
 #include <vector>
 
-#include "hystlab/db/signals.hpp"
+#include "hystlab/domain/signals.hpp"
 #include "hystlab/protocols/signals.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
@@ -13,8 +13,8 @@ namespace hystlab::web {
 namespace {
 std::map<std::string, std::int64_t> campaigns_by_state(db::Store& store) {
   std::map<std::string, std::int64_t> out;
-  for (const db::CampaignState s : db::kCampaignStates) out[db::to_string(s)] = 0;
-  for (const auto& [state, n] : store.campaign_counts()) out[db::to_string(state)] = n;
+  for (const domain::CampaignState s : domain::kCampaignStates) out[domain::to_string(s)] = 0;
+  for (const auto& [state, n] : store.campaign_counts()) out[domain::to_string(state)] = n;
   return out;
 }
 
@@ -149,7 +149,7 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
   json j{{"id", info.id},
          {"index", k},
          {"name", info.name},
-         {"kind", info.kind},
+         {"kind", domain::to_string(info.kind)},
          {"description", info.description},
          {"simulated", info.simulated},
          {"campaign", live.campaign},
@@ -185,7 +185,7 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
   // configured stroke: POST .../recover brings it back.
   const json& stroke = sv.envelope.is_object() ? sv.envelope.value("stroke_mm", json()) : json();
   const bool outside = stroke.is_array() && stroke.size() == 2 && (sv.position_mm < stroke[0].get<double>() || sv.position_mm > stroke[1].get<double>());
-  j["recoverable"] = info.kind != "shaker" && sv.have_sample && !sv.recovering &&
+  j["recoverable"] = info.kind != domain::RigKind::shaker && sv.have_sample && !sv.recovering &&
                      ((sv.latched && (w & stb::limit_tripped) != 0) || (!sv.latched && sv.state == "idle" && outside));
   j["link_losses"] = sv.link_losses;
   j["transitions"] = sv.recent;
@@ -196,7 +196,7 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
   if (h > 0) (void)d.read_live(k, h - 1, 1, last);
   if (!last.empty()) {
     const control::LiveSample& s = last.back();
-    const auto& n = info.kind == "shaker" ? db::kLiveShakerSignals : db::kLiveFrameSignals;
+    const auto& n = info.kind == domain::RigKind::shaker ? domain::kLiveShakerSignals : domain::kLiveFrameSignals;
     j["sample"] = {{"t", s.t}, {n[0], s.cmd}, {n[1], s.disp}, {n[2], s.force}, {"status", s.status}, {"run", s.run}};
   }
   return j;
@@ -204,27 +204,29 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
 
 void add_status_routes(httplib::Server& s, ApiContext& c) {
   auto cache = std::make_shared<StatusCache>();
-  s.Get("/api/status", guarded([&c, cache](const httplib::Request&, httplib::Response& res) {
-          std::lock_guard lk(cache->mu);
-          const auto now = std::chrono::steady_clock::now();
-          if (cache->body.empty() || now - cache->at > std::chrono::milliseconds(250)) {
-            json rigs = json::array();
-            for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
-              rigs.push_back({{"name", c.daemon.rig_info(k).name}, {"kind", c.daemon.rig_info(k).kind}, {"campaign", c.daemon.rig_counters(k).campaign}});
-            const control::WriterCounters w = c.daemon.writer();
-            cache->body = json{{"name", "hystlabd"},
-                               {"version", HYSTLAB_VERSION},
-                               {"uptime_s", c.daemon.uptime_s()},
-                               {"database", c.db_path},
-                               {"rigs", rigs},
-                               {"campaigns", campaigns_by_state(reader(c.db_path))},
-                               {"writer", {{"written", w.written}, {"queue_depth", w.depth}, {"dropped", w.dropped}}},
-                               {"stream_clients", c.stream_clients.load()}}
-                              .dump();
-            cache->at = now;
-          }
-          res.set_content(cache->body, "application/json");
-        }));
+  s.Get(
+      "/api/status", guarded([&c, cache](const httplib::Request&, httplib::Response& res) {
+        std::lock_guard lk(cache->mu);
+        const auto now = std::chrono::steady_clock::now();
+        if (cache->body.empty() || now - cache->at > std::chrono::milliseconds(250)) {
+          json rigs = json::array();
+          for (std::size_t k = 0; k < c.daemon.rig_count(); ++k)
+            rigs.push_back(
+                {{"name", c.daemon.rig_info(k).name}, {"kind", domain::to_string(c.daemon.rig_info(k).kind)}, {"campaign", c.daemon.rig_counters(k).campaign}});
+          const control::WriterCounters w = c.daemon.writer();
+          cache->body = json{{"name", "hystlabd"},
+                             {"version", HYSTLAB_VERSION},
+                             {"uptime_s", c.daemon.uptime_s()},
+                             {"database", c.db_path},
+                             {"rigs", rigs},
+                             {"campaigns", campaigns_by_state(reader(c.db_path))},
+                             {"writer", {{"written", w.written}, {"queue_depth", w.depth}, {"dropped", w.dropped}}},
+                             {"stream_clients", c.stream_clients.load()}}
+                            .dump();
+          cache->at = now;
+        }
+        res.set_content(cache->body, "application/json");
+      }));
   s.Get("/api/rigs", guarded([&c](const httplib::Request&, httplib::Response& res) {
           json out = json::array();
           for (std::size_t k = 0; k < c.daemon.rig_count(); ++k) out.push_back(rig_json(c.daemon, k));

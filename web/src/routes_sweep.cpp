@@ -22,7 +22,7 @@ std::string csv_number(double v) {
 }
 
 json point_json(const db::TransmissibilityInfo& t) {
-  json j = t.detail.empty() ? json::object() : parse_or_text(t.detail);
+  json j = t.detail.empty() ? json::object() : event_detail("transmissibility", t.detail);
   if (!j.is_object()) j = json::object();
   j["id"] = t.id;
   j["run"] = t.run;

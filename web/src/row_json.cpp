@@ -44,6 +44,12 @@ json warnings_of(const json& q) {
 }
 }  // namespace
 
+json event_detail(const std::string& kind, const std::string& detail) {
+  std::string error;
+  if (const auto e = domain::decode_event(kind, detail, error)) return domain::detail_json(*e);
+  return parse_or_text(detail);
+}
+
 json parse_or_text(const std::string& s) {
   if (s.empty()) return nullptr;
   const json j = json::parse(s, nullptr, false);
@@ -74,9 +80,9 @@ json table_json(const db::TableInfo& t) {
 }
 
 json run_quality(db::Store& store, std::int64_t campaign, std::int64_t run) {
-  for (const std::string& text : store.event_details(campaign, "quality")) {
-    json q = json::parse(text, nullptr, false);
-    if (q.is_discarded() || !q.is_object() || q.value("run", std::int64_t{0}) != run) continue;
+  for (const domain::QualityEvent& e : db::events_of<domain::QualityEvent>(store, campaign)) {
+    if (e.run != run) continue;
+    json q = domain::detail_json(e);
     q["warnings"] = warnings_of(q);
     return q;
   }

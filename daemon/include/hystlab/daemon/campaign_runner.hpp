@@ -18,15 +18,17 @@
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/supervisor.hpp"
-#include "hystlab/db/campaign_enums.hpp"
 #include "hystlab/db/sample_writer.hpp"
+#include "hystlab/domain/campaign.hpp"
 #include "hystlab/drivers/rig.hpp"
 #include "hystlab/models/fot_node.hpp"
 #include "hystlab/models/online_table_builder.hpp"
 
 namespace hystlab::daemon {
 
-enum class Control { pause, resume, abort, estop };  // estop: the rig's e-stop, now; no motion
+// An operator's command as the rig's thread takes it: the domain's one enum (estop: the rig's
+// e-stop, now; no motion).
+using Control = domain::CampaignCommand;
 
 // What the campaign's loop is doing now, as an operator names it (the rig panel, the safety
 // matrix's states). Text only at the edges.
@@ -51,7 +53,7 @@ enum class CampaignPhase : std::uint8_t {
 enum class CampaignEnd { none, completed, failed, aborted, interrupted };
 [[nodiscard]] const char* to_string(CampaignEnd e) noexcept;
 // The campaign's (and its run's) state for an end; running for none.
-[[nodiscard]] db::CampaignState state_of(CampaignEnd e) noexcept;
+[[nodiscard]] domain::CampaignState state_of(CampaignEnd e) noexcept;
 
 // The measured loop, kept for the final fits and loop figures: 16 bytes a sample, bounded. At
 // kMaxSamples (2^21, 32 MB) every other sample is dropped and from then on every second one offered

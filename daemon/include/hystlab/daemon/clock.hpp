@@ -2,7 +2,13 @@
 // The acquisition loop's clock (monotonic seconds, and sleeping until an absolute deadline), as
 // an interface: the daemon uses the steady clock, the tests a fake one that jumps to each
 // deadline, so supervision rules are tested fast and without sleeping.
+#include <string>
+
 namespace hystlab::daemon {
+
+// The wall clock's UTC time to the millisecond, "2026-11-26T08:21:36.123Z": every record's stamp
+// (events, runs, states). Wall time, unlike Clock below: records are read by people and across hosts.
+[[nodiscard]] std::string now_iso();
 
 class Clock {
  public:

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "hystlab/daemon/plan.hpp"
+#include "hystlab/domain/events.hpp"
 
 namespace hystlab::daemon {
 
@@ -55,6 +56,8 @@ struct RigConfigError : std::invalid_argument {
 [[nodiscard]] RigEnvelope parse_envelope(const nlohmann::json& j, const std::string& where, bool shaker);
 [[nodiscard]] SupervisionSettings parse_supervision(const nlohmann::json& j, const std::string& where);
 [[nodiscard]] nlohmann::json envelope_json(const RigEnvelope& e, bool shaker);
+// The same as the campaign's "envelope" event.
+[[nodiscard]] domain::EnvelopeEvent envelope_event(const RigEnvelope& e, bool shaker);
 [[nodiscard]] nlohmann::json supervision_json(const SupervisionSettings& s);
 
 // Refuses a plan the rig cannot run, with the field named and both numbers:

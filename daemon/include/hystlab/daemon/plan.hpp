@@ -26,7 +26,7 @@
 
 #include "hystlab/control/values.hpp"
 #include "hystlab/daemon/sine_plan.hpp"
-#include "hystlab/db/campaign_enums.hpp"
+#include "hystlab/domain/campaign.hpp"
 #include "hystlab/models/grid.hpp"
 
 namespace hystlab::daemon {
@@ -61,7 +61,7 @@ struct Validation {
 };
 
 struct Plan {
-  db::CampaignKind kind = db::CampaignKind::fot;
+  domain::CampaignKind kind = domain::CampaignKind::fot;
   // fot
   double lo_mm = 0, hi_mm = 0;
   int subdivisions = 0, repeats = 1;

@@ -8,10 +8,9 @@
 #include <string>
 
 #include "hystlab/db/store.hpp"
+#include "hystlab/domain/record.hpp"
 
 namespace hystlab::db {
-
-inline constexpr std::size_t kSpecimenMaxChars = 200, kNotesMaxChars = 4000;
 
 struct CampaignRecord {
   std::string specimen, notes;
@@ -20,18 +19,5 @@ struct CampaignRecord {
 
 // The record as it stands: the newest "record" event's, else the plan's fields.
 [[nodiscard]] CampaignRecord campaign_record(Store& store, const CampaignRow& row);
-
-// A record event's detail: {"specimen": ..., "notes": ...} as JSON text.
-[[nodiscard]] std::string record_detail(const CampaignRecord& r);
-
-// Why `text` cannot be the field ("specimen" or "notes"), or nullopt when it can. Inline: the plan
-// parser checks the plan's fields with it, and the plan fuzzer links no store.
-[[nodiscard]] inline std::optional<std::string> record_field_problem(const std::string& field, const std::string& text) {
-  const std::size_t most = field == "specimen" ? kSpecimenMaxChars : kNotesMaxChars;
-  if (field != "specimen" && field != "notes") return "is not part of a campaign's record (specimen, notes)";
-  if (text.size() > most) return "must be text of at most " + std::to_string(most) + " characters (got " + std::to_string(text.size()) + ")";
-  if (field == "specimen" && text.find('\n') != std::string::npos) return "must be one line";
-  return std::nullopt;
-}
 
 }  // namespace hystlab::db

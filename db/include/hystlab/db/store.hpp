@@ -11,9 +11,10 @@
 #include <variant>
 #include <vector>
 
-#include "hystlab/db/campaign_enums.hpp"
 #include "hystlab/db/reads.hpp"
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/domain/campaign.hpp"
+#include "hystlab/domain/events.hpp"
 
 namespace hystlab::db {
 
@@ -25,7 +26,7 @@ struct SampleRow {  // a load frame's sample
   std::int64_t status = 0;
 };
 
-struct ShakerRow {  // a shaker's sample: its signals in the order of kShakerSignals (signals.hpp)
+struct ShakerRow {  // a shaker's sample: its signals in the order of domain::kShakerSignals (signals.hpp)
   std::int64_t run_id = 0, seq = 0;
   double t = 0;
   std::array<double, 6> v{};
@@ -41,9 +42,9 @@ struct Bucket {  // min/max of one stretch of a run: no peak is lost by decimati
 
 struct CampaignRow {
   std::int64_t id = 0, rig_id = 0;
-  CampaignKind kind = CampaignKind::fot;
+  domain::CampaignKind kind = domain::CampaignKind::fot;
   std::string plan;
-  CampaignState state = CampaignState::queued;
+  domain::CampaignState state = domain::CampaignState::queued;
   std::string created_at, updated_at;
 };
 
@@ -63,15 +64,18 @@ class Store {
   [[nodiscard]] Database& database() noexcept { return db_; }
 
   std::int64_t upsert_rig(const std::string& name, const std::string& config_json, const std::string& now);
-  std::int64_t create_campaign(std::int64_t rig_id, CampaignKind kind, const std::string& plan_json, const std::string& now);
+  std::int64_t create_campaign(std::int64_t rig_id, domain::CampaignKind kind, const std::string& plan_json, const std::string& now);
   // Updates the state and records the transition as an event, in one transaction.
-  void transition(std::int64_t campaign_id, CampaignState to, const std::string& reason, const std::string& now);
-  std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s, RunRole role = RunRole::campaign);
+  void transition(std::int64_t campaign_id, domain::CampaignState to, const std::string& reason, const std::string& now);
+  std::int64_t add_run(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s,
+                       domain::RunRole role = domain::RunRole::campaign);
   // The campaign's run and, when asked, its validation run (else 0), in one transaction.
   std::pair<std::int64_t, std::int64_t> add_runs(std::int64_t campaign_id, const std::string& now, double wall_anchor_unix, double monotonic_anchor_s,
                                                  bool validation);
-  void end_run(std::int64_t run_id, CampaignState state, const std::string& now);
-  std::int64_t add_event(std::int64_t campaign_id, const std::string& kind, const std::string& detail, const std::string& now);
+  void end_run(std::int64_t run_id, domain::CampaignState state, const std::string& now);
+  std::int64_t add_event(std::int64_t campaign_id, const domain::CampaignEvent& event, const std::string& now);
+  // A detail as stored, of any kind: the tests of older or foreign details (the daemon writes typed events).
+  std::int64_t add_raw_event(std::int64_t campaign_id, const std::string& kind, const std::string& detail, const std::string& now);
   std::int64_t add_transmissibility(std::int64_t run_id, double f_hz, double base_mm, double mass_mm, double ratio, double phase);
   std::int64_t add_fot_node(std::int64_t run_id, double alpha, double beta, double f_alpha, double f_alpha_beta, double t);
   std::int64_t add_table(std::optional<std::int64_t> campaign_id, std::optional<std::int64_t> run_id, const std::string& method, int n, double lo, double hi,
@@ -90,7 +94,7 @@ class Store {
   struct LoopRecord {
     std::int64_t run = 0;
     int k = 0;
-    LoopPhase phase = LoopPhase::rows;
+    domain::LoopPhase phase = domain::LoopPhase::rows;
     std::string figures_json;
   };
   struct RunEnd {
@@ -98,7 +102,7 @@ class Store {
     std::int64_t validation_run = 0;  // 0: none; removed when it never took a sample
     std::vector<TableRecord> tables;
     std::vector<LoopRecord> loops;
-    CampaignState state = CampaignState::completed;
+    domain::CampaignState state = domain::CampaignState::completed;
     std::string reason, now;
     // The table the campaign recommends (an index into tables) and why: stored as a
     // "recommendation" event naming the new table's id, before the campaign's last state.
@@ -116,7 +120,7 @@ class Store {
   std::vector<std::int64_t> finish_run(const RunEnd& end);
   [[nodiscard]] std::int64_t table_count(std::int64_t campaign_id);
   // Every run of the campaign, or those of one role.
-  [[nodiscard]] std::vector<std::int64_t> runs_of_campaign(std::int64_t campaign_id, std::optional<RunRole> role = std::nullopt);
+  [[nodiscard]] std::vector<std::int64_t> runs_of_campaign(std::int64_t campaign_id, std::optional<domain::RunRole> role = std::nullopt);
   [[nodiscard]] std::vector<std::string> rig_names();
   void add_io_stats(std::int64_t rig_id, const std::string& stats_json, const std::string& now);
 
@@ -147,8 +151,8 @@ class Store {
 
   // ---- reads for the API and the CLI (store_reads.cpp) ----
   [[nodiscard]] std::string rig_name(std::int64_t rig_id);
-  [[nodiscard]] std::vector<std::pair<std::int64_t, std::string>> rigs();               // id, name
-  [[nodiscard]] std::vector<std::pair<CampaignState, std::int64_t>> campaign_counts();  // by state
+  [[nodiscard]] std::vector<std::pair<std::int64_t, std::string>> rigs();                       // id, name
+  [[nodiscard]] std::vector<std::pair<domain::CampaignState, std::int64_t>> campaign_counts();  // by state
   [[nodiscard]] std::optional<RunInfo> run(std::int64_t id);
   [[nodiscard]] std::vector<RunInfo> runs(std::int64_t campaign_id);
   [[nodiscard]] std::optional<std::pair<double, double>> time_span(std::int64_t run_id);  // rig seconds
@@ -164,7 +168,7 @@ class Store {
   // Details of a campaign's events of one kind, oldest first.
   [[nodiscard]] std::vector<std::string> event_details(std::int64_t campaign_id, const std::string& kind);
   // Why the campaign is in `state`: the reason of its newest transition there ("" when none).
-  [[nodiscard]] std::string state_reason(std::int64_t campaign_id, CampaignState state);
+  [[nodiscard]] std::string state_reason(std::int64_t campaign_id, domain::CampaignState state);
   // Records since an id, across campaigns, oldest first, at most limit (the event stream).
   [[nodiscard]] std::vector<EventInfo> events_after(std::int64_t id, int limit);
   [[nodiscard]] std::vector<NodeInfo> nodes_after(std::int64_t id, int limit);
@@ -176,10 +180,22 @@ class Store {
   std::int64_t read_xy(std::int64_t run_id, std::int64_t seq0, bool base_mass, std::vector<float>& x, std::vector<float>& y);
 
  private:
-  void transition_in(std::int64_t campaign_id, CampaignState to, const std::string& reason, const std::string& now);
+  void transition_in(std::int64_t campaign_id, domain::CampaignState to, const std::string& reason, const std::string& now);
   Database db_;
   Statement insert_sample_, upsert_block_;
   Statement insert_shaker_;  // after the others: the first one's initializer migrates the file
 };
+
+// A campaign's events of one kind, typed (domain/events.hpp), oldest first; those whose detail
+// does not fit their type (written by another version) are left out.
+template <class E>
+std::vector<E> events_of(Store& store, std::int64_t campaign) {
+  std::vector<E> out;
+  const std::string kind(domain::kind_of(E{}));
+  std::string error;
+  for (const std::string& text : store.event_details(campaign, kind))
+    if (auto e = domain::decode_event(kind, text, error)) out.push_back(std::get<E>(std::move(*e)));
+  return out;
+}
 
 }  // namespace hystlab::db

@@ -5,6 +5,8 @@
 #include <optional>
 #include <string_view>
 
+#include "hystlab/domain/campaign.hpp"
+
 namespace hystlab::protocols {
 
 enum class Signal : std::size_t {
@@ -36,7 +38,7 @@ enum class Signal : std::size_t {
 };
 inline constexpr std::size_t kSignalCount = static_cast<std::size_t>(Signal::count_);
 
-enum class RigKind { load_frame, shaker };
+using RigKind = domain::RigKind;  // the domain's
 
 [[nodiscard]] std::string_view signal_name(Signal s) noexcept;
 [[nodiscard]] std::optional<Signal> signal_from_name(std::string_view name) noexcept;

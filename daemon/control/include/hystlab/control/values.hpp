@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "hystlab/db/campaign_enums.hpp"
+#include "hystlab/domain/campaign.hpp"
 
 namespace hystlab::control {
 
@@ -25,7 +25,8 @@ struct PlanError : std::invalid_argument {
 
 struct RigInfo {
   std::int64_t id = 0;
-  std::string name, kind, description;  // kind: "load_frame" or "shaker"
+  std::string name, description;
+  domain::RigKind kind = domain::RigKind::load_frame;
   bool simulated = false;
 };
 
@@ -51,15 +52,10 @@ struct CommandOutcome {
 };
 [[nodiscard]] const char* to_string(CommandOutcome::Result r) noexcept;
 
-// Operator commands for a campaign. Text only at the edges (JSON, the database's commands).
-enum class CampaignCommand { pause, resume, abort, estop };
-[[nodiscard]] const char* to_string(CampaignCommand c) noexcept;
-// nullopt for anything else: an unknown command is refused, never taken for an abort.
-[[nodiscard]] std::optional<CampaignCommand> campaign_command_from(std::string_view text) noexcept;
-// The commands that do something to a campaign in this state, as the daemon carries them out:
-// what a page offers (pause a running one; resume a paused, interrupted or held one; abort or
-// e-stop any that is not over).
-[[nodiscard]] std::vector<CampaignCommand> commands_for(db::CampaignState s);
+// Operator commands for a campaign: the domain's (one enum from the API to the rig's thread).
+using domain::campaign_command_from;
+using domain::CampaignCommand;
+using domain::commands_for;
 
 // The rig's supervision (a copy, taken under a lock).
 struct RigSupervision {
@@ -108,7 +104,7 @@ struct WriterCounters {
 
 // What a plan will do, before it is submitted.
 struct PlanPreview {
-  db::CampaignKind kind = db::CampaignKind::fot;
+  domain::CampaignKind kind = domain::CampaignKind::fot;
   double duration_s = 0;                         // rig seconds, from the rig at the range's bottom
   std::size_t nodes = 0;                         // FOT nodes measured (fot), frequencies (sine)
   double peak_speed_mm_s = 0;                    // commanded

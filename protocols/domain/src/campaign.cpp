@@ -1,6 +1,6 @@
-#include "hystlab/db/campaign_enums.hpp"
+#include "hystlab/domain/campaign.hpp"
 
-namespace hystlab::db {
+namespace hystlab::domain {
 
 const char* to_string(CampaignState s) noexcept {
   switch (s) {
@@ -74,4 +74,45 @@ const char* to_string(LoopPhase p) noexcept {
   return "?";
 }
 
-}  // namespace hystlab::db
+const char* to_string(CampaignCommand c) noexcept {
+  switch (c) {
+    case CampaignCommand::pause:
+      return "pause";
+    case CampaignCommand::resume:
+      return "resume";
+    case CampaignCommand::abort:
+      return "abort";
+    case CampaignCommand::estop:
+      return "estop";
+  }
+  return "?";
+}
+
+std::optional<CampaignCommand> campaign_command_from(std::string_view text) noexcept {
+  for (const CampaignCommand c : {CampaignCommand::pause, CampaignCommand::resume, CampaignCommand::abort, CampaignCommand::estop})
+    if (text == to_string(c)) return c;
+  return std::nullopt;
+}
+
+std::vector<CampaignCommand> commands_for(domain::CampaignState s) {
+  using S = domain::CampaignState;
+  if (domain::is_final(s)) return {};
+  std::vector<CampaignCommand> out;
+  if (s == S::running) out.push_back(CampaignCommand::pause);
+  if (s == S::paused || s == S::interrupted || s == S::held) out.push_back(CampaignCommand::resume);
+  // An interrupted campaign can be ended too (it was answered 202 and then ignored): abort ends
+  // it where it is; e-stop also latches its rig.
+  out.push_back(CampaignCommand::abort);
+  out.push_back(CampaignCommand::estop);
+  return out;
+}
+
+const char* to_string(RigKind k) noexcept { return k == RigKind::shaker ? "shaker" : "load_frame"; }
+
+std::optional<RigKind> rig_kind_from(std::string_view text) noexcept {
+  if (text == "load_frame") return RigKind::load_frame;
+  if (text == "shaker") return RigKind::shaker;
+  return std::nullopt;
+}
+
+}  // namespace hystlab::domain

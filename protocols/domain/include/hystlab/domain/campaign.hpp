@@ -4,8 +4,9 @@
 #include <array>
 #include <optional>
 #include <string_view>
+#include <vector>
 
-namespace hystlab::db {
+namespace hystlab::domain {
 
 enum class CampaignState { queued, held, arming, running, paused, completed, aborted, failed, interrupted };
 inline constexpr std::array<CampaignState, 9> kCampaignStates{CampaignState::queued,  CampaignState::held,   CampaignState::arming,
@@ -36,4 +37,21 @@ enum class RunRole { campaign, validation };
 enum class LoopPhase { training, rows, validation };
 [[nodiscard]] const char* to_string(LoopPhase p) noexcept;
 
-}  // namespace hystlab::db
+// Operator commands for a campaign, from the API to the rig's thread (estop: the rig's e-stop,
+// now; no motion). Text only at the edges (JSON, the database's command events).
+enum class CampaignCommand { pause, resume, abort, estop };
+[[nodiscard]] const char* to_string(CampaignCommand c) noexcept;
+// nullopt for anything else: an unknown command is refused, never taken for an abort.
+[[nodiscard]] std::optional<CampaignCommand> campaign_command_from(std::string_view text) noexcept;
+// The commands that do something to a campaign in this state, as the daemon carries them out:
+// what a page offers (pause a running one; resume a paused, interrupted or held one; abort or
+// e-stop any that is not over).
+[[nodiscard]] std::vector<CampaignCommand> commands_for(CampaignState s);
+
+// The kind of rig: a load frame (a specimen between grips, displacement and force) or a shaker
+// (a mass on the specimen over a moving base). Text at the edges: "load_frame", "shaker".
+enum class RigKind { load_frame, shaker };
+[[nodiscard]] const char* to_string(RigKind k) noexcept;
+[[nodiscard]] std::optional<RigKind> rig_kind_from(std::string_view text) noexcept;
+
+}  // namespace hystlab::domain

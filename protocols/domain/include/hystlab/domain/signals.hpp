@@ -4,7 +4,7 @@
 #include <array>
 #include <string>
 
-namespace hystlab::db {
+namespace hystlab::domain {
 
 struct SignalName {
   const char* name;   // with its unit: "base_displacement_mm"
@@ -39,4 +39,4 @@ std::string csv_header(const std::array<SignalName, N>& s) {
   return h + ",status\n";
 }
 
-}  // namespace hystlab::db
+}  // namespace hystlab::domain
