@@ -84,22 +84,27 @@ void Loop::event(const domain::CampaignEvent& e) {
   ctx.writer.post([id, e, now](db::Store& s) { s.add_event(id, e, now); });
 }
 
-void Loop::publish(double t, double a, double b, double c, std::uint16_t status) {
-  ctx.writer.try_push(db::SampleRow{result.run_id, next_seq++, t, a, b, c, status});
+void Loop::publish(const drivers::RigSample& s) {
+  ctx.writer.try_push(db::SampleRow{result.run_id, next_seq++, s.time_s, s.command_mm, s.displacement_mm, s.force_N, s.status_word});
   ++result.samples;
   if (ctx.live) {
-    ctx.live->ring.push({ctx.clock.now(), t, a, b, c, result.run_id, status});
+    ctx.live->ring.push(
+        LiveSample::of(ctx.clock.now(), s.time_s, domain::FrameSample{s.command_mm, s.displacement_mm, s.force_N}, result.run_id, s.status_word));
     ctx.live->samples.fetch_add(1, std::memory_order_relaxed);
   }
 }
 
 void Loop::publish(const drivers::ShakerSample& s) {
-  db::ShakerRow row{result.run_id, next_seq++, s.time_s, {}, s.status_word};
-  row.v = {drive_hz, drive_mm, s.base_displacement_mm, s.mass_displacement_mm, s.base_accel_m_s2, s.mass_accel_m_s2};
+  db::ShakerRow row{result.run_id,
+                    next_seq++,
+                    s.time_s,
+                    {drive_hz, drive_mm, s.base_displacement_mm, s.mass_displacement_mm, s.base_accel_m_s2, s.mass_accel_m_s2},
+                    s.status_word};
   ctx.writer.try_push(row);
   ++result.samples;
   if (ctx.live) {
-    ctx.live->ring.push({ctx.clock.now(), s.time_s, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, result.run_id, s.status_word});
+    ctx.live->ring.push(LiveSample::of(ctx.clock.now(), s.time_s, domain::LiveShaker{s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2},
+                                       result.run_id, s.status_word));
     ctx.live->samples.fetch_add(1, std::memory_order_relaxed);
   }
 }
@@ -301,7 +306,7 @@ bool safing_step(Loop& L, double t, double x) {
 // One fresh load-frame sample; false when the campaign ends.
 bool frame_sample(Loop& L, Strategy& strategy, const drivers::RigSample& s) {
   L.check_gap(s.time_s);
-  L.publish(s.time_s, s.command_mm, s.displacement_mm, s.force_N, s.status_word);
+  L.publish(s);
   if (auto why = L.ctx.supervisor.on_status(s.time_s, view_of(s))) {
     L.end(CampaignEnd::failed, *why + (L.safing ? " (on the way to the safe position)" : ""));
     L.safing = false;
@@ -465,7 +470,7 @@ void hand_off(Loop& L, Strategy& strategy, bool drove = true) {
   fj.campaign = L.job.id;
   fj.plan = L.plan;
   strategy.fill_finish(L, fj);  // first: the last descent's bottom node is counted there
-  if (fj.validation.x.empty() && !L.job.prior_validation.x.empty()) fj.validation = L.job.prior_validation;
+  if (fj.validation.empty() && !L.job.prior_validation.empty()) fj.validation = L.job.prior_validation;  // its chunks shared: O(chunks)
   fj.result = L.result;
   if (L.result.gaps > 0) L.event(domain::GapsEvent{static_cast<std::int64_t>(L.result.gaps), L.result.gap_total_s * 1e3, L.result.longest_gap_s * 1e3});
   if (drove) record_quality(L);

@@ -79,7 +79,7 @@ struct Loop {
   // The safe ramp (abort or trip): the loop keeps sampling, storing and publishing until the
   // rig is within the in-position tolerance of the safe position, or holds where it stopped.
   void begin_safing(double t, CampaignEnd e, const std::string& reason, double position_mm);
-  void publish(double t, double a, double b, double c, std::uint16_t status);
+  void publish(const drivers::RigSample& s);
   void publish(const drivers::ShakerSample& s);  // stored with the drive in force (drive_hz, drive_mm)
   double drive_hz = 0, drive_mm = 0;             // the shaker's drive as last commanded
   // The shaker's drive; false (result set, rig held) when the rig refused it.

@@ -17,6 +17,7 @@
 #include "hystlab/db/campaign_record.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "monotonic_clock.hpp"
+#include "resume_loader.hpp"
 #include "rig_worker.hpp"
 
 namespace hystlab::daemon {
@@ -28,6 +29,7 @@ struct Daemon::Impl {
   std::vector<std::unique_ptr<RigWorker>> workers;
   std::unique_ptr<db::SampleWriter> writer;
   std::unique_ptr<Finisher> finisher;
+  std::unique_ptr<ResumeLoader> loader;  // resumed campaigns' earlier samples, read off the main loop
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
   std::mutex mu;
   std::condition_variable cv;
@@ -186,22 +188,39 @@ struct Daemon::Impl {
     }
     record_envelope(w, id);
     for (const auto& [a, b, fa, fab] : store.fot_nodes_of_campaign(id)) job.prior_nodes.push_back({a, b, fa, fab});
-    if (job.plan.kind == domain::CampaignKind::fot && !job.prior_nodes.empty()) {             // the fits after a resume use every run
-      for (const std::int64_t run : store.runs_of_campaign(id, domain::RunRole::campaign)) {  // never the validation runs
-        store.for_each_sample(run, 0, std::numeric_limits<std::int64_t>::max(), [&job](const db::SampleRow& r) { job.prior_series.add(r.disp, r.force); });
-        job.prior_run = run;
-      }
-      // The last validation run that holds samples: a resume with every node measured scores its
-      // tables on it (an interruption during the validation run or the finishing left it there).
-      const std::vector<std::int64_t> vruns = store.runs_of_campaign(id, domain::RunRole::validation);
-      const auto last = std::find_if(vruns.rbegin(), vruns.rend(), [this](std::int64_t run) { return store.sample_count(run) > 0; });
-      if (last != vruns.rend()) {
-        store.for_each_sample(*last, 0, std::numeric_limits<std::int64_t>::max(),
-                              [&job](const db::SampleRow& r) { job.prior_validation.add(r.disp, r.force); });
-        job.prior_validation_run = *last;
-      }
+    if (job.plan.kind == domain::CampaignKind::fot && !job.prior_nodes.empty()) {  // the fits after a resume use every run: read off this loop
+      loader->load(
+          std::move(job), [this, &w](CampaignJob j) { post_main([this, &w, j = std::move(j)]() mutable { hand_over_loaded(w, std::move(j)); }); },
+          [this, id](const std::string&) { post_main([this, id] { again(id); }); });
+      return std::nullopt;
     }
     return job;
+  }
+
+  // A resumed campaign whose record is in: to its rig, unless it was ended while it was read.
+  void hand_over_loaded(RigWorker& w, CampaignJob j) {
+    try {
+      const auto row = store.campaign(j.id);
+      if (row && row->state == domain::CampaignState::queued) w.push_job(std::move(j));
+    } catch (const std::exception& e) {
+      spdlog::warn("campaign {}: not handed to its rig ({}); tried again", j.id, e.what());
+      again(j.id);
+    }
+  }
+  // Handed over again on a later pass (the database refused this one).
+  void again(std::int64_t id) {
+    dispatched.erase(id);
+    redispatch = true;
+  }
+
+  // f on the main loop's next pass (dropped once the daemon stops accepting work).
+  void post_main(std::function<void()> f) {
+    {
+      std::lock_guard lk(mu);
+      if (!accepting) return;
+      jobs.push_back(std::move(f));
+    }
+    cv.notify_all();
   }
 
   void store_io_stats() {
@@ -301,6 +320,7 @@ Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>(config
     } const done{d, j.campaign};
     return finish_campaign(std::move(j), *d.writer, now_iso);
   });
+  d.loader = std::make_unique<ResumeLoader>(config.db_path);
   if (moved) (void)avoid_cpu(-1);
 }
 
@@ -310,6 +330,7 @@ Daemon::~Daemon() {
     std::lock_guard lk(d.mu);
     d.accepting = false;
   }
+  d.loader.reset();
   for (auto& w : d.workers)
     if (w->thread.joinable()) w->thread.join();
   d.finisher.reset();  // what was handed over is finished
@@ -320,14 +341,16 @@ Daemon::~Daemon() {
 
 void Daemon::run(const std::atomic<bool>& stop) {
   auto& d = *impl_;
-  const std::function<void(FinishJob)> finish = [&d](FinishJob j) {
+  Offload offload;
+  offload.finish = [&d](FinishJob j) {
     {
       std::lock_guard lk(d.finishing_mu);
       d.finishing.insert(j.campaign);
     }
     d.finisher->submit(std::move(j));
   };
-  for (auto& w : d.workers) w->thread = std::thread(rig_thread, std::ref(*w), std::ref(*d.writer), finish, std::cref(stop), d.config.base_dir);
+  offload.background = [&d](std::function<void()> task) { d.finisher->post(std::move(task)); };
+  for (auto& w : d.workers) w->thread = std::thread(rig_thread, std::ref(*w), std::ref(*d.writer), offload, std::cref(stop), d.config.base_dir);
   spdlog::info("hystlabd running: database {}", d.config.db_path);
   auto last_stats = std::chrono::steady_clock::now();
   while (!stop) {
@@ -352,6 +375,7 @@ void Daemon::run(const std::atomic<bool>& stop) {
   } catch (const std::exception& e) {
     spdlog::error("main loop: {}", e.what());
   }
+  d.loader.reset();                            // a load under way finishes; its rig's thread still takes jobs
   for (auto& w : d.workers) w->thread.join();  // each holds its rig and marks its campaign interrupted
   d.finisher.reset();
   d.writer->flush();

@@ -26,8 +26,8 @@ class RampStrategy final : public Strategy {
         time_scale_(L.ctx.time_scale),
         shakedown_(L.plan.training) {
     series_ = L.job.prior_series;
-    rows_begin_ = series_.x.size();
-    halvings_seen_ = series_.halvings;
+    rows_begin_ = series_.size();
+    halvings_seen_ = series_.halvings();
     if (plan_.kind != domain::CampaignKind::fot) return;
     const models::Grid g = fot_grid(plan_);
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
@@ -56,8 +56,8 @@ class RampStrategy final : public Strategy {
 
   bool on_frame(Loop& L, const drivers::RigSample& s) override {
     (validating_ ? validation_ : series_).add(s.displacement_mm, s.force_N);
-    if (series_.halvings != halvings_seen_) {  // the series was thinned 2:1: its indices follow
-      halvings_seen_ = series_.halvings;
+    if (series_.halvings() != halvings_seen_) {  // the series was thinned 2:1: its indices follow
+      halvings_seen_ = series_.halvings();
       rows_begin_ = (rows_begin_ + 1) / 2;
       cycle_start_.reset();  // a training cycle in progress is not judged on a thinned record
     }
@@ -77,7 +77,7 @@ class RampStrategy final : public Strategy {
     if (fot_ && !validating_) {
       fot_->set_spacing(L.spacing);
       fot_->feed(s.time_s, s.displacement_mm, s.force_N, collecting());
-      if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
+      if (fot_->take_descent_completed()) post_evaluation(L.ctx, L.job.id, *builder_, series_, L.ctx.now_iso());
       if (seq_.done() && !validating_) retake_rows(L);
     }
     return true;
@@ -108,7 +108,7 @@ class RampStrategy final : public Strategy {
     if (shakedown_.cycles() > 0) fj.training_summary = shakedown_.summary();
     if (fot_) {
       fot_->finish();  // the last descent ends here: evaluate it like the others
-      if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
+      if (fot_->take_descent_completed()) post_evaluation(L.ctx, L.job.id, *builder_, series_, L.ctx.now_iso());
     }
     fj.series = std::move(series_);
     if (builder_) fj.builder = std::move(builder_);
@@ -142,8 +142,8 @@ class RampStrategy final : public Strategy {
       seq_.restart_at(seq_.find(SegmentKind::rise, seq_.index()));
       return seq_.step(s.time_s, s.displacement_mm);
     }
-    if (cur && cur->kind == SegmentKind::training && cur->target_mm == plan_.hi_mm) cycle_start_ = series_.x.size() - 1;
-    if (cur && cur->kind != SegmentKind::training && before < seq_.size() && seq_.at(before).kind == SegmentKind::training) rows_begin_ = series_.x.size() - 1;
+    if (cur && cur->kind == SegmentKind::training && cur->target_mm == plan_.hi_mm) cycle_start_ = series_.size() - 1;
+    if (cur && cur->kind != SegmentKind::training && before < seq_.size() && seq_.at(before).kind == SegmentKind::training) rows_begin_ = series_.size() - 1;
     if (cur && cur->kind == SegmentKind::validation && !validating_) {
       const std::size_t at = seq_.index();
       if (builder_) retake_rows(L);
@@ -156,14 +156,15 @@ class RampStrategy final : public Strategy {
 
   // The figures of the training cycle that just ended; true when training ends with it.
   bool end_training_cycle(Loop& L) {
-    const std::size_t b = *cycle_start_, e = series_.x.size() - 1;
+    // The cycle's samples, copied into a buffer kept across cycles: O(cycle), no allocation once
+    // it has grown to a cycle's length.
+    const std::size_t b = *cycle_start_, e = series_.size() - 1;
     cycle_start_.reset();
-    const std::span<const double> x(series_.x), f(series_.f);
-    const std::size_t top =
-        b + static_cast<std::size_t>(std::max_element(x.begin() + static_cast<std::ptrdiff_t>(b), x.begin() + static_cast<std::ptrdiff_t>(e) + 1) -
-                                     (x.begin() + static_cast<std::ptrdiff_t>(b)));
-    if (!(b < top && top < e)) return false;
-    const models::LoopFigures fig = models::loop_figures(x, f, b, top, e);
+    series_.copy(b, e + 1, cycle_);
+    const std::span<const double> x(cycle_.x), f(cycle_.f);
+    const auto top = static_cast<std::size_t>(std::max_element(x.begin(), x.end()) - x.begin());
+    if (!(0 < top && top < e - b)) return false;
+    const models::LoopFigures fig = models::loop_figures(x, f, 0, top, e - b);
     const ShakedownStep st = shakedown_.add(fig.peak_force_N, fig.energy_Nmm);
     domain::ShakedownEvent ev;
     ev.cycle = st.cycle, ev.consecutive = st.consecutive, ev.stable = st.stable;
@@ -182,7 +183,7 @@ class RampStrategy final : public Strategy {
       fot_->set_spacing(L.spacing);
       fot_->feed(s.time_s, s.displacement_mm, s.force_N, false);
       fot_->finish();
-      if (fot_->take_descent_completed()) post_evaluation(L.ctx.writer, L.job.id, *builder_, series_, L.ctx.now_iso());
+      if (fot_->take_descent_completed()) post_evaluation(L.ctx, L.job.id, *builder_, series_, L.ctx.now_iso());
     }
     validating_ = true;
     campaign_run_ = L.result.run_id;
@@ -254,6 +255,7 @@ class RampStrategy final : public Strategy {
   std::shared_ptr<models::OnlineTableBuilder> builder_;
   std::unique_ptr<OnlineFot> fot_;
   RunSeries series_, validation_;
+  Columns cycle_;  // the training cycle being judged
   double time_scale_ = 1.0;
   ShakedownRule shakedown_;
   std::optional<std::size_t> cycle_start_;  // the sample a training cycle began at

@@ -227,8 +227,7 @@ RigSupervision RigWorker::snapshot() const {
 
 namespace {
 
-void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish, const std::atomic<bool>& stop,
-             double epoch) {
+void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const Offload& offload, const std::atomic<bool>& stop, double epoch) {
   SteadyClock clock;
   RunnerContext ctx(*w.rig, *w.supervisor, writer, clock);
   ctx.time_scale = w.entry.time_scale;
@@ -237,7 +236,8 @@ void run_job(RigWorker& w, CampaignJob job, db::SampleWriter& writer, const std:
   ctx.next_control = [&w] { return w.pop_control(); };
   ctx.service = [&w](double t) { w.service(t); };
   ctx.live = &w.live;
-  ctx.finish = finish;
+  ctx.finish = offload.finish;
+  ctx.background = offload.background;
   ctx.epoch = epoch;
   const auto id = job.id;
   ctx.on_state = [&w, id](const std::string& s) { spdlog::info("rig '{}': campaign {} {}", w.entry.name, id, s); };
@@ -267,13 +267,14 @@ void idle_tick(RigWorker& w, double t, const std::string& base, double host_s) {
     ec = w.rig->read_shaker(t, s);
     v = {s.status_word, s.fault_code, 0.0};
     x = s.mass_displacement_mm, f = s.mass_accel_m_s2;
-    if (!ec) w.live.ring.push({mono_now(), t, s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2, 0, s.status_word});
+    if (!ec)
+      w.live.ring.push(LiveSample::of(mono_now(), t, domain::LiveShaker{s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2}, 0, s.status_word));
   } else {
     drivers::RigSample s;
     ec = w.rig->read_sample(t, s);
     v = {s.status_word, s.fault_code, s.displacement_mm};
     x = s.displacement_mm, f = s.force_N;
-    if (!ec) w.live.ring.push({mono_now(), t, s.command_mm, s.displacement_mm, s.force_N, 0, s.status_word});
+    if (!ec) w.live.ring.push(LiveSample::of(mono_now(), t, domain::FrameSample{s.command_mm, s.displacement_mm, s.force_N}, 0, s.status_word));
   }
   // The link is lost when the connection is, or after kIdleMissesForLinkLoss failed reads in a
   // row: one late answer is no lost link (a starved CI host timed out a read every few seconds,
@@ -308,7 +309,7 @@ void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, do
   w.live.phase = 0;
 }
 
-void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish, const std::atomic<bool>& stop, const std::string& base) {
+void rig_thread(RigWorker& w, db::SampleWriter& writer, const Offload& offload, const std::atomic<bool>& stop, const std::string& base) {
   // Ahead of everything else in the process when the system allows it; otherwise it says so once.
   spdlog::info("rig '{}': acquisition thread at {}", w.entry.name, enter_acquisition_thread(w.acquisition));
   const double t0 = mono_now();
@@ -319,7 +320,7 @@ void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void
       w.service(rig_time());
       if (auto job = w.pop_job()) {
         if (job->submitted_mono > 0) w.live.submit_latency_s = mono_now() - job->submitted_mono;
-        run_job(w, std::move(*job), writer, finish, stop, t0);
+        run_job(w, std::move(*job), writer, offload, stop, t0);
         w.idle_misses = 0;
         w.running_campaign = 0;
         continue;

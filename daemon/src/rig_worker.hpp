@@ -95,6 +95,11 @@ void contain(RigWorker& w, db::SampleWriter& writer, const std::string& what, do
 // The rig's acquisition thread: operator commands first, then queued campaigns in order; between
 // them the rig is sampled every 50 ms (supervised, shown live). Every exception is caught here:
 // the rig is held, the campaign failed with the reason, and the thread goes on.
-void rig_thread(RigWorker& w, db::SampleWriter& writer, const std::function<void(FinishJob)>& finish, const std::atomic<bool>& stop, const std::string& base);
+// Work leaves the thread through `offload`: the ends of runs and the evaluations during them.
+struct Offload {
+  std::function<void(FinishJob)> finish;
+  std::function<void(std::function<void()>)> background;
+};
+void rig_thread(RigWorker& w, db::SampleWriter& writer, const Offload& offload, const std::atomic<bool>& stop, const std::string& base);
 
 }  // namespace hystlab::daemon

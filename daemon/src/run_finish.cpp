@@ -22,37 +22,42 @@ namespace hystlab::daemon {
 namespace {
 using nlohmann::json;
 
-json evaluate(const models::EverettTable& table, const RunSeries& s) { return models::accuracy_json(models::score_table(table, s.x, s.f)); }
+json evaluate(const models::EverettTable& table, const Columns& s) { return models::accuracy_json(models::score_table(table, s.x, s.f)); }
 }  // namespace
 
-void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const models::OnlineTableBuilder& builder, const RunSeries& series,
-                     const std::string& now) {
-  auto table = builder.table();
-  const std::size_t known = builder.identified_nodes(), needed = builder.required_nodes();
-  // On at most 65,536 samples of the run, evenly spread: a copy of the whole run after every
-  // descent was O(N) on the acquisition thread, and held ~400 bytes a sample in the process's
-  // heap over a long campaign (fragments of ever larger copies); the final tables are scored on all.
-  RunSeries few = series.thinned(kEvaluationSamples);
-  writer.post([campaign, table = std::move(table), x = std::move(few.x), f = std::move(few.f), known, needed, now](db::Store& s) {
-    s.add_event(campaign,
-                domain::FitEvent{static_cast<std::int64_t>(known), static_cast<std::int64_t>(needed), models::accuracy_json(models::score_table(table, x, f))},
-                now);
-  });
+void post_evaluation(RunnerContext& ctx, std::int64_t campaign, const models::OnlineTableBuilder& builder, const RunSeries& series, const std::string& now) {
+  const auto known = static_cast<std::int64_t>(builder.identified_nodes()), needed = static_cast<std::int64_t>(builder.required_nodes());
+  auto work = [&writer = ctx.writer, campaign, table = builder.table(), shared = series.share(), known, needed, now] {
+    // On at most 65,536 samples of the run, evenly spread: the final tables are scored on all.
+    const Columns few = shared.thinned(kEvaluationSamples);
+    domain::CampaignEvent e = domain::FitEvent{known, needed, models::accuracy_json(models::score_table(table, few.x, few.f))};
+    writer.post([campaign, e = std::move(e), now](db::Store& s) { s.add_event(campaign, e, now); });
+  };
+  if (ctx.background)
+    ctx.background(std::move(work));
+  else
+    work();
 }
 
 namespace {
+// The run's record and the validation run's, contiguous: made on the finisher's thread (the
+// acquisition thread hands over its chunks).
+struct Record {
+  Columns series, validation;
+};
+
 // Every closed cycle of the campaign's run (those starting before rows_begin are training loops)
 // and of the validation run, with the plan's plateau displacements.
-std::vector<db::Store::LoopRecord> loop_records(const FinishJob& j, std::int64_t run, std::int64_t vrun) {
+std::vector<db::Store::LoopRecord> loop_records(const FinishJob& j, const Record& rec, std::int64_t run, std::int64_t vrun) {
   std::vector<db::Store::LoopRecord> out;
   models::LoopOptions o;
   o.plateau_at_mm = j.plan.plateaus_mm;
   int k = 0;
-  for (const models::LoopFigures& L : models::find_loops(j.series.x, j.series.f, o))
+  for (const models::LoopFigures& L : models::find_loops(rec.series.x, rec.series.f, o))
     out.push_back({run, k++, L.begin < j.rows_begin ? domain::LoopPhase::training : domain::LoopPhase::rows, models::loop_json(L).dump()});
-  if (vrun > 0 && !j.validation.x.empty()) {
+  if (vrun > 0 && !rec.validation.x.empty()) {
     k = 0;
-    for (const models::LoopFigures& L : models::find_loops(j.validation.x, j.validation.f, o))
+    for (const models::LoopFigures& L : models::find_loops(rec.validation.x, rec.validation.f, o))
       out.push_back({vrun, k++, domain::LoopPhase::validation, models::loop_json(L).dump()});
   }
   return out;
@@ -69,10 +74,11 @@ struct Candidate {
   std::optional<double> heldout_rms;
 };
 
-Candidate candidate(const FinishJob& j, std::string label, std::string method, int n, const models::EverettTable& table, models::TableProvenance prov) {
-  Candidate c{std::move(label), {std::move(method), n, j.plan.lo_mm, j.plan.hi_mm, "", ""}, std::move(prov), table, evaluate(table, j.series), {}};
-  if (j.validation.x.size() >= 2) {
-    json held = evaluate(table, j.validation);
+Candidate candidate(const FinishJob& j, const Record& rec, std::string label, std::string method, int n, const models::EverettTable& table,
+                    models::TableProvenance prov) {
+  Candidate c{std::move(label), {std::move(method), n, j.plan.lo_mm, j.plan.hi_mm, "", ""}, std::move(prov), table, evaluate(table, rec.series), {}};
+  if (rec.validation.x.size() >= 2) {
+    json held = evaluate(table, rec.validation);
     c.heldout_rms = held.at("overall").at("rms_N").get<double>();
     c.accuracy["held_out"] = std::move(held);
   }
@@ -104,13 +110,13 @@ std::string recommend(std::vector<Candidate>& cs) {
 // The fot tables of a finished campaign: the calibrated table from every node, and the
 // least-squares table (prior decided by held-out blocks), each with its accuracy on every sample
 // of the campaign's runs, on the validation run, drift and provenance.
-std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const std::string& now, std::string& note, std::string& recommendation) {
+std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const Record& rec, const std::string& now, std::string& note, std::string& recommendation) {
   const Plan& plan = j.plan;
   const models::DriftReport drift = models::drift_report(*j.builder);
   const std::string source = "campaign " + std::to_string(j.campaign), run = "run " + std::to_string(j.result.run_id);
   const std::string fot_label = "fot n=" + std::to_string(plan.subdivisions);
   std::vector<Candidate> cs;
-  cs.push_back(candidate(j, fot_label, "fot", plan.subdivisions, j.builder->table(),
+  cs.push_back(candidate(j, rec, fot_label, "fot", plan.subdivisions, j.builder->table(),
                          {source, "fot", now, run, {{"drift_max_spread_N", drift.max_spread}, {"drift_pooled_std_N", drift.pooled_std}}}));
   // At most n = 24, as before: the campaign's end (and a shutdown) waits for it, the fit cannot
   // be cancelled yet, and its cross-validation costs O(samples) per solver step (bench_fit: n = 48
@@ -119,8 +125,8 @@ std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const std::string& 
   const int n = std::min(plan.subdivisions, 24);
   const models::Grid lsq_grid = n == plan.subdivisions ? fot_grid(plan) : models::Grid::make(plan.lo_mm, plan.hi_mm, n);
   try {
-    const models::PreisachFitResult fit = models::fit_preisach(j.series.x, j.series.f, lsq_grid);
-    cs.push_back(candidate(j, "lsq " + std::string(models::to_string(fit.chosen.prior)) + " n=" + std::to_string(n), "lsq", n, fit.chosen.table,
+    const models::PreisachFitResult fit = models::fit_preisach(rec.series.x, rec.series.f, lsq_grid);
+    cs.push_back(candidate(j, rec, "lsq " + std::string(models::to_string(fit.chosen.prior)) + " n=" + std::to_string(n), "lsq", n, fit.chosen.table,
                            {source, "lsq", now, run, models::fit_provenance(fit)}));
   } catch (const std::exception& e) {  // optional: its failure never costs the campaign its fot table
     note = std::string("; least-squares table skipped: ") + e.what();
@@ -142,13 +148,14 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   const std::string now = now_iso();
   db::Store::RunEnd end;
   std::string note, recommendation;
+  const Record rec{j.series.columns(), j.validation.columns()};
   if (r.end == CampaignEnd::completed && j.builder) {
     if (!j.builder->complete()) {
       r.end = CampaignEnd::failed;
       r.reason = "the input ended with " + std::to_string(j.builder->identified_nodes()) + " of " + std::to_string(j.builder->required_nodes()) +
                  " FOT nodes measured";
     } else {
-      end.tables = fot_tables(j, now, note, recommendation);
+      end.tables = fot_tables(j, rec, now, note, recommendation);
       for (std::size_t k = 0; k < end.tables.size(); ++k)
         if (json::parse(end.tables[k].accuracy_json).value("recommended", false)) end.recommended = k;
       end.recommendation = recommendation;
@@ -166,7 +173,7 @@ RunnerResult finish_campaign(FinishJob j, db::SampleWriter& writer, const std::f
   }
   if (j.plan.kind != domain::CampaignKind::sine) {
     try {
-      end.loops = loop_records(j, r.run_id, r.validation_run_id);
+      end.loops = loop_records(j, rec, r.run_id, r.validation_run_id);
     } catch (const std::exception& e) {  // figures are extra: they never cost the campaign its end
       note += std::string("; loop figures skipped: ") + e.what();
     }

@@ -8,10 +8,10 @@
 namespace hystlab::daemon {
 
 // After a descent: the partial table against the samples so far (at most kEvaluationSamples of
-// them, evenly spread), per branch, stored as an event by the writer thread (the acquisition
-// thread only copies that many).
+// them, evenly spread), per branch, stored as a "fit" event. Scored in the background (the
+// finisher's thread): the acquisition thread copies the partial table and shares the record's
+// chunks, O(n² + chunks), never the samples.
 inline constexpr std::size_t kEvaluationSamples = 65536;
-void post_evaluation(db::SampleWriter& writer, std::int64_t campaign, const models::OnlineTableBuilder& builder, const RunSeries& series,
-                     const std::string& now);
+void post_evaluation(RunnerContext& ctx, std::int64_t campaign, const models::OnlineTableBuilder& builder, const RunSeries& series, const std::string& now);
 
 }  // namespace hystlab::daemon

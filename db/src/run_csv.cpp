@@ -32,7 +32,7 @@ void append_csv_row(std::string& out, const ShakerRow& r) {
   out += std::to_string(r.seq);
   out.push_back(',');
   number(out, r.t);
-  for (const double v : r.v) number(out, v);
+  for (const double v : domain::values(r.v)) number(out, v);
   out += std::to_string(r.status);
   out.push_back('\n');
 }

@@ -85,7 +85,8 @@ std::int64_t write_samples(Store& store, hid_t group, const RunInfo& run, RigKin
     } else {
       store.for_each_shaker_sample(run.id, s0, s0 + step - 1, [&c](const ShakerRow& r) {
         c.seq.push_back(r.seq), c.status.push_back(r.status), c.v[0].push_back(r.t);
-        for (std::size_t k = 0; k < r.v.size(); ++k) c.v[k + 1].push_back(r.v[k]);
+        const auto v = domain::values(r.v);
+        for (std::size_t k = 0; k < v.size(); ++k) c.v[k + 1].push_back(v[k]);
       });
     }
     n += static_cast<std::int64_t>(c.seq.size());

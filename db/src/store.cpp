@@ -238,10 +238,11 @@ void Store::insert_rows(std::span<const AnyRow> rows) {
     const ShakerRow& r = std::get<ShakerRow>(any);
     insert_shaker_.reset();
     insert_shaker_.bind(1, r.run_id).bind(2, r.seq).bind(3, r.t);
-    for (std::size_t k = 0; k < r.v.size(); ++k) insert_shaker_.bind(static_cast<int>(k) + 4, r.v[k]);
+    const auto v = domain::values(r.v);  // the columns are kShakerSignals' names, in order
+    for (std::size_t k = 0; k < v.size(); ++k) insert_shaker_.bind(static_cast<int>(k) + 4, v[k]);
     insert_shaker_.bind(10, r.status);
     insert_shaker_.step();
-    blocks[{r.run_id, r.seq / kBlockSize}].add(r.t, r.v[domain::shaker_signal::base_displacement], r.v[domain::shaker_signal::mass_displacement]);
+    blocks[{r.run_id, r.seq / kBlockSize}].add(r.t, r.v.base_displacement_mm, r.v.mass_displacement_mm);
   }
   for (const auto& [key, b] : blocks) {
     upsert_block_.reset();
@@ -346,9 +347,8 @@ std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int 
     if (t >= t0 && t <= t1) merge(out[slot(t)], t, t, d, d, f, f, 1);
   };
   if (shaker)
-    for_each_shaker_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const ShakerRow& r) {
-      take(r.t, r.v[domain::shaker_signal::base_displacement], r.v[domain::shaker_signal::mass_displacement]);
-    });
+    for_each_shaker_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1,
+                           [&](const ShakerRow& r) { take(r.t, r.v.base_displacement_mm, r.v.mass_displacement_mm); });
   else
     for_each_sample(run, first * kBlockSize, (last + 1) * kBlockSize - 1, [&](const SampleRow& r) { take(r.t, r.disp, r.force); });
   std::erase_if(out, [](const Bucket& b) { return b.n == 0; });
@@ -367,8 +367,9 @@ void Store::for_each_shaker_sample(std::int64_t run, std::int64_t seq0, std::int
                "mass_accel_m_s2, status FROM shaker_samples WHERE run_id = ? AND seq BETWEEN ? AND ? ORDER BY seq");
   st.bind(1, run).bind(2, seq0).bind(3, seq1);
   while (st.step()) {
-    ShakerRow r{run, st.column_int(0), st.column_double(1), {}, st.column_int(8)};
-    for (int k = 0; k < 6; ++k) r.v[static_cast<std::size_t>(k)] = st.column_double(k + 2);
+    std::array<double, 6> v{};
+    for (int k = 0; k < 6; ++k) v[static_cast<std::size_t>(k)] = st.column_double(k + 2);
+    const ShakerRow r{run, st.column_int(0), st.column_double(1), domain::shaker_sample(v), st.column_int(8)};
     f(r);
   }
 }

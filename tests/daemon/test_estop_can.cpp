@@ -71,7 +71,7 @@ TEST_CASE("operator e-stop over CAN in every phase: written within two periods, 
         std::vector<control::LiveSample> last;
         const auto h = w.live.ring.head();
         if (h > 0) (void)w.live.ring.read(h - 1, 1, last);
-        if (phase_now() == p && !last.empty() && last.back().disp >= min_x) return true;
+        if (phase_now() == p && !last.empty() && last.back().frame().displacement_mm >= min_x) return true;
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
       }
       return false;
@@ -104,10 +104,10 @@ TEST_CASE("operator e-stop over CAN in every phase: written within two periods, 
     std::vector<control::LiveSample> after;
     (void)w.live.ring.read(head > 0 ? head - 1 : 0, 1, after);
     REQUIRE_FALSE(after.empty());
-    const double x0 = after.front().disp;
+    const double x0 = after.front().frame().displacement_mm;
     double moved = 0, seen = -1;
     for (const auto& s : after) {
-      moved = std::max(moved, std::fabs(s.disp - x0));
+      moved = std::max(moved, std::fabs(s.frame().displacement_mm - x0));
       if (seen < 0 && (s.status & protocols::status::estop)) seen = s.mono_s - pressed;
     }
     MESSAGE(phase << ": e-stop in the status word " << seen * 1e3 << " ms after the press; moved " << moved << " mm");

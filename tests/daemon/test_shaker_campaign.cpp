@@ -93,8 +93,7 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   CHECK(rows_in(*b.store, "shaker_samples", r.run_id) > 1000);
   CHECK(rows_in(*b.store, "samples", r.run_id) == 0);
   double drive_min = 1;  // the drive column: what the loop commanded (below the demand: the table gains above 1 here)
-  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30,
-                                  [&](const db::ShakerRow& row) { drive_min = std::min(drive_min, row.v[domain::shaker_signal::drive_amplitude]); });
+  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30, [&](const db::ShakerRow& row) { drive_min = std::min(drive_min, row.v.drive_amplitude_mm); });
   CHECK(drive_min < 0.005 * 0.95);
 }
 

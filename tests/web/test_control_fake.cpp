@@ -43,7 +43,7 @@ class FakeDaemon final : public control::DaemonInterface {
   }
   std::uint64_t live_head(std::size_t) const noexcept override { return 3; }
   std::uint64_t read_live(std::size_t, std::uint64_t from, std::size_t, std::vector<control::LiveSample>& out, std::uint64_t*) const override {
-    for (std::uint64_t i = from; i < 3; ++i) out.push_back({0, static_cast<double>(i), 1, 2.5, 42.0, 0, 5});
+    for (std::uint64_t i = from; i < 3; ++i) out.push_back(control::LiveSample::of(0, static_cast<double>(i), domain::FrameSample{1, 2.5, 42.0}, 0, 5));
     return 3;
   }
   std::int64_t submit(const std::string&, const nlohmann::json& plan) override {

@@ -44,7 +44,7 @@ Press press(LiveDaemon& ld) {
   auto c = ld.client();
   const std::uint64_t head = ld.control->live_head(0);
   const auto before = samples(ld, head > 0 ? head - 1 : 0);
-  const double x0 = before.empty() ? 0.0 : before.back().disp;
+  const double x0 = before.empty() ? 0.0 : before.back().frame().displacement_mm;
   const double t0 = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   const auto r = c.Post("/api/rigs/sim%20frame/estop", "", "application/json");
   p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() - t0;
@@ -54,7 +54,7 @@ Press press(LiveDaemon& ld) {
   std::this_thread::sleep_for(std::chrono::seconds(1));
   for (const control::LiveSample& s : samples(ld, head)) {
     if (s.mono_s < t0) continue;
-    p.moved_mm = std::max(p.moved_mm, std::fabs(s.disp - x0));
+    p.moved_mm = std::max(p.moved_mm, std::fabs(s.frame().displacement_mm - x0));
     if (p.estop_seen_s < 0 && (s.status & protocols::status::estop)) p.estop_seen_s = s.mono_s - t0;
   }
   return p;
@@ -78,7 +78,7 @@ bool wait_phase(LiveDaemon& ld, const std::string& phase, double seconds, const 
 double position(LiveDaemon& ld) {
   const std::uint64_t head = ld.control->live_head(0);
   const auto s = samples(ld, head > 0 ? head - 1 : 0);
-  return s.empty() ? 0.0 : s.back().disp;
+  return s.empty() ? 0.0 : s.back().frame().displacement_mm;
 }
 
 std::int64_t submit(httplib::Client& c) {

@@ -28,7 +28,7 @@ double fastest(LiveDaemon& ld, std::uint64_t from) {
   (void)ld.control->read_live(0, from, 1, s);
   double v = 0;
   for (std::size_t k = 1; k < s.size(); ++k)
-    if (s[k].t > s[k - 1].t) v = std::max(v, std::fabs(s[k].disp - s[k - 1].disp) / (s[k].t - s[k - 1].t));
+    if (s[k].t > s[k - 1].t) v = std::max(v, std::fabs(s[k].frame().displacement_mm - s[k - 1].frame().displacement_mm) / (s[k].t - s[k - 1].t));
   return v;
 }
 }  // namespace

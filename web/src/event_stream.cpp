@@ -70,10 +70,11 @@ std::string samples(const control::DaemonInterface& d, StreamState& st) {
     got.clear();
     st.ring_pos[k] = d.read_live(st.rigs[k], st.ring_pos[k], stride, got);
     if (got.empty()) continue;
+    // The wire's "cmd", "disp", "force" hold the rig kind's three live values, named in "signals".
     json t, cmd, disp, force;
-    for (const auto& s : got) t.push_back(s.t), cmd.push_back(s.cmd), disp.push_back(s.disp), force.push_back(s.force);
+    for (const auto& s : got) t.push_back(s.t), cmd.push_back(s.v[0]), disp.push_back(s.v[1]), force.push_back(s.v[2]);
     const control::RigInfo info = d.rig_info(st.rigs[k]);
-    const auto& names = info.kind == domain::RigKind::shaker ? domain::kLiveShakerSignals : domain::kLiveFrameSignals;  // what cmd, disp, force hold
+    const auto& names = domain::live_signals(info.kind);
     out += frame("samples", {{"rig", info.name},
                              {"run", got.back().run},
                              {"t", t},

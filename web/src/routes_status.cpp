@@ -196,8 +196,8 @@ json rig_json(const control::DaemonInterface& d, std::size_t k) {
   if (h > 0) (void)d.read_live(k, h - 1, 1, last);
   if (!last.empty()) {
     const control::LiveSample& s = last.back();
-    const auto& n = info.kind == domain::RigKind::shaker ? domain::kLiveShakerSignals : domain::kLiveFrameSignals;
-    j["sample"] = {{"t", s.t}, {n[0], s.cmd}, {n[1], s.disp}, {n[2], s.force}, {"status", s.status}, {"run", s.run}};
+    const auto& n = domain::live_signals(info.kind);
+    j["sample"] = {{"t", s.t}, {n[0], s.v[0]}, {n[1], s.v[1]}, {n[2], s.v[2]}, {"status", s.status}, {"run", s.run}};
   }
   return j;
 }

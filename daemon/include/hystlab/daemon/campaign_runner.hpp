@@ -17,6 +17,7 @@
 #include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/plan.hpp"
+#include "hystlab/daemon/run_series.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/domain/campaign.hpp"
@@ -54,42 +55,6 @@ enum class CampaignEnd { none, completed, failed, aborted, interrupted };
 [[nodiscard]] const char* to_string(CampaignEnd e) noexcept;
 // The campaign's (and its run's) state for an end; running for none.
 [[nodiscard]] domain::CampaignState state_of(CampaignEnd e) noexcept;
-
-// The measured loop, kept for the final fits and loop figures: 16 bytes a sample, bounded. At
-// kMaxSamples (2^21, 32 MB) every other sample is dropped and from then on every second one offered
-// is kept (stride 2, then 4, ...): a day at 1 kHz (8.6e7 samples) keeps 1.3e6, every 64th. The
-// halving moves 2^20 values in place once per doubling of the run (about 2 ms, a late wake-up that
-// block reads lose nothing to); `halvings` counts them, so that indices into it can follow.
-struct RunSeries {
-  static constexpr std::size_t kMaxSamples = std::size_t{1} << 21;
-  std::vector<double> x, f;
-  std::size_t stride = 1, halvings = 0;
-  void add(double xi, double fi) {
-    if (stride > 1 && ++offered_ % stride != 0) return;
-    if (x.size() >= kMaxSamples) halve();
-    x.push_back(xi);
-    f.push_back(fi);
-  }
-  // At most n samples, evenly spread (the per-descent evaluation: bounded work whatever the length).
-  [[nodiscard]] RunSeries thinned(std::size_t n) const {
-    RunSeries out;
-    const std::size_t step = x.size() > n ? (x.size() + n - 1) / n : 1;
-    out.x.reserve(x.size() / step + 1), out.f.reserve(x.size() / step + 1);
-    for (std::size_t k = 0; k < x.size(); k += step) out.x.push_back(x[k]), out.f.push_back(f[k]);
-    return out;
-  }
-
- private:
-  void halve() {
-    std::size_t w = 0;
-    for (std::size_t r = 0; r < x.size(); r += 2, ++w) x[w] = x[r], f[w] = f[r];
-    x.resize(w), f.resize(w);
-    stride *= 2;
-    ++halvings;
-    offered_ = 0;
-  }
-  std::size_t offered_ = 0;
-};
 
 // A campaign as the daemon hands it to the rig's thread: the plan with the limits the rig's
 // envelope allows (the tighter of the plan's and the envelope's), and for a resumed campaign
@@ -160,6 +125,8 @@ struct RunnerContext {
   std::vector<float>* loop_periods_us = nullptr;     // when set, every tick's period is recorded (benchmarks)
   // Finishing (fits, tables, the final state) off this thread; empty: done inline, then returns.
   std::function<void(FinishJob)> finish;
+  // Other work off this thread, in order with finish (a descent's evaluation); empty: inline.
+  std::function<void(std::function<void()>)> background;
   // The steady-clock second at which the rig's time began (the supervisor's deadlines run on it
   // across campaigns); NaN: the campaign's own start.
   double epoch = std::numeric_limits<double>::quiet_NaN();

@@ -25,9 +25,9 @@ class LiveSampleRing {
     std::atomic_thread_fence(std::memory_order_release);
     slot.v[0].store(s.mono_s, std::memory_order_relaxed);
     slot.v[1].store(s.t, std::memory_order_relaxed);
-    slot.v[2].store(s.cmd, std::memory_order_relaxed);
-    slot.v[3].store(s.disp, std::memory_order_relaxed);
-    slot.v[4].store(s.force, std::memory_order_relaxed);
+    slot.v[2].store(s.v[0], std::memory_order_relaxed);
+    slot.v[3].store(s.v[1], std::memory_order_relaxed);
+    slot.v[4].store(s.v[2], std::memory_order_relaxed);
     slot.run.store(s.run, std::memory_order_relaxed);
     slot.status.store(s.status, std::memory_order_relaxed);
     slot.seq.store(2 * i + 2, std::memory_order_release);
@@ -42,9 +42,9 @@ class LiveSampleRing {
     if (s1 != 2 * i + 2) return false;
     out.mono_s = slot.v[0].load(std::memory_order_relaxed);
     out.t = slot.v[1].load(std::memory_order_relaxed);
-    out.cmd = slot.v[2].load(std::memory_order_relaxed);
-    out.disp = slot.v[3].load(std::memory_order_relaxed);
-    out.force = slot.v[4].load(std::memory_order_relaxed);
+    out.v[0] = slot.v[2].load(std::memory_order_relaxed);
+    out.v[1] = slot.v[3].load(std::memory_order_relaxed);
+    out.v[2] = slot.v[4].load(std::memory_order_relaxed);
     out.run = slot.run.load(std::memory_order_relaxed);
     out.status = slot.status.load(std::memory_order_relaxed);
     std::atomic_thread_fence(std::memory_order_acquire);

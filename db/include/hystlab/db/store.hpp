@@ -15,6 +15,7 @@
 #include "hystlab/db/sqlite.hpp"
 #include "hystlab/domain/campaign.hpp"
 #include "hystlab/domain/events.hpp"
+#include "hystlab/domain/signals.hpp"
 
 namespace hystlab::db {
 
@@ -26,10 +27,10 @@ struct SampleRow {  // a load frame's sample
   std::int64_t status = 0;
 };
 
-struct ShakerRow {  // a shaker's sample: its signals in the order of domain::kShakerSignals (signals.hpp)
+struct ShakerRow {  // a shaker's sample
   std::int64_t run_id = 0, seq = 0;
   double t = 0;
-  std::array<double, 6> v{};
+  domain::ShakerSample v;
   std::int64_t status = 0;
 };
 

@@ -1,6 +1,7 @@
 #pragma once
 // The values the daemon's interface hands out: copies, owned by the caller, safe to keep. Text
 // appears only where it is shown as is (names, reasons); states and commands are enums.
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "hystlab/domain/campaign.hpp"
+#include "hystlab/domain/signals.hpp"
 
 namespace hystlab::control {
 
@@ -73,11 +75,23 @@ struct RigSupervision {
 };
 
 // One live sample of a rig, as its acquisition thread saw it.
+// A rig's live sample: three values, those of its kind's live signals (domain::live_signals):
+// a load frame's command, displacement and force, a shaker's base and mass motion.
 struct LiveSample {
-  double mono_s = 0;                           // host steady clock when acquired (the same clock in every process here)
-  double t = 0, cmd = 0, disp = 0, force = 0;  // shakers: base displacement, mass displacement, mass acceleration
-  std::int64_t run = 0;                        // 0: the rig is idle (a sample read between campaigns)
+  double mono_s = 0;          // host steady clock when acquired (the same clock in every process here)
+  double t = 0;               // rig time
+  std::array<double, 3> v{};  // in the order of domain::live_signals(kind): frame() or shaker()
+  std::int64_t run = 0;       // 0: the rig is idle (a sample read between campaigns)
   std::uint32_t status = 0;
+
+  [[nodiscard]] static LiveSample of(double mono, double t, const domain::FrameSample& s, std::int64_t run, std::uint32_t status) noexcept {
+    return {mono, t, {s.command_mm, s.displacement_mm, s.force_N}, run, status};
+  }
+  [[nodiscard]] static LiveSample of(double mono, double t, const domain::LiveShaker& s, std::int64_t run, std::uint32_t status) noexcept {
+    return {mono, t, {s.base_displacement_mm, s.mass_displacement_mm, s.mass_accel_m_s2}, run, status};
+  }
+  [[nodiscard]] domain::FrameSample frame() const noexcept { return {v[0], v[1], v[2]}; }
+  [[nodiscard]] domain::LiveShaker shaker() const noexcept { return {v[0], v[1], v[2]}; }
 };
 
 // The rig link's I/O health.
