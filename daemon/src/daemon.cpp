@@ -168,7 +168,13 @@ struct Daemon::Impl {
       for (const std::int64_t id : store.queued_campaigns(w->info.id)) {
         if (dispatched.count(id)) continue;
         dispatched.insert(id);
-        auto job = make_job(*w, id);
+        std::optional<CampaignJob> job;
+        try {
+          job = make_job(*w, id);
+        } catch (...) {  // the database refused: handed over again on a later pass, not forgotten
+          dispatched.erase(id);
+          throw;
+        }
         if (job) w->push_job(std::move(*job));
       }
   }
