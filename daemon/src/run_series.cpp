@@ -4,16 +4,36 @@
 
 namespace hystlab::daemon {
 
+RunSeries& RunSeries::operator=(RunSeries&& o) noexcept {
+  chunks_ = std::move(o.chunks_), spare_ = std::move(o.spare_);
+  size_ = o.size_, stride_ = o.stride_, halvings_ = o.halvings_, offered_ = o.offered_;
+  o.chunks_.clear(), o.spare_.clear();
+  o.size_ = 0, o.stride_ = 1, o.halvings_ = 0, o.offered_ = 0;
+  return *this;
+}
+
+bool RunSeries::mine(const std::shared_ptr<Chunk>& c) noexcept { return c.use_count() == 1 && c->readers.load(std::memory_order_acquire) == 0; }
+
+void RunSeries::own(std::size_t k) {
+  if (mine(chunks_[k])) return;
+  auto copy = fresh();
+  copy->x = chunks_[k]->x;
+  copy->f = chunks_[k]->f;
+  chunks_[k] = std::move(copy);
+}
+
+RunSeries::Shared::Hold::~Hold() {
+  for (const auto& c : chunks) c->readers.fetch_sub(1, std::memory_order_release);
+}
+
 void RunSeries::add(double xi, double fi) {
   if (stride_ > 1 && ++offered_ % stride_ != 0) return;
   if (size_ >= kMaxSamples) halve();
   const std::size_t k = size_ / kChunk, i = size_ % kChunk;
   if (k == chunks_.size()) {
     chunks_.push_back(fresh());  // every kChunk samples
-  } else if (chunks_[k].use_count() > 1) {
-    auto own = fresh();  // shared (a copy, a reader): written only as our own copy
-    *own = *chunks_[k];
-    chunks_[k] = std::move(own);
+  } else {
+    own(k);  // shared (a copy, a reader): written only as our own copy
   }
   chunks_[k]->x[i] = xi;
   chunks_[k]->f[i] = fi;
@@ -27,18 +47,14 @@ void RunSeries::halve() {
   std::size_t w = 0;
   for (std::size_t r = 0; r < size_; r += 2, ++w) {
     const std::size_t k = w / kChunk;
-    if (w % kChunk == 0 && chunks_[k].use_count() > 1) {
-      auto own = fresh();
-      *own = *chunks_[k];
-      chunks_[k] = std::move(own);
-    }
+    if (w % kChunk == 0) own(k);
     chunks_[k]->x[w % kChunk] = x(r);
     chunks_[k]->f[w % kChunk] = f(r);
   }
   // The chunks freed are kept for the samples to come: the record's memory stays as it was (given
   // back, the heap was trimmed and re-faulted at every halving: 48 to 65 MB and back in bench_memory).
   for (std::size_t k = (w + kChunk - 1) / kChunk; k < chunks_.size(); ++k)
-    if (chunks_[k].use_count() == 1) spare_.push_back(std::move(chunks_[k]));
+    if (mine(chunks_[k])) spare_.push_back(std::move(chunks_[k]));
   chunks_.resize((w + kChunk - 1) / kChunk);
   size_ = w;
   stride_ *= 2;
@@ -59,8 +75,11 @@ void RunSeries::copy(std::size_t b, std::size_t e, Columns& out) const {
 }
 
 RunSeries::Shared RunSeries::share() const {
+  auto hold = std::make_shared<Shared::Hold>();
+  hold->chunks.assign(chunks_.begin(), chunks_.end());
+  for (const auto& c : hold->chunks) c->readers.fetch_add(1, std::memory_order_relaxed);  // this thread's own later checks see it
   Shared s;
-  s.chunks.assign(chunks_.begin(), chunks_.end());
+  s.hold = std::move(hold);
   s.size = size_;
   return s;
 }

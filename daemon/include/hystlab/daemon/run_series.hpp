@@ -14,6 +14,7 @@
 // (about 2 ms, a late wake-up that block reads lose nothing to); `halvings` counts them, so that
 // indices into the record can follow.
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -31,17 +32,39 @@ class RunSeries {
   static constexpr std::size_t kChunk = 4096;                       // 64 KiB a chunk: below malloc's mmap threshold
   struct Chunk {
     std::array<double, kChunk> x, f;
+    // Shared records holding it. Released (release) by the reader when done and read (acquire)
+    // before a write in place: that orders the reader's reads before the writes, which a
+    // use_count() (a relaxed load) does not.
+    mutable std::atomic<int> readers{0};
   };
 
   // The first `size` samples of a series, as they were when shared: readable on any thread.
   struct Shared {
-    std::vector<std::shared_ptr<const Chunk>> chunks;
+    struct Hold {  // the chunks, counted as read until the last copy of this Shared is gone
+      std::vector<std::shared_ptr<const Chunk>> chunks;
+      Hold() = default;
+      Hold(const Hold&) = delete;
+      Hold& operator=(const Hold&) = delete;
+      ~Hold();
+    };
+    std::shared_ptr<const Hold> hold;
     std::size_t size = 0;
-    [[nodiscard]] double x(std::size_t i) const noexcept { return chunks[i / kChunk]->x[i % kChunk]; }
-    [[nodiscard]] double f(std::size_t i) const noexcept { return chunks[i / kChunk]->f[i % kChunk]; }
+    [[nodiscard]] double x(std::size_t i) const noexcept { return hold->chunks[i / kChunk]->x[i % kChunk]; }
+    [[nodiscard]] double f(std::size_t i) const noexcept { return hold->chunks[i / kChunk]->f[i % kChunk]; }
     // At most n samples, evenly spread (a score of bounded cost whatever the record's length).
     [[nodiscard]] Columns thinned(std::size_t n) const;
   };
+
+  RunSeries() = default;
+  // A copy shares the chunks (each written only as its own copy from then on), never the spares.
+  RunSeries(const RunSeries& o) : chunks_(o.chunks_), size_(o.size_), stride_(o.stride_), halvings_(o.halvings_), offered_(o.offered_) {}
+  RunSeries& operator=(const RunSeries& o) {
+    if (this != &o) *this = RunSeries(o);
+    return *this;
+  }
+  RunSeries(RunSeries&& o) noexcept { *this = std::move(o); }
+  RunSeries& operator=(RunSeries&& o) noexcept;  // leaves o empty
+  ~RunSeries() = default;
 
   void add(double xi, double fi);
   [[nodiscard]] std::size_t size() const noexcept { return size_; }
@@ -59,7 +82,9 @@ class RunSeries {
 
  private:
   void halve();
-  std::shared_ptr<Chunk> fresh();  // a spare chunk, else a new one
+  std::shared_ptr<Chunk> fresh();                              // a spare chunk, else a new one
+  static bool mine(const std::shared_ptr<Chunk>& c) noexcept;  // held by no one else: writable in place
+  void own(std::size_t k);                                     // chunk k made writable
   std::vector<std::shared_ptr<Chunk>> chunks_, spare_;
   std::size_t size_ = 0, stride_ = 1, halvings_ = 0, offered_ = 0;
 };
