@@ -9,7 +9,6 @@
 #include "acquisition_loop.hpp"
 
 namespace hystlab::daemon {
-using nlohmann::json;
 
 domain::CampaignState state_of(CampaignEnd e) noexcept {
   switch (e) {

@@ -381,7 +381,7 @@ void Daemon::run(const std::atomic<bool>& stop) {
   } catch (const std::exception& e) {
     spdlog::error("main loop: {}", e.what());
   }
-  d.loader.reset();                            // a load under way finishes; its rig's thread still takes jobs
+  d.loader.reset();  // a load under way finishes; its job is dropped (no longer accepted): the campaign stays queued, held at the next start
   for (auto& w : d.workers) w->thread.join();  // each holds its rig and marks its campaign interrupted
   d.finisher.reset();
   d.writer->flush();
