@@ -10,9 +10,9 @@
 #include "commands.hpp"
 #include "daemon_client.hpp"
 #include "event_text.hpp"
-#include "hystlab/daemon/plan.hpp"
 #include "hystlab/db/campaign_record.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/domain/plan.hpp"
 #include "hystlab/domain/signals.hpp"
 #include "hystlab/fmu/element_export.hpp"
 #include "hystlab/models/formats.hpp"
@@ -132,7 +132,7 @@ std::string heldout_line(const std::string& json_text) {
 }
 
 // hystlab tables list: one row a table, the columns aligned, and what its marks mean below it.
-void list_tables(db::Store& store) {
+void list_tables(db::Reads& store) {
   const std::vector<Column> columns{{"id", true},
                                     {"campaign", true},
                                     {"method"},
@@ -180,12 +180,12 @@ int print_preview(const nlohmann::json& p) {
 }
 
 // A sine campaign's points and its resonance table (measured, and predicted where it was).
-void print_sweep(db::Store& store, const db::CampaignRow& row) {
+void print_sweep(db::Reads& store, const db::CampaignRow& row) {
   const auto rows = store.transmissibility(row.id);
   if (rows.empty()) return;
   double threshold = 0.10, worst = 0;
   try {
-    threshold = daemon::parse_plan(nlohmann::json::parse(row.plan)).sine.jump_threshold_pct / 100;
+    threshold = domain::parse_plan(nlohmann::json::parse(row.plan)).sine.jump_threshold_pct / 100;
   } catch (const std::exception&) {  // a plan of an older hystlab: the default threshold
   }
   std::vector<models::SweepCurvePoint> measured, predicted;
@@ -215,7 +215,7 @@ void print_sweep(db::Store& store, const db::CampaignRow& row) {
   }
 }
 
-void show_json(db::Store& store, const db::CampaignRow& row) {
+void show_json(db::Reads& store, const db::CampaignRow& row) {
   const auto plan = nlohmann::json::parse(row.plan, nullptr, false);
   const std::string why = store.state_reason(row.id, row.state);
   nlohmann::json j{{"id", row.id},
@@ -250,7 +250,7 @@ void show_json(db::Store& store, const db::CampaignRow& row) {
 
 // The campaign's first lines: what, where, its state and why, when; the specimen and the notes
 // the lab recorded with it (with the plan, or changed since: db/campaign_record.hpp).
-void print_heading(db::Store& store, const db::CampaignRow& row) {
+void print_heading(db::Reads& store, const db::CampaignRow& row) {
   const std::string why = store.state_reason(row.id, row.state);
   std::cout << "campaign " << row.id << ": " << domain::to_string(row.kind) << " on " << store.rig_name(row.rig_id) << ", " << domain::to_string(row.state)
             << (why.empty() ? "" : ": " + why) << "\n"
@@ -266,7 +266,7 @@ void print_heading(db::Store& store, const db::CampaignRow& row) {
 }
 
 // Every event, a sentence each, under the date it happened (UTC).
-void print_events(db::Store& store, const db::CampaignRow& row) {
+void print_events(db::Reads& store, const db::CampaignRow& row) {
   std::cout << "  events (oldest first; times in UTC):\n";
   auto events = store.events(row.id);
   std::erase_if(events, [](const db::EventRow& e) { return e.kind == "gap"; });  // one per hole: the "gaps" summary says it in one line
@@ -279,7 +279,7 @@ void print_events(db::Store& store, const db::CampaignRow& row) {
   }
 }
 
-int show_campaign(db::Store& store, const db::CampaignRow& row, bool as_json) {
+int show_campaign(db::Reads& store, const db::CampaignRow& row, bool as_json) {
   if (as_json) {
     show_json(store, row);
     return 0;

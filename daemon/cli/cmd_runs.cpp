@@ -39,7 +39,7 @@ std::int64_t whole_number(const std::string& text, const std::string& what) {
 
 // The run's CSV (db/run_csv.hpp: the API's layout and bytes), written a window of samples at a
 // time: bounded memory at any length.
-void write_csv_rows(db::Store& store, std::int64_t id, bool shaker, std::FILE* f, const std::string& name) {
+void write_csv_rows(db::Reads& store, std::int64_t id, bool shaker, std::FILE* f, const std::string& name) {
   std::string buf = db::run_csv_header(shaker);
   const std::int64_t last = db::last_seq(store, id, shaker);
   for (std::int64_t seq0 = 0; seq0 <= last; seq0 += db::kRunCsvWindow) {
@@ -50,7 +50,7 @@ void write_csv_rows(db::Store& store, std::int64_t id, bool shaker, std::FILE* f
 }
 
 // To stdout, or to FILE.tmp renamed to FILE once complete (a failure leaves no half file).
-void export_csv(db::Store& store, std::int64_t id, const std::string& path) {
+void export_csv(db::Reads& store, std::int64_t id, const std::string& path) {
   const db::RunSamples where = db::run_samples(store, id);
   if (where == db::RunSamples::none) throw CliError("no samples for run " + std::to_string(id));
   const bool shaker = where == db::RunSamples::shaker;  // a shaker's run: its own columns
@@ -78,7 +78,7 @@ void export_csv(db::Store& store, std::int64_t id, const std::string& path) {
 }
 
 // HDF5 beside the target, then renamed: the export removes its own file when it fails.
-void export_h5(db::Store& store, std::int64_t id, bool campaign, const std::string& path) {
+void export_h5(db::Reads& store, std::int64_t id, bool campaign, const std::string& path) {
   if (path.empty() || path == "-") throw CliError("-o: HDF5 is a binary file: give its name (-o run.h5); it is not written to stdout");
   const std::string tmp = path + ".tmp";
   try {

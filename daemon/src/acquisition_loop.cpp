@@ -143,9 +143,9 @@ void Loop::begin_safing(double t, CampaignEnd e, const std::string& reason, doub
   safing = true;
   safe_started = t;
   safe_stalled = stalled;
-  const Limits& l = plan.limits;
-  const SupervisionSettings& s = ctx.supervisor.settings();
-  safe_deadline = t + std::fabs(x - l.safe_position_mm) / l.safe_rate_mm_s + s.lag_s + s.settle_s + kHostStallAllowance_s * ctx.time_scale;
+  const domain::Limits& l = plan.limits;
+  const domain::SupervisionSettings& s = ctx.supervisor.settings();
+  safe_deadline = t + std::fabs(x - l.safe_position_mm) / l.safe_rate_mm_s + s.lag_s + s.settle_s + domain::kHostStallAllowance_s * ctx.time_scale;
   ctx.supervisor.begin_safing(t, reason + ": to the safe position");
   if (auto ec = ctx.rig.command(l.safe_position_mm, l.safe_rate_mm_s)) {
     ctx.supervisor.hold(t, "the safe ramp was refused: held");
@@ -180,7 +180,8 @@ bool arm(Loop& L) {
   double next = c.clock.now();
   // A rig that does not answer for 2 s plus the arming timeout is not armed (on a time-scaled rig
   // at least the host-stall allowance of wall time: 3 s of rig time is 15 ms at scale 200).
-  const double give_up = L.rig_time() + std::max(2.0 + c.supervisor.settings().arm_timeout_s, c.time_scale > 1 ? kHostStallAllowance_s * c.time_scale : 0.0);
+  const double give_up =
+      L.rig_time() + std::max(2.0 + c.supervisor.settings().arm_timeout_s, c.time_scale > 1 ? domain::kHostStallAllowance_s * c.time_scale : 0.0);
   bool begun = false;
   (void)c.rig.connect(L.rig_time());
   for (;;) {
@@ -286,7 +287,7 @@ bool handle_control(Loop& L, Strategy& strategy, double t, double x) {
 
 // The safe ramp's end: arrived within the in-position tolerance, or held where it stopped.
 bool safing_step(Loop& L, double t, double x) {
-  const Limits& l = L.plan.limits;
+  const domain::Limits& l = L.plan.limits;
   const double tol = L.ctx.supervisor.settings().in_position_mm;
   if (std::fabs(x - l.safe_position_mm) <= tol) {
     L.event(domain::SafeEvent{x, l.safe_position_mm, t - L.safe_started});
@@ -503,7 +504,7 @@ RunnerResult run_campaign(const CampaignJob& job, RunnerContext& ctx) {
   L.wall0 = ctx.clock.now();
   ctx.supervisor.set_time_scale(ctx.time_scale);
   ctx.supervisor.set_time_offset(std::isnan(ctx.epoch) ? 0.0 : (L.wall0 - ctx.epoch) * ctx.time_scale);
-  const Limits& l = job.plan.limits;
+  const domain::Limits& l = job.plan.limits;
   L.event(domain::LimitsEvent{{l.displacement_min_mm, l.displacement_max_mm},
                               l.force_max_N,
                               l.rate_max_mm_s,

@@ -37,7 +37,7 @@ std::unique_ptr<Strategy> make_sine_strategy(Loop& L);  // sine (shaker)
 struct Loop {
   Loop(const CampaignJob& j, RunnerContext& c);
   const CampaignJob& job;
-  const Plan& plan;
+  const domain::Plan& plan;
   RunnerContext& ctx;
   const bool shaker;
   RunnerResult result;

@@ -13,8 +13,8 @@
 #include <thread>
 
 #include "finisher.hpp"
-#include "hystlab/daemon/plan.hpp"
 #include "hystlab/db/campaign_record.hpp"
+#include "hystlab/domain/plan.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "monotonic_clock.hpp"
 #include "resume_loader.hpp"
@@ -140,7 +140,7 @@ struct Daemon::Impl {
   // record, not a condition of the run: a busy database here never keeps a job from its rig.
   void record_envelope(const RigWorker& w, std::int64_t id) noexcept {
     try {
-      store.add_event(id, envelope_event(w.entry.envelope, w.info.kind == domain::RigKind::shaker), now_iso());
+      store.add_event(id, domain::envelope_event(w.entry.envelope, w.info.kind == domain::RigKind::shaker), now_iso());
     } catch (const std::exception& e) {
       spdlog::warn("campaign {}: the envelope in force was not recorded ({})", id, e.what());
     }
@@ -149,7 +149,7 @@ struct Daemon::Impl {
   // A campaign just submitted: its plan, parsed once by submit() and checked against the rig's
   // envelope, goes to the rig's thread as it is (no second parse, no database round trip: the
   // row is the record, and the source only at a restart or a resume).
-  void dispatch_new(RigWorker& w, std::int64_t id, Plan plan, double submitted_mono) {
+  void dispatch_new(RigWorker& w, std::int64_t id, domain::Plan plan, double submitted_mono) {
     CampaignJob job;
     job.isolator = w.entry.isolator;
     job.id = id;
@@ -186,8 +186,8 @@ struct Daemon::Impl {
     job.isolator = w.entry.isolator;
     job.id = id;
     try {
-      job.plan = parse_plan(json::parse(row->plan));
-      job.plan.limits = check_plan_against(job.plan, w.entry.envelope, w.entry.supervision, w.info.kind == domain::RigKind::shaker);
+      job.plan = domain::parse_plan(json::parse(row->plan));
+      job.plan.limits = domain::check_plan_against(job.plan, w.entry.envelope, w.entry.supervision, w.info.kind == domain::RigKind::shaker);
     } catch (const std::exception& e) {  // a plan stored by an older or foreign tool: fail it, say why
       store.transition(id, domain::CampaignState::failed, e.what(), now_iso());
       return std::nullopt;
@@ -419,21 +419,21 @@ std::size_t Daemon::rig_index(const std::string& name, std::string_view plan_kin
   throw std::invalid_argument("rig: no rig named '" + name + "' (the rigs: " + names + ")");
 }
 
-std::pair<Plan, std::size_t> Daemon::check_plan(const std::string& rig_name, const json& plan_json) const {
-  Plan plan = parse_plan(plan_json);  // PlanError names the field
+std::pair<domain::Plan, std::size_t> Daemon::check_plan(const std::string& rig_name, const json& plan_json) const {
+  domain::Plan plan = domain::parse_plan(plan_json);  // PlanError names the field
   const std::size_t k = rig_index(rig_name, domain::to_string(plan.kind));
   const RigWorker& rig = *impl_->workers.at(k);
   const bool shaker = rig.info.kind == domain::RigKind::shaker;
   if ((plan.kind == domain::CampaignKind::sine) != shaker)
     throw std::invalid_argument(std::string("plan.kind: a ") + domain::to_string(plan.kind) + " plan cannot run on rig '" + rig.info.name + "', a " +
                                 domain::to_string(rig.info.kind));
-  (void)check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, shaker);  // PlanError names the field
+  (void)domain::check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, shaker);  // PlanError names the field
   return {std::move(plan), k};
 }
 
-Limits Daemon::applied_limits(const Plan& plan, std::size_t k) const {
+domain::Limits Daemon::applied_limits(const domain::Plan& plan, std::size_t k) const {
   const RigWorker& rig = *impl_->workers.at(k);
-  return check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, rig.info.kind == domain::RigKind::shaker);
+  return domain::check_plan_against(plan, rig.entry.envelope, rig.entry.supervision, rig.info.kind == domain::RigKind::shaker);
 }
 
 std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) {
@@ -445,7 +445,7 @@ std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) 
   const std::int64_t rig_id = rig.info.id;
   const domain::CampaignKind kind = plan.kind;
   const std::string text = plan_json.dump();
-  Plan checked = plan;
+  domain::Plan checked = plan;
   checked.limits = applied_limits(plan, k);
   // On the main loop: the row first (the record), then the parsed job straight to the rig.
   return impl_->on_main<std::int64_t>([this, rig_id, kind, text, &rig, called, checked = std::move(checked)]() mutable {

@@ -93,11 +93,12 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
   DaemonConfig c;
   c.base_dir = base_dir;
   if (j.is_null()) {  // embedded defaults: a simulated load frame and a simulated shaker (in real time)
-    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}, nullptr});
+    c.rigs.push_back(
+        RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, domain::RigEnvelope{}, domain::SupervisionSettings{}, nullptr});
     SimulatorOptions shaker;
     shaker.rig = "shaker";
     shaker.time_scale = 1.0;
-    c.rigs.push_back(RigEntry{"simulated shaker", json::object(), 1.0, true, shaker, RigEnvelope{}, SupervisionSettings{},
+    c.rigs.push_back(RigEntry{"simulated shaker", json::object(), 1.0, true, shaker, domain::RigEnvelope{}, domain::SupervisionSettings{},
                               std::make_shared<const IsolatorModel>(simulated_isolator())});
     return c;
   }
@@ -111,7 +112,8 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
     c.db_path = j["db"].get<std::string>();
   }
   if (!j.contains("rigs")) {
-    c.rigs.push_back(RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, RigEnvelope{}, SupervisionSettings{}, nullptr});
+    c.rigs.push_back(
+        RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, domain::RigEnvelope{}, domain::SupervisionSettings{}, nullptr});
     return c;
   }
   if (!j["rigs"].is_array() || j["rigs"].empty()) fail("rigs", "must be a non-empty array");
@@ -164,9 +166,9 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
     }  // driver fields are checked by make_rig when the daemon creates the rigs, before anything runs
     const bool shaker = e.simulated ? e.sim.rig == "shaker" : r.value("rig", std::string("load_frame")) == "shaker";
     try {
-      e.envelope = parse_envelope(r.value("envelope", json()), where + ".envelope", shaker);
-      e.supervision = parse_supervision(r.value("supervision", json()), where + ".supervision");
-    } catch (const RigConfigError& err) {
+      e.envelope = domain::parse_envelope(r.value("envelope", json()), where + ".envelope", shaker);
+      e.supervision = domain::parse_supervision(r.value("supervision", json()), where + ".supervision");
+    } catch (const domain::RigConfigError& err) {
       throw ConfigError(err.what());
     }
     r.erase("envelope");

@@ -60,13 +60,8 @@ class DaemonControl final : public control::DaemonInterface {
     const auto [p, k] = d_.check_plan(rig, plan);
     control::PlanPreview v = preview_plan(p, model);
     v.time_scale = d_.rig_time_scale(k);
-    v.limits_applied = limits_tightened(p, d_.applied_limits(p, k));
+    v.limits_applied = domain::limits_tightened(p, d_.applied_limits(p, k));
     return v;
-  }
-  std::optional<control::FotGrid> fot_grid(const nlohmann::json& stored_plan) const override {
-    const Plan p = parse_plan(stored_plan);
-    if (p.kind != domain::CampaignKind::fot) return std::nullopt;
-    return control::FotGrid{p.lo_mm, p.hi_mm, p.subdivisions, p.nodes_mm};
   }
   control::CommandOutcome command(std::int64_t campaign, control::CampaignCommand c) override { return d_.command(campaign, c); }
   void set_record(std::int64_t campaign, const nlohmann::json& changes) override { d_.set_record(campaign, changes); }

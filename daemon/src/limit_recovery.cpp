@@ -74,7 +74,7 @@ void Supervisor::recovery_step(double now, const StatusView& v) {
     if (rig_->hold(false) || rig_->command(recovery_target_, s_.safe_rate_mm_s)) return recovery_failed(now, "the rig did not take the ramp");
     recovery_ = Recovery::moving;
     recovery_closest_ = std::fabs(v.position_mm - recovery_target_);
-    recovery_deadline_ = now + recovery_closest_ / s_.safe_rate_mm_s + s_.lag_s + s_.settle_s + s_.safe_timeout_s + kHostStallAllowance_s * time_scale_;
+    recovery_deadline_ = now + recovery_closest_ / s_.safe_rate_mm_s + s_.lag_s + s_.settle_s + s_.safe_timeout_s + domain::kHostStallAllowance_s * time_scale_;
     return;
   }
   (void)recovery_moving(now, v);

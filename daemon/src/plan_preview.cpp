@@ -8,18 +8,18 @@
 
 namespace hystlab::daemon {
 namespace {
-PlanPreview preview_sine(const Plan& p) {
+PlanPreview preview_sine(const domain::Plan& p) {
   PlanPreview v;
   const double a = p.sine.max_amplitude_mm(), w = 2 * std::numbers::pi * p.sine.highest_hz();
-  v.duration_s = nominal_duration_s(p.sine);
+  v.duration_s = domain::nominal_duration_s(p.sine);
   v.peak_speed_mm_s = w * a;
   v.peak_accel_m_s2 = w * w * a * 1e-3;
-  v.nodes = step_count(p.sine);
+  v.nodes = domain::step_count(p.sine);
   return v;
 }
 }  // namespace
 
-PlanPreview preview_plan(const Plan& plan, models::HysteresisModel* model) {
+PlanPreview preview_plan(const domain::Plan& plan, models::HysteresisModel* model) {
   PlanPreview v;
   if (plan.kind == domain::CampaignKind::sine) {
     v = preview_sine(plan);

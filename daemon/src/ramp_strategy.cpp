@@ -29,7 +29,7 @@ class RampStrategy final : public Strategy {
     rows_begin_ = series_.size();
     halvings_seen_ = series_.halvings();
     if (plan_.kind != domain::CampaignKind::fot) return;
-    const models::Grid g = fot_grid(plan_);
+    const models::Grid g = domain::fot_grid(plan_);
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
     for (const models::FotNode& n : L.job.prior_nodes) (void)builder_->add(n);
     if (!L.job.prior_nodes.empty()) resume_rows_only(L);
@@ -115,7 +115,7 @@ class RampStrategy final : public Strategy {
   }
 
  private:
-  static std::vector<Segment> schedule(const Plan& p) { return p.kind == domain::CampaignKind::fot ? fot_schedule(p) : waveform_schedule(p); }
+  static std::vector<Segment> schedule(const domain::Plan& p) { return p.kind == domain::CampaignKind::fot ? fot_schedule(p) : waveform_schedule(p); }
 
   // A resumed campaign drives only the rows not yet complete (no training), then the validation.
   void resume_rows_only(Loop& L) {
@@ -205,7 +205,7 @@ class RampStrategy final : public Strategy {
     // Plus kHostStallAllowance_s of wall time: a host (or a time-scaled simulator) starved for that
     // long is no servo failure; at time scale 200 it is 300 s of rig time.
     deadline_ = t + std::fabs(cmd.target_mm - x) / cmd.rate_mm_s + settings_.lag_s + settings_.settle_s + (seg ? seg->dwell_s : 0.0) +
-                kHostStallAllowance_s * time_scale_;
+                domain::kHostStallAllowance_s * time_scale_;
   }
 
   bool target_missed(Loop& L, const drivers::RigSample& s) {
@@ -249,9 +249,9 @@ class RampStrategy final : public Strategy {
     return s && (s->kind == SegmentKind::rise || s->kind == SegmentKind::descent);
   }
 
-  const Plan& plan_;
+  const domain::Plan& plan_;
   Sequencer seq_;
-  SupervisionSettings settings_;
+  domain::SupervisionSettings settings_;
   std::shared_ptr<models::OnlineTableBuilder> builder_;
   std::unique_ptr<OnlineFot> fot_;
   RunSeries series_, validation_;

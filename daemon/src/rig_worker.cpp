@@ -39,8 +39,8 @@ void RigWorker::build_rig(const std::string& base) {
     supervisor = std::make_unique<Supervisor>(*rig, entry.supervision, shaker, [this](const RigTransition& t) { record(t); });
   supervisor->set_time_scale(entry.time_scale);
   std::lock_guard lk(mu_);
-  snap_.envelope = envelope_json(entry.envelope, shaker);
-  snap_.supervision = supervision_json(entry.supervision);
+  snap_.envelope = domain::envelope_json(entry.envelope, shaker);
+  snap_.supervision = domain::supervision_json(entry.supervision);
 }
 
 namespace {

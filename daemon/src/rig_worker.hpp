@@ -16,10 +16,10 @@
 #include "hystlab/control/values.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/config.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/live_feed.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/db/sample_writer.hpp"
+#include "hystlab/domain/envelope.hpp"
 #include "hystlab/drivers/rig.hpp"
 #include "sim_child.hpp"
 

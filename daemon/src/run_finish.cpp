@@ -111,7 +111,7 @@ std::string recommend(std::vector<Candidate>& cs) {
 // least-squares table (prior decided by held-out blocks), each with its accuracy on every sample
 // of the campaign's runs, on the validation run, drift and provenance.
 std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const Record& rec, const std::string& now, std::string& note, std::string& recommendation) {
-  const Plan& plan = j.plan;
+  const domain::Plan& plan = j.plan;
   const models::DriftReport drift = models::drift_report(*j.builder);
   const std::string source = "campaign " + std::to_string(j.campaign), run = "run " + std::to_string(j.result.run_id);
   const std::string fot_label = "fot n=" + std::to_string(plan.subdivisions);
@@ -123,7 +123,7 @@ std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const Record& rec, 
   // on 10^5 samples 30 s).
   // A grid of its own is fitted on its own nodes (up to n = 24; beyond, 24 uniform steps).
   const int n = std::min(plan.subdivisions, 24);
-  const models::Grid lsq_grid = n == plan.subdivisions ? fot_grid(plan) : models::Grid::make(plan.lo_mm, plan.hi_mm, n);
+  const models::Grid lsq_grid = n == plan.subdivisions ? domain::fot_grid(plan) : models::Grid::make(plan.lo_mm, plan.hi_mm, n);
   try {
     const models::PreisachFitResult fit = models::fit_preisach(rec.series.x, rec.series.f, lsq_grid);
     cs.push_back(candidate(j, rec, "lsq " + std::string(models::to_string(fit.chosen.prior)) + " n=" + std::to_string(n), "lsq", n, fit.chosen.table,

@@ -6,14 +6,14 @@
 
 namespace hystlab::daemon {
 
-std::vector<Segment> fot_schedule(const Plan& p) {
+std::vector<Segment> fot_schedule(const domain::Plan& p) {
   std::vector<Segment> s;
   s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::preamble, 0});
   for (int c = 0; c < p.training.max_cycles; ++c) {  // stabilise the specimen on its major loop
     s.push_back({p.hi_mm, p.ramp_rate_mm_s, 0.0, SegmentKind::training, 0});
     s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::training, 0});
   }
-  const models::Grid g = fot_grid(p);
+  const models::Grid g = domain::fot_grid(p);
   for (int r = 0; r < p.repeats; ++r)
     for (int i = 1; i <= p.subdivisions; ++i) {
       const double top = g.node(i);
@@ -25,7 +25,7 @@ std::vector<Segment> fot_schedule(const Plan& p) {
   return s;
 }
 
-std::vector<double> validation_points(const Validation& v) {
+std::vector<double> validation_points(const domain::Validation& v) {
   std::mt19937_64 rng(v.seed);
   // From the generator's bits, not std::uniform_real_distribution (whose mapping the standard
   // leaves to the library): the same plan gives the same input everywhere.
@@ -42,7 +42,7 @@ std::vector<double> validation_points(const Validation& v) {
   return out;
 }
 
-std::vector<Segment> waveform_schedule(const Plan& p) {
+std::vector<Segment> waveform_schedule(const domain::Plan& p) {
   std::vector<Segment> s;
   for (double x : p.points_mm) s.push_back({x, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::waypoint, 0});
   return s;

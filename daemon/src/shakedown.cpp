@@ -32,11 +32,11 @@ ShakedownStep ShakedownRule::add(double peak, double energy) noexcept {
 std::string ShakedownRule::summary() const {
   if (!t_.until) return "trained " + std::to_string(cycles_) + " cycle(s), as planned";
   if (stable_)
-    return "the loop settled after " + std::to_string(cycles_) + " training cycle(s): peak force within " + plan_number(t_.peak_force_change_pct) +
-           " % and energy within " + plan_number(t_.energy_change_pct) + " % for " + std::to_string(t_.consecutive) + " cycles in a row";
+    return "the loop settled after " + std::to_string(cycles_) + " training cycle(s): peak force within " + domain::plan_number(t_.peak_force_change_pct) +
+           " % and energy within " + domain::plan_number(t_.energy_change_pct) + " % for " + std::to_string(t_.consecutive) + " cycles in a row";
   return "the loop did not settle in " + std::to_string(cycles_) + " training cycle(s) (the maximum): peak force within " +
-         plan_number(t_.peak_force_change_pct) + " % and energy within " + plan_number(t_.energy_change_pct) + " % for " + std::to_string(t_.consecutive) +
-         " cycles in a row was not reached";
+         domain::plan_number(t_.peak_force_change_pct) + " % and energy within " + domain::plan_number(t_.energy_change_pct) + " % for " +
+         std::to_string(t_.consecutive) + " cycles in a row was not reached";
 }
 
 }  // namespace hystlab::daemon

@@ -22,7 +22,8 @@ constexpr double kTwoPi = 2 * std::numbers::pi;
 
 class SineStrategy final : public Strategy {
  public:
-  explicit SineStrategy(const Plan& p) : plan_(p), s_(p.sine), control_(p.sine.control), passes_(sweep_passes(p.sine)), total_(step_count(p.sine)) {}
+  explicit SineStrategy(const domain::Plan& p)
+      : plan_(p), s_(p.sine), control_(p.sine.control), passes_(domain::sweep_passes(p.sine)), total_(domain::step_count(p.sine)) {}
 
   bool on_shaker(Loop& L, const drivers::ShakerSample& s) override {
     if (!started_) {
@@ -59,7 +60,7 @@ class SineStrategy final : public Strategy {
     fj.isolator = L.job.isolator;
     fj.sine_steps = steps_;
     if (points_ > 0)
-      L.event(domain::SweepDoneEvent{points_, static_cast<std::int64_t>(total_), warnings_, last_t_ - t0_, nominal_duration_s(s_),
+      L.event(domain::SweepDoneEvent{points_, static_cast<std::int64_t>(total_), warnings_, last_t_ - t0_, domain::nominal_duration_s(s_),
                                      L.job.isolator ? L.job.isolator->describe : ""});
   }
 
@@ -72,7 +73,7 @@ class SineStrategy final : public Strategy {
 
   // A step (stepped pass) or the start of a continuous pass: drive at the learnt response.
   bool begin_step(Loop& L, double t) {
-    f_ = s_.continuous ? (up() ? s_.from_hz : s_.to_hz) : pass_frequencies(s_, passes_[pass_])[step_];
+    f_ = s_.continuous ? (up() ? s_.from_hz : s_.to_hz) : domain::pass_frequencies(s_, passes_[pass_])[step_];
     drive_ = control_.start(demand());
     control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false, established_ = !s_.control.closed;
     prev_mass_ = NAN;
@@ -105,7 +106,7 @@ class SineStrategy final : public Strategy {
   // longer the steps done took than theirs (per step: a 5 Hz step is ten times a 50 Hz one, and
   // counting steps alike put the default sweep's first estimate at 513 s for 282 s).
   double eta(double t) const {
-    const double nominal = nominal_duration_s(s_);
+    const double nominal = domain::nominal_duration_s(s_);
     const double done = s_.continuous ? (total_ > 0 ? nominal * static_cast<double>(points_) / static_cast<double>(total_) : 0.0) : nominal_done_;
     const double pace = done > 0 ? std::max(1.0, (t - t0_) / done) : 1.0;
     return std::max(0.0, nominal - done) * pace;
@@ -260,7 +261,7 @@ class SineStrategy final : public Strategy {
     const double phase = std::remainder(m.fundamental.phase_rad - b.fundamental.phase_rad, kTwoPi);
     const double f = s_.continuous ? w_.mean_frequency() : f_;
     ++points_;
-    if (!s_.continuous) nominal_done_ += step_nominal_s(s_, f_);
+    if (!s_.continuous) nominal_done_ += domain::step_nominal_s(s_, f_);
     domain::TransmissibilityEvent rec;
     rec.k = points_, rec.of = static_cast<std::int64_t>(total_), rec.pass = static_cast<std::int64_t>(pass_) + 1;
     rec.frequency_hz = f, rec.amplitude_mm = demand(), rec.direction = up() ? "up" : "down", rec.drive_mm = drive_;
@@ -279,10 +280,10 @@ class SineStrategy final : public Strategy {
     });
   }
 
-  const Plan& plan_;
-  const SinePlan& s_;
+  const domain::Plan& plan_;
+  const domain::SinePlan& s_;
   BaseControl control_;
-  std::vector<SweepPass> passes_;
+  std::vector<domain::SweepPass> passes_;
   std::vector<std::pair<std::int64_t, PredictStep>> steps_;
   std::size_t total_ = 0, pass_ = 0, step_ = 0;
   std::int64_t points_ = 0;

@@ -44,7 +44,7 @@ std::string describe_status(std::uint16_t status, std::uint16_t code, const std:
   return out;
 }
 
-Supervisor::Supervisor(drivers::Rig& rig, SupervisionSettings settings, bool shaker, Observer observer)
+Supervisor::Supervisor(drivers::Rig& rig, domain::SupervisionSettings settings, bool shaker, Observer observer)
     : rig_(&rig), s_(settings), shaker_(shaker), observer_(std::move(observer)) {}
 
 // A controller's handshake time is its own, but the answer reaches us only at our next poll: at
@@ -52,7 +52,7 @@ Supervisor::Supervisor(drivers::Rig& rig, SupervisionSettings settings, bool sha
 // starved host wakes late. On a time-scaled rig kHandshakeFloor_s of wall time is the least any
 // handshake gets; a real rig (time scale 1) keeps its configured timeouts exactly.
 double Supervisor::deadline(double now, double timeout_s) const noexcept {
-  return now + (time_scale_ > 1 ? std::max(timeout_s, kHandshakeFloor_s * time_scale_) : timeout_s);
+  return now + (time_scale_ > 1 ? std::max(timeout_s, domain::kHandshakeFloor_s * time_scale_) : timeout_s);
 }
 
 void Supervisor::go(double now, RigState to, const std::string& reason) {

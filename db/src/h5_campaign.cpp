@@ -15,18 +15,10 @@ namespace hystlab::db::h5_layout {
 namespace {
 using h5::Handle;
 
-// The rig's name and its config as hystlabd stored it (SQL stays in db/).
-std::pair<std::string, std::string> rig_record(Store& store, std::int64_t rig_id) {
-  Statement st(store.database(), "SELECT name, config FROM rigs WHERE id = ?");
-  st.bind(1, rig_id);
-  if (!st.step()) return {"", "{}"};
-  return {st.column_text(0), st.column_text(1)};
-}
-
 // The envelope the campaign ran under: its newest "envelope" event (the rig's envelope as the
 // daemon had it when it started the campaign: the rig's row holds only today's config, rewritten
 // at every start of hystlabd), else the envelope the rig's stored config names; "null" when neither.
-std::string envelope_in_force(Store& store, std::int64_t campaign, const std::string& config) {
+std::string envelope_in_force(Reads& store, std::int64_t campaign, const std::string& config) {
   if (const auto recorded = store.event_details(campaign, "envelope"); !recorded.empty()) {
     const auto e = nlohmann::json::parse(recorded.back(), nullptr, false);
     if (e.is_object()) return e.dump();
@@ -35,7 +27,7 @@ std::string envelope_in_force(Store& store, std::int64_t campaign, const std::st
   return j.is_object() && j.contains("envelope") && j["envelope"].is_object() ? j["envelope"].dump() : "null";
 }
 
-void write_campaign_group(Store& store, hid_t file, const CampaignRow& c) {
+void write_campaign_group(Reads& store, hid_t file, const CampaignRow& c) {
   const Handle g = h5::create_group(file, "campaign");
   h5::attr_int(g.get(), "id", c.id);
   h5::attr_text(g.get(), "kind", to_string(c.kind));
@@ -46,7 +38,7 @@ void write_campaign_group(Store& store, hid_t file, const CampaignRow& c) {
   const CampaignRecord record = campaign_record(store, c);
   h5::attr_text(g.get(), "specimen", record.specimen);
   h5::attr_text(g.get(), "notes", record.notes);
-  const auto [rig, config] = rig_record(store, c.rig_id);
+  const auto [rig, config] = store.rig_record(c.rig_id);
   h5::attr_text(g.get(), "rig", rig);
   h5::dataset_text(g.get(), "plan", c.plan);
   h5::dataset_text(g.get(), "rig_config", config);
@@ -56,7 +48,7 @@ void write_campaign_group(Store& store, hid_t file, const CampaignRow& c) {
   h5::dataset_text(g.get(), "limits", limits.empty() ? "null" : limits.back());
 }
 
-void write_events(Store& store, hid_t file, std::int64_t campaign, int deflate_level) {
+void write_events(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
   const Handle g = h5::create_group(file, "events");
   std::vector<std::int64_t> id;
   std::vector<std::string> at, kind, from, to, detail;
@@ -72,7 +64,7 @@ void write_events(Store& store, hid_t file, std::int64_t campaign, int deflate_l
   h5::dataset_texts(g.get(), "detail", detail, deflate_level);
 }
 
-void write_nodes(Store& store, hid_t file, std::int64_t campaign, int deflate_level) {
+void write_nodes(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
   const Handle g = h5::create_group(file, "fot_nodes");
   std::vector<std::int64_t> id, run;
   std::vector<double> alpha, beta, fa, fab, t;
@@ -92,7 +84,7 @@ void write_nodes(Store& store, hid_t file, std::int64_t campaign, int deflate_le
 }
 }  // namespace
 
-std::int64_t write_campaign(Store& store, hid_t file, std::int64_t campaign, int deflate_level) {
+std::int64_t write_campaign(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
   const auto c = store.campaign(campaign);
   if (!c) throw H5ExportError(H5ExportError::Kind::not_found, "no campaign " + std::to_string(campaign));
   write_campaign_group(store, file, *c);

@@ -12,8 +12,8 @@ class Store;
 namespace hystlab::db::h5_layout {
 
 // /campaign, /events, /fot_nodes and /tables of the campaign; returns how many tables.
-std::int64_t write_campaign(Store& store, hid_t file, std::int64_t campaign, int deflate_level);
+std::int64_t write_campaign(Reads& store, hid_t file, std::int64_t campaign, int deflate_level);
 // /tables/table_<id>: each table's document as stored and as numbers, its provenance and scores.
-std::int64_t write_tables(Store& store, hid_t file, std::int64_t campaign, int deflate_level);
+std::int64_t write_tables(Reads& store, hid_t file, std::int64_t campaign, int deflate_level);
 
 }  // namespace hystlab::db::h5_layout

@@ -18,11 +18,6 @@ void records_changed() noexcept { g_records.fetch_add(1, std::memory_order_relea
 
 std::uint64_t record_generation() noexcept { return g_records.load(std::memory_order_acquire); }
 namespace {
-Database& migrated(Database& db) {
-  migrate(db);
-  return db;
-}
-
 struct BlockDelta {
   std::int64_t n = 0;
   double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min, d_min = t_min, d_max = -t_min, f_min = t_min, f_max = -t_min;
@@ -43,9 +38,14 @@ void merge(Bucket& b, double t0, double t1, double d0, double d1, double f0, dou
 }
 }  // namespace
 
+detail::OpenDatabase::OpenDatabase(const std::string& path, bool synchronous_full) : db(path, synchronous_full) { migrate(db); }
+
 Store::Store(const std::string& path, bool synchronous_full)
-    : db_(path, synchronous_full),
-      insert_sample_(migrated(db_), "INSERT INTO samples(run_id, seq, t, cmd, disp, force, status) VALUES(?,?,?,?,?,?,?)"),
+    : OpenDatabase(path, synchronous_full), Reads(OpenDatabase::db), Writes(OpenDatabase::db), Lifecycle(OpenDatabase::db, *this) {}
+
+Writes::Writes(Database& db)
+    : db_(db),
+      insert_sample_(db_, "INSERT INTO samples(run_id, seq, t, cmd, disp, force, status) VALUES(?,?,?,?,?,?,?)"),
       upsert_block_(db_,
                     "INSERT INTO sample_blocks(run_id, block, n, t_min, t_max, disp_min, disp_max, force_min, force_max) "
                     "VALUES(?,?,?,?,?,?,?,?,?) ON CONFLICT(run_id, block) DO UPDATE SET n = n + excluded.n, "
@@ -56,7 +56,7 @@ Store::Store(const std::string& path, bool synchronous_full)
                      "INSERT INTO shaker_samples(run_id, seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, "
                      "mass_displacement_mm, base_accel_m_s2, mass_accel_m_s2, status) VALUES(?,?,?,?,?,?,?,?,?,?)") {}
 
-std::int64_t Store::upsert_rig(const std::string& name, const std::string& config, const std::string& now) {
+std::int64_t Lifecycle::upsert_rig(const std::string& name, const std::string& config, const std::string& now) {
   Statement st(db_,
                "INSERT INTO rigs(name, config, created_at) VALUES(?,?,?) "
                "ON CONFLICT(name) DO UPDATE SET config = excluded.config RETURNING id");
@@ -65,7 +65,7 @@ std::int64_t Store::upsert_rig(const std::string& name, const std::string& confi
   return st.column_int(0);
 }
 
-std::int64_t Store::create_campaign(std::int64_t rig, domain::CampaignKind kind, const std::string& plan, const std::string& now) {
+std::int64_t Lifecycle::create_campaign(std::int64_t rig, domain::CampaignKind kind, const std::string& plan, const std::string& now) {
   Transaction tx(db_);
   Statement st(db_, "INSERT INTO campaigns(rig_id, kind, plan, state, created_at, updated_at) VALUES(?,?,?,'queued',?,?)");
   st.bind(1, rig).bind(2, std::string_view(to_string(kind))).bind(3, plan).bind(4, now).bind(5, now);
@@ -79,14 +79,14 @@ std::int64_t Store::create_campaign(std::int64_t rig, domain::CampaignKind kind,
   return id;
 }
 
-void Store::transition(std::int64_t id, domain::CampaignState to, const std::string& reason, const std::string& now) {
+void Lifecycle::transition(std::int64_t id, domain::CampaignState to, const std::string& reason, const std::string& now) {
   Transaction tx(db_);
   transition_in(id, to, reason, now);
   tx.commit();
   records_changed();
 }
 
-void Store::transition_in(std::int64_t id, domain::CampaignState to, const std::string& reason, const std::string& now) {
+void Lifecycle::transition_in(std::int64_t id, domain::CampaignState to, const std::string& reason, const std::string& now) {
   Statement cur(db_, "SELECT state FROM campaigns WHERE id = ?");
   cur.bind(1, id);
   if (!cur.step()) throw DbError("no campaign " + std::to_string(id), 0);
@@ -99,14 +99,14 @@ void Store::transition_in(std::int64_t id, domain::CampaignState to, const std::
   ev.step();
 }
 
-std::int64_t Store::add_run(std::int64_t campaign, const std::string& now, double wall, double mono, domain::RunRole role) {
+std::int64_t Lifecycle::add_run(std::int64_t campaign, const std::string& now, double wall, double mono, domain::RunRole role) {
   Statement st(db_, "INSERT INTO runs(campaign_id, started_at, wall_anchor_unix, monotonic_anchor_s, state, role) VALUES(?,?,?,?,'running',?)");
   st.bind(1, campaign).bind(2, now).bind(3, wall).bind(4, mono).bind(5, std::string_view(to_string(role)));
   st.step();
   return db_.last_insert_rowid();
 }
 
-std::pair<std::int64_t, std::int64_t> Store::add_runs(std::int64_t campaign, const std::string& now, double wall, double mono, bool validation) {
+std::pair<std::int64_t, std::int64_t> Lifecycle::add_runs(std::int64_t campaign, const std::string& now, double wall, double mono, bool validation) {
   Transaction tx(db_);
   const std::int64_t run = add_run(campaign, now, wall, mono);
   const std::int64_t vrun = validation ? add_run(campaign, now, wall, mono, domain::RunRole::validation) : 0;
@@ -114,17 +114,17 @@ std::pair<std::int64_t, std::int64_t> Store::add_runs(std::int64_t campaign, con
   return {run, vrun};
 }
 
-void Store::end_run(std::int64_t run, domain::CampaignState state, const std::string& now) {
+void Lifecycle::end_run(std::int64_t run, domain::CampaignState state, const std::string& now) {
   Statement st(db_, "UPDATE runs SET state = ?, ended_at = ? WHERE id = ?");
   st.bind(1, std::string_view(to_string(state))).bind(2, now).bind(3, run);
   st.step();
 }
 
-std::int64_t Store::add_event(std::int64_t campaign, const domain::CampaignEvent& event, const std::string& now) {
+std::int64_t Lifecycle::add_event(std::int64_t campaign, const domain::CampaignEvent& event, const std::string& now) {
   return add_raw_event(campaign, std::string(domain::kind_of(event)), domain::encode(event), now);
 }
 
-std::int64_t Store::add_raw_event(std::int64_t campaign, const std::string& kind, const std::string& detail, const std::string& now) {
+std::int64_t Lifecycle::add_raw_event(std::int64_t campaign, const std::string& kind, const std::string& detail, const std::string& now) {
   Statement st(db_, "INSERT INTO events(campaign_id, at, kind, detail) VALUES(?,?,?,?)");
   st.bind(1, campaign).bind(2, now).bind(3, kind).bind(4, detail);
   st.step();
@@ -132,7 +132,7 @@ std::int64_t Store::add_raw_event(std::int64_t campaign, const std::string& kind
   return db_.last_insert_rowid();
 }
 
-std::int64_t Store::add_transmissibility(std::int64_t run, double f, double base, double mass, double ratio, double phase) {
+std::int64_t Writes::add_transmissibility(std::int64_t run, double f, double base, double mass, double ratio, double phase) {
   Statement st(db_,
                "INSERT INTO transmissibility(run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad) "
                "VALUES(?,?,?,?,?,?)");
@@ -142,7 +142,7 @@ std::int64_t Store::add_transmissibility(std::int64_t run, double f, double base
   return db_.last_insert_rowid();
 }
 
-std::int64_t Store::add_sine_point(std::int64_t run, const SinePointRow& p) {
+std::int64_t Writes::add_sine_point(std::int64_t run, const SinePointRow& p) {
   Statement st(db_,
                "INSERT INTO transmissibility(run_id, frequency_hz, base_amplitude_mm, mass_amplitude_mm, ratio, phase_rad, step, demand_mm, "
                "direction, detail) VALUES(?,?,?,?,?,?,?,?,?,?)");
@@ -153,14 +153,14 @@ std::int64_t Store::add_sine_point(std::int64_t run, const SinePointRow& p) {
   return db_.last_insert_rowid();
 }
 
-void Store::set_prediction(std::int64_t point, double ratio, double phase) {
+void Writes::set_prediction(std::int64_t point, double ratio, double phase) {
   Statement st(db_, "UPDATE transmissibility SET predicted_ratio = ?, predicted_phase_rad = ? WHERE id = ?");
   st.bind(1, ratio).bind(2, phase).bind(3, point);
   st.step();
   records_changed();
 }
 
-std::int64_t Store::add_fot_node(std::int64_t run, double a, double b, double fa, double fab, double t) {
+std::int64_t Writes::add_fot_node(std::int64_t run, double a, double b, double fa, double fab, double t) {
   Statement st(db_, "INSERT INTO fot_nodes(run_id, alpha, beta, force_alpha, force_alpha_beta, t) VALUES(?,?,?,?,?,?)");
   st.bind(1, run).bind(2, a).bind(3, b).bind(4, fa).bind(5, fab).bind(6, t);
   st.step();
@@ -168,8 +168,8 @@ std::int64_t Store::add_fot_node(std::int64_t run, double a, double b, double fa
   return db_.last_insert_rowid();
 }
 
-std::int64_t Store::add_table(std::optional<std::int64_t> campaign, std::optional<std::int64_t> run, const std::string& method, int n, double lo, double hi,
-                              const std::string& now, const std::string& accuracy, const std::string& document) {
+std::int64_t Lifecycle::add_table(std::optional<std::int64_t> campaign, std::optional<std::int64_t> run, const std::string& method, int n, double lo, double hi,
+                                  const std::string& now, const std::string& accuracy, const std::string& document) {
   Statement st(db_,
                "INSERT INTO tables(campaign_id, run_id, method, n, range_lo, range_hi, created_at, accuracy, document) "
                "VALUES(?,?,?,?,?,?,?,?,?)");
@@ -181,14 +181,14 @@ std::int64_t Store::add_table(std::optional<std::int64_t> campaign, std::optiona
   return db_.last_insert_rowid();
 }
 
-int Store::mark_interrupted(const std::string& now) {
+int Lifecycle::mark_interrupted(const std::string& now) {
   std::vector<std::int64_t> ids;
   {
     Statement st(db_, "SELECT id FROM campaigns WHERE state IN ('arming', 'running', 'paused')");
     while (st.step()) ids.push_back(st.column_int(0));
   }
   for (auto id : ids)
-    if (table_count(id) > 0)
+    if (reads_.table_count(id) > 0)
       transition(id, domain::CampaignState::completed, "its tables were stored before the daemon stopped", now);
     else
       transition(id, domain::CampaignState::interrupted, "the daemon stopped without finishing it", now);
@@ -198,7 +198,7 @@ int Store::mark_interrupted(const std::string& now) {
   return static_cast<int>(ids.size());
 }
 
-std::vector<std::int64_t> Store::queued_campaigns(std::int64_t rig) {
+std::vector<std::int64_t> Reads::queued_campaigns(std::int64_t rig) {
   std::vector<std::int64_t> out;
   Statement st(db_, "SELECT id FROM campaigns WHERE rig_id = ? AND state = 'queued' ORDER BY id");
   st.bind(1, rig);
@@ -206,7 +206,7 @@ std::vector<std::int64_t> Store::queued_campaigns(std::int64_t rig) {
   return out;
 }
 
-std::vector<std::tuple<double, double, double, double>> Store::fot_nodes_of_campaign(std::int64_t campaign) {
+std::vector<std::tuple<double, double, double, double>> Reads::fot_nodes_of_campaign(std::int64_t campaign) {
   std::vector<std::tuple<double, double, double, double>> out;
   Statement st(db_,
                "SELECT alpha, beta, force_alpha, force_alpha_beta FROM fot_nodes JOIN runs ON runs.id = fot_nodes.run_id "
@@ -220,12 +220,12 @@ namespace {
 using Blocks = std::map<std::pair<std::int64_t, std::int64_t>, BlockDelta>;
 }
 
-void Store::insert_samples(std::span<const SampleRow> rows) {
+void Writes::insert_samples(std::span<const SampleRow> rows) {
   std::vector<AnyRow> all(rows.begin(), rows.end());
   insert_rows(all);
 }
 
-void Store::insert_rows(std::span<const AnyRow> rows) {
+void Writes::insert_rows(std::span<const AnyRow> rows) {
   Blocks blocks;
   for (const AnyRow& any : rows) {
     if (const auto* r = std::get_if<SampleRow>(&any)) {
@@ -272,21 +272,21 @@ CampaignRow campaign_row(Statement& st) {
 }
 }  // namespace
 
-std::optional<CampaignRow> Store::campaign(std::int64_t id) {
+std::optional<CampaignRow> Reads::campaign(std::int64_t id) {
   Statement st(db_, "SELECT id, rig_id, kind, plan, state, created_at, updated_at FROM campaigns WHERE id = ?");
   st.bind(1, id);
   if (!st.step()) return std::nullopt;
   return campaign_row(st);
 }
 
-std::vector<CampaignRow> Store::campaigns() {
+std::vector<CampaignRow> Reads::campaigns() {
   std::vector<CampaignRow> out;
   Statement st(db_, "SELECT id, rig_id, kind, plan, state, created_at, updated_at FROM campaigns ORDER BY id");
   while (st.step()) out.push_back(campaign_row(st));
   return out;
 }
 
-std::vector<EventRow> Store::events(std::int64_t campaign) {
+std::vector<EventRow> Reads::events(std::int64_t campaign) {
   std::vector<EventRow> out;
   Statement st(db_, "SELECT id, at, kind, from_state, to_state, detail FROM events WHERE campaign_id = ? ORDER BY id");
   st.bind(1, campaign);
@@ -294,14 +294,14 @@ std::vector<EventRow> Store::events(std::int64_t campaign) {
   return out;
 }
 
-std::int64_t Store::sample_count(std::int64_t run) {
+std::int64_t Reads::sample_count(std::int64_t run) {
   Statement st(db_, "SELECT coalesce(sum(n), 0) FROM sample_blocks WHERE run_id = ?");
   st.bind(1, run);
   st.step();
   return st.column_int(0);
 }
 
-std::int64_t Store::max_seq(std::int64_t run) {
+std::int64_t Reads::max_seq(std::int64_t run) {
   Statement st(db_, "SELECT coalesce(max(seq), -1) FROM samples WHERE run_id = ?");
   st.bind(1, run);
   st.step();
@@ -311,7 +311,7 @@ std::int64_t Store::max_seq(std::int64_t run) {
 // Raw rows an overview reads at most (about 0.2 s here); beyond, block summaries.
 constexpr std::int64_t kRawOverviewRows = 200'000;
 
-std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int buckets, bool shaker) {
+std::vector<Bucket> Reads::overview(std::int64_t run, double t0, double t1, int buckets, bool shaker) {
   std::vector<Bucket> out(static_cast<std::size_t>(std::max(1, buckets)));
   const double span = t1 > t0 ? t1 - t0 : 1.0;
   auto slot = [&](double t) {
@@ -355,13 +355,13 @@ std::vector<Bucket> Store::overview(std::int64_t run, double t0, double t1, int 
   return out;
 }
 
-void Store::for_each_sample(std::int64_t run, std::int64_t seq0, std::int64_t seq1, const std::function<void(const SampleRow&)>& f) {
+void Reads::for_each_sample(std::int64_t run, std::int64_t seq0, std::int64_t seq1, const std::function<void(const SampleRow&)>& f) {
   Statement st(db_, "SELECT seq, t, cmd, disp, force, status FROM samples WHERE run_id = ? AND seq BETWEEN ? AND ? ORDER BY seq");
   st.bind(1, run).bind(2, seq0).bind(3, seq1);
   while (st.step()) f(SampleRow{run, st.column_int(0), st.column_double(1), st.column_double(2), st.column_double(3), st.column_double(4), st.column_int(5)});
 }
 
-void Store::for_each_shaker_sample(std::int64_t run, std::int64_t seq0, std::int64_t seq1, const std::function<void(const ShakerRow&)>& f) {
+void Reads::for_each_shaker_sample(std::int64_t run, std::int64_t seq0, std::int64_t seq1, const std::function<void(const ShakerRow&)>& f) {
   Statement st(db_,
                "SELECT seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, mass_displacement_mm, base_accel_m_s2, "
                "mass_accel_m_s2, status FROM shaker_samples WHERE run_id = ? AND seq BETWEEN ? AND ? ORDER BY seq");
@@ -374,14 +374,14 @@ void Store::for_each_shaker_sample(std::int64_t run, std::int64_t seq0, std::int
   }
 }
 
-std::int64_t Store::max_shaker_seq(std::int64_t run) {
+std::int64_t Reads::max_shaker_seq(std::int64_t run) {
   Statement st(db_, "SELECT coalesce(max(seq), -1) FROM shaker_samples WHERE run_id = ?");
   st.bind(1, run);
   st.step();
   return st.column_int(0);
 }
 
-std::string Store::integrity_check() {
+std::string Reads::integrity_check() {
   Statement st(db_, "PRAGMA integrity_check");
   std::string out;
   while (st.step()) out += (out.empty() ? "" : "; ") + st.column_text(0);

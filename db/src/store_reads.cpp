@@ -37,18 +37,25 @@ std::vector<Row> all(Statement& st, F row) {
 }
 }  // namespace
 
-std::string Store::rig_name(std::int64_t rig_id) {
+std::pair<std::string, std::string> Reads::rig_record(std::int64_t rig_id) {
+  Statement st(db_, "SELECT name, config FROM rigs WHERE id = ?");
+  st.bind(1, rig_id);
+  if (!st.step()) return {"", "{}"};
+  return {st.column_text(0), st.column_text(1)};
+}
+
+std::string Reads::rig_name(std::int64_t rig_id) {
   Statement st(db_, "SELECT name FROM rigs WHERE id = ?");
   st.bind(1, rig_id);
   return st.step() ? st.column_text(0) : std::string();
 }
 
-std::vector<std::pair<std::int64_t, std::string>> Store::rigs() {
+std::vector<std::pair<std::int64_t, std::string>> Reads::rigs() {
   Statement st(db_, "SELECT id, name FROM rigs ORDER BY id");
   return all<std::pair<std::int64_t, std::string>>(st, [](Statement& s) { return std::make_pair(s.column_int(0), s.column_text(1)); });
 }
 
-std::vector<std::pair<domain::CampaignState, std::int64_t>> Store::campaign_counts() {
+std::vector<std::pair<domain::CampaignState, std::int64_t>> Reads::campaign_counts() {
   Statement st(db_, "SELECT state, count(*) FROM campaigns GROUP BY state");
   return all<std::pair<domain::CampaignState, std::int64_t>>(st, [](Statement& s) {
     const std::string text = s.column_text(0);
@@ -58,20 +65,20 @@ std::vector<std::pair<domain::CampaignState, std::int64_t>> Store::campaign_coun
   });
 }
 
-std::optional<RunInfo> Store::run(std::int64_t id) {
+std::optional<RunInfo> Reads::run(std::int64_t id) {
   Statement st(db_, std::string(kRunSelect) + "WHERE id = ?");
   st.bind(1, id);
   if (!st.step()) return std::nullopt;
   return run_row(st);
 }
 
-std::vector<RunInfo> Store::runs(std::int64_t campaign) {
+std::vector<RunInfo> Reads::runs(std::int64_t campaign) {
   Statement st(db_, std::string(kRunSelect) + "WHERE campaign_id = ? ORDER BY id");
   st.bind(1, campaign);
   return all<RunInfo>(st, run_row);
 }
 
-std::optional<std::pair<double, double>> Store::time_span(std::int64_t run) {
+std::optional<std::pair<double, double>> Reads::time_span(std::int64_t run) {
   Statement st(db_, "SELECT min(t_min), max(t_max) FROM sample_blocks WHERE run_id = ?");
   st.bind(1, run);
   st.step();
@@ -79,20 +86,20 @@ std::optional<std::pair<double, double>> Store::time_span(std::int64_t run) {
   return std::make_pair(st.column_double(0), st.column_double(1));
 }
 
-std::vector<TableInfo> Store::tables(std::optional<std::int64_t> campaign) {
+std::vector<TableInfo> Reads::tables(std::optional<std::int64_t> campaign) {
   Statement st(db_, std::string(kTableSelect) + (campaign ? "WHERE campaign_id = ? ORDER BY id" : "ORDER BY id"));
   if (campaign) st.bind(1, *campaign);
   return all<TableInfo>(st, table_row);
 }
 
-std::optional<TableInfo> Store::table(std::int64_t id) {
+std::optional<TableInfo> Reads::table(std::int64_t id) {
   Statement st(db_, std::string(kTableSelect) + "WHERE id = ?");
   st.bind(1, id);
   if (!st.step()) return std::nullopt;
   return table_row(st);
 }
 
-std::optional<std::string> Store::table_document(std::int64_t id) {
+std::optional<std::string> Reads::table_document(std::int64_t id) {
   Statement st(db_, "SELECT document FROM tables WHERE id = ?");
   st.bind(1, id);
   if (!st.step()) return std::nullopt;
@@ -110,21 +117,21 @@ std::optional<TableInfo> newest_table(Database& db, const char* owner, std::int6
 }
 }  // namespace
 
-std::optional<TableInfo> Store::newest_table_of_rig(std::int64_t rig_id, const std::string& method) {
+std::optional<TableInfo> Reads::newest_table_of_rig(std::int64_t rig_id, const std::string& method) {
   return newest_table(db_, "campaign_id IN (SELECT id FROM campaigns WHERE rig_id = ?)", rig_id, method);
 }
 
-std::optional<TableInfo> Store::newest_table_of_campaign(std::int64_t campaign_id, const std::string& method) {
+std::optional<TableInfo> Reads::newest_table_of_campaign(std::int64_t campaign_id, const std::string& method) {
   return newest_table(db_, "campaign_id = ?", campaign_id, method);
 }
 
-std::vector<NodeInfo> Store::nodes(std::int64_t campaign) {
+std::vector<NodeInfo> Reads::nodes(std::int64_t campaign) {
   Statement st(db_, std::string(kNodeSelect) + "WHERE r.campaign_id = ? ORDER BY f.id");
   st.bind(1, campaign);
   return all<NodeInfo>(st, node_row);
 }
 
-std::vector<TransmissibilityInfo> Store::transmissibility(std::int64_t campaign) {
+std::vector<TransmissibilityInfo> Reads::transmissibility(std::int64_t campaign) {
   Statement st(db_,
                "SELECT t.id, t.run_id, frequency_hz, coalesce(base_amplitude_mm, 0), coalesce(mass_amplitude_mm, 0), coalesce(ratio, 0), "
                "coalesce(phase_rad, 0), coalesce(step, 0), coalesce(demand_mm, 0), coalesce(direction, ''), coalesce(detail, ''), "
@@ -138,21 +145,21 @@ std::vector<TransmissibilityInfo> Store::transmissibility(std::int64_t campaign)
   });
 }
 
-std::vector<std::string> Store::event_details(std::int64_t campaign, const std::string& kind) {
+std::vector<std::string> Reads::event_details(std::int64_t campaign, const std::string& kind) {
   Statement st(db_, "SELECT coalesce(detail, '') FROM events WHERE campaign_id = ? AND kind = ? ORDER BY id");
   st.bind(1, campaign);
   st.bind(2, kind);
   return all<std::string>(st, [](Statement& s) { return s.column_text(0); });
 }
 
-std::string Store::state_reason(std::int64_t campaign, domain::CampaignState state) {
+std::string Reads::state_reason(std::int64_t campaign, domain::CampaignState state) {
   Statement st(db_, "SELECT coalesce(detail, '') FROM events WHERE campaign_id = ? AND kind = 'state' AND to_state = ? ORDER BY id DESC LIMIT 1");
   st.bind(1, campaign);
   st.bind(2, std::string_view(to_string(state)));
   return st.step() ? st.column_text(0) : std::string();
 }
 
-std::vector<EventInfo> Store::events_after(std::int64_t id, int limit) {
+std::vector<EventInfo> Reads::events_after(std::int64_t id, int limit) {
   Statement st(db_,
                "SELECT id, coalesce(campaign_id, 0), at, kind, coalesce(from_state, ''), coalesce(to_state, ''), coalesce(detail, '') "
                "FROM events WHERE id > ? ORDER BY id LIMIT ?");
@@ -163,28 +170,28 @@ std::vector<EventInfo> Store::events_after(std::int64_t id, int limit) {
   });
 }
 
-std::vector<NodeInfo> Store::nodes_after(std::int64_t id, int limit) {
+std::vector<NodeInfo> Reads::nodes_after(std::int64_t id, int limit) {
   Statement st(db_, std::string(kNodeSelect) + "WHERE f.id > ? ORDER BY f.id LIMIT ?");
   st.bind(1, id);
   st.bind(2, static_cast<std::int64_t>(limit));
   return all<NodeInfo>(st, node_row);
 }
 
-std::vector<TableInfo> Store::tables_after(std::int64_t id, int limit) {
+std::vector<TableInfo> Reads::tables_after(std::int64_t id, int limit) {
   Statement st(db_, std::string(kTableSelect) + "WHERE id > ? ORDER BY id LIMIT ?");
   st.bind(1, id);
   st.bind(2, static_cast<std::int64_t>(limit));
   return all<TableInfo>(st, table_row);
 }
 
-std::int64_t Store::newest_id(const std::string& table) {
+std::int64_t Reads::newest_id(const std::string& table) {
   if (table != "events" && table != "fot_nodes" && table != "tables") throw std::invalid_argument("newest_id: no table '" + table + "'");
   Statement st(db_, "SELECT coalesce(max(id), 0) FROM " + table);
   st.step();
   return st.column_int(0);
 }
 
-std::int64_t Store::read_xy(std::int64_t run, std::int64_t seq0, bool base_mass, std::vector<float>& x, std::vector<float>& y) {
+std::int64_t Reads::read_xy(std::int64_t run, std::int64_t seq0, bool base_mass, std::vector<float>& x, std::vector<float>& y) {
   Statement st(db_, base_mass ? "SELECT seq, base_displacement_mm, mass_displacement_mm FROM shaker_samples WHERE run_id = ? AND seq >= ? ORDER BY seq"
                               : "SELECT seq, disp, force FROM samples WHERE run_id = ? AND seq >= ? ORDER BY seq");
   st.bind(1, run);
@@ -198,7 +205,7 @@ std::int64_t Store::read_xy(std::int64_t run, std::int64_t seq0, bool base_mass,
   return next;
 }
 
-std::vector<LoopInfo> Store::loops(std::int64_t campaign) {
+std::vector<LoopInfo> Reads::loops(std::int64_t campaign) {
   Statement st(db_, "SELECT l.run_id, l.k, l.phase, l.figures FROM loops l JOIN runs r ON r.id = l.run_id WHERE r.campaign_id = ? ORDER BY l.run_id, l.k");
   st.bind(1, campaign);
   return all<LoopInfo>(st, [](Statement& s) { return LoopInfo{s.column_int(0), s.column_int(1), s.column_text(2), s.column_text(3)}; });

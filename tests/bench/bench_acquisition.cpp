@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "hystlab/daemon/campaign_runner.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/domain/envelope.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "realtime_bench.hpp"
 
@@ -61,7 +61,7 @@ daemon::RunnerResult acquire(bool blocks, int port, double seconds, db::Store& s
   nlohmann::json points = nlohmann::json::array();
   const int legs = std::max(2, static_cast<int>(seconds / 1.5));
   for (int k = 0; k <= legs; ++k) points.push_back(k % 2 ? 3.0 : 0.0);  // 1.5 s legs at 2 mm/s
-  const auto plan = daemon::parse_plan({{"kind", "waveform"},
+  const auto plan = domain::parse_plan({{"kind", "waveform"},
                                         {"points_mm", points},
                                         {"ramp_rate_mm_s", 2.0},
                                         {"sample_rate_hz", 1000},
@@ -70,14 +70,14 @@ daemon::RunnerResult acquire(bool blocks, int port, double seconds, db::Store& s
   std::vector<float> periods;
   periods.reserve(static_cast<std::size_t>(seconds * 1100));
   daemon::SteadyClock clock;
-  daemon::Supervisor supervisor(*rig, daemon::SupervisionSettings{}, false);
+  daemon::Supervisor supervisor(*rig, domain::SupervisionSettings{}, false);
   daemon::RunnerContext ctx(*rig, supervisor, writer, clock);
   ctx.now_iso = [] { return std::string("t"); };
   ctx.loop_periods_us = &periods;
   daemon::CampaignJob job;
   job.id = id;
   job.plan = plan;
-  job.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, false);
+  job.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, false);
   const auto r = daemon::run_campaign(job, ctx);
   writer.flush();
   const db::WriterStats w = writer.stats();

@@ -20,8 +20,8 @@
 #include "../daemon/fake_rig.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/clock.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
+#include "hystlab/domain/envelope.hpp"
 
 using namespace hystlab;
 namespace fs = std::filesystem;
@@ -90,10 +90,10 @@ int main(int argc, char** argv) {
     loop_periods.reserve(static_cast<std::size_t>(faults) * 64);
     for (int k = 0; k < faults; ++k) {
       TimedRig rig(at(rng));
-      daemon::Supervisor sup(rig, daemon::SupervisionSettings{}, false);
+      daemon::Supervisor sup(rig, domain::SupervisionSettings{}, false);
       daemon::CampaignJob job;
-      job.plan = daemon::parse_plan(plan_json);
-      job.plan.limits = daemon::check_plan_against(job.plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, false);
+      job.plan = domain::parse_plan(plan_json);
+      job.plan.limits = domain::check_plan_against(job.plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, false);
       job.id = store.create_campaign(rig_id, hystlab::domain::CampaignKind::waveform, plan_json.dump(), "t");
       daemon::RunnerContext ctx(rig, sup, writer, clock);
       ctx.now_iso = [] { return std::string("t"); };

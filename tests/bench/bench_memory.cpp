@@ -19,9 +19,9 @@
 #include "../daemon/fake_rig.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/clock.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/db/run_h5.hpp"
+#include "hystlab/domain/envelope.hpp"
 
 using namespace hystlab;
 namespace fs = std::filesystem;
@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     db::SampleWriter writer(path, db::WriterOptions{1U << 17, 0.1, 50'000, false});
     const std::int64_t rig_id = store.upsert_rig("fake", "{}", "t");
     test::FakeRig rig;
-    daemon::SupervisionSettings settings;
+    domain::SupervisionSettings settings;
     daemon::Supervisor sup(rig, settings, false);
     daemon::FakeClock clock;
     // Legs of 2 mm at 2 mm/s: 1 s, 1,000 samples each.
@@ -72,8 +72,8 @@ int main(int argc, char** argv) {
     const nlohmann::json plan_json{
         {"kind", "waveform"}, {"points_mm", points}, {"ramp_rate_mm_s", 2.0}, {"sample_rate_hz", 1000}, {"limits", {{"displacement_mm", {-0.5, 2.5}}}}};
     daemon::CampaignJob job;
-    job.plan = daemon::parse_plan(plan_json);
-    job.plan.limits = daemon::check_plan_against(job.plan, daemon::RigEnvelope{}, settings, false);
+    job.plan = domain::parse_plan(plan_json);
+    job.plan.limits = domain::check_plan_against(job.plan, domain::RigEnvelope{}, settings, false);
     job.id = store.create_campaign(rig_id, job.plan.kind, "{\"kind\": \"waveform\"}", "t");
     daemon::RunnerContext ctx(rig, sup, writer, clock);
     ctx.now_iso = [] { return std::string("2026-11-25T00:00:00Z"); };

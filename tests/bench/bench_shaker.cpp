@@ -14,9 +14,9 @@
 #include <filesystem>
 
 #include "hystlab/daemon/campaign_runner.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/daemon/supervisor.hpp"
+#include "hystlab/domain/envelope.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
 #include "realtime_bench.hpp"
@@ -39,7 +39,7 @@ long bare_loop_missed(double seconds) {
   return missed;
 }
 
-int report_points(db::Store& store, std::int64_t id, const daemon::SinePlan& sine, bool completed) {
+int report_points(db::Store& store, std::int64_t id, const domain::SinePlan& sine, bool completed) {
   std::vector<models::SweepCurvePoint> pts;
   double worst = 0;
   int beyond = 0;
@@ -54,7 +54,7 @@ int report_points(db::Store& store, std::int64_t id, const daemon::SinePlan& sin
   std::printf(
       "points: %zu of %zu; worst step's control error %.2f %% (tolerance %.0f %%); %d points beyond it, %zu steps where control "
       "gave up after its windows\n",
-      pts.size(), daemon::step_count(sine), worst, sine.control.tolerance_pct, beyond, unreached);
+      pts.size(), domain::step_count(sine), worst, sine.control.tolerance_pct, beyond, unreached);
   const models::SweepReport r = models::analyse_sweep(pts, sine.jump_threshold_pct / 100);
   for (const models::SweepCurve& c : r.curves)
     if (c.resonance)
@@ -67,7 +67,7 @@ int report_points(db::Store& store, std::int64_t id, const daemon::SinePlan& sin
       std::printf("%.3f mm: up and down differ by up to %.0f %% between %.2f and %.2f Hz\n", a.amplitude_mm, 100 * j.max_difference, j.lo_hz, j.hi_hz);
   }
   // What can fail: a completed sweep has every point, and none beyond tolerance unless control said it gave up there.
-  if (completed && pts.size() != daemon::step_count(sine)) return 1;
+  if (completed && pts.size() != domain::step_count(sine)) return 1;
   return completed && beyond > static_cast<int>(unreached) ? 1 : 0;
 }
 }  // namespace
@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
   db::Store& store = bench.store;
   db::SampleWriter& writer = *bench.writer;
 
-  const auto plan = daemon::parse_plan({{"kind", "sine"},
+  const auto plan = domain::parse_plan({{"kind", "sine"},
                                         {"sweep", {{"from_hz", 5}, {"to_hz", 100}, {"steps", steps}}},
                                         {"direction", "up-down"},
                                         {"amplitudes_mm", {0.005, 0.05}},
@@ -90,14 +90,14 @@ int main(int argc, char** argv) {
   auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", bench.sim.modbus_port}, {"rig", "shaker"}});
   const auto id = store.create_campaign(store.upsert_rig("sim", "{}", "t"), domain::CampaignKind::sine, plan.source.dump(), "t");
   daemon::SteadyClock clock;
-  daemon::Supervisor supervisor(*rig, daemon::SupervisionSettings{}, true);
+  daemon::Supervisor supervisor(*rig, domain::SupervisionSettings{}, true);
   daemon::RunnerContext ctx(*rig, supervisor, writer, clock);
   ctx.now_iso = [] { return std::string("t"); };
   daemon::CampaignJob job;
   job.id = id;
   job.plan = plan;
-  job.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, true);
-  const double nominal = daemon::nominal_duration_s(plan.sine);
+  job.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, true);
+  const double nominal = domain::nominal_duration_s(plan.sine);
   const auto t0 = std::chrono::steady_clock::now();
   const auto r = daemon::run_campaign(job, ctx);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -75,6 +75,40 @@ const has = async p => (await fetch(base + p, { signal: AbortSignal.timeout(1000
 const getJSON = async p => (await fetch(base + p, { signal: AbortSignal.timeout(10000) })).json();
 const rigLatched = name => window.hystlab.rigs().some(r => r.name === name && r.latched);
 
+// The form is the daemon's table of plan fields (GET /api/plans/form): an input for each field
+// the table gives one, with its words. A field given an input there (here: control.gain, added
+// to the answer on its way to the page) appears on the form, is checked with its bounds, and is
+// sent at its path in the plan.
+async function checkFormFromTable(context) {
+  const table = await getJSON('/api/plans/form');
+  const page = await context.newPage();
+  await page.route('**/api/plans/form', async route => {
+    const answer = await (await route.fetch()).json();
+    answer.fields.push({ path: 'control.gain', words: 'control gain', label: 'control gain', unit: '', type: 'number', min: 0.05, max: 1,
+                         group: 'sine', input: 'gain', value: '0.5', placeholder: '', optional: false });
+    await route.fulfill({ json: answer });
+  });
+  const previews = [];
+  page.on('request', r => { if (r.url().endsWith('/api/plans/preview')) previews.push(r.postDataJSON()); });
+  await page.goto(base + '/');
+  await page.waitForSelector('#f-gain', { state: 'attached', timeout: 20000 });
+  const shown = await page.evaluate(fields => fields.filter(f => f.group).map(f => {
+    const label = document.querySelector(`label[for="f-${f.input}"]`);
+    return label && label.textContent.startsWith(f.label) && document.querySelector(`fieldset.${f.group} #f-${f.input}`) ? null : f.input;
+  }).filter(Boolean), table.fields);
+  check(shown.length === 0 && table.fields.filter(f => f.group).length > 20, `every input of the daemon's table is on the form, with its words (missing: ${shown.join(', ') || 'none'})`);
+  await page.selectOption('select[name=kind]', 'sine');
+  await page.fill('input[name=gain]', '0.3');
+  const sent = () => previews.some(b => b.plan && b.plan.kind === 'sine' && b.plan.control && b.plan.control.gain === 0.3);
+  for (const end = Date.now() + 10000; !sent() && Date.now() < end;) await new Promise(r => setTimeout(r, 100));
+  check(sent(), 'a field added to the table reaches the plan the page sends (control.gain 0.3)');
+  await page.fill('input[name=gain]', '2');
+  await page.click('#submit');
+  check(await wait(page, () => /control gain must be from 0\.05 to 1/.test(document.getElementById('f-gain-msg').textContent), null, 'the new field\'s bounds', 10000),
+        'and is checked with the bounds the table gives it');
+  await page.close();
+}
+
 // A ramp rate above the rig's maximum speed (20 mm/s): the server refuses the plan and names
 // the field; the page shows its message beside the ramp rate input, and drops it on a change.
 async function checkServerFieldError(page) {
@@ -106,7 +140,8 @@ async function checkHeaderShare(page) {
   const before = page.viewportSize();
   for (const [w, h] of [[800, 700], [1280, 800], [2560, 1440]]) {
     await page.setViewportSize({ width: w, height: h });
-    await page.waitForTimeout(200);
+    await wait(page, ww => innerWidth === ww, w, `the viewport at ${w} px`, 10000);
+    await page.evaluate(() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r))));  // laid out and drawn
     const m = await page.evaluate(() => {
       const top = document.getElementById('top').getBoundingClientRect();
       const stops = [...document.querySelectorAll('#top button.estop')].map(b => b.getBoundingClientRect());
@@ -234,8 +269,8 @@ async function checkLongLoop(page) {
     console.log(`     the completed view draws ${lp.x.length} points`);
     checkLoopShape(lp, subdivisions, 'the completed loop');
     for (const [points, file] of [[5000, 'loop-5k.png'], [50000, 'loop-50k.png']]) {
-      await page.evaluate(n => window.hystlab.loadLoop(n), points);
-      await page.waitForTimeout(500);
+      await page.evaluate(n => window.hystlab.loadLoop(n), points);  // resolves once loaded and drawn
+      await page.evaluate(() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r))));
       const drawn = await page.evaluate(() => window.hystlab.loopPath());
       console.log(`     ${file}: ${drawn.x.length} points drawn`);
       checkLoopShape(drawn, subdivisions, `the loop at ${points} points`);
@@ -407,15 +442,19 @@ try {
   await checkHeaderShare(page);
 
   if (!only.length) {
+    await checkFormFromTable(context);
     // 0. The form checks its fields before sending anything.
     const campaignCount = async () => (await getJSON('/api/campaigns')).length;
     const before = await campaignCount();
+    let posts = 0;  // the page's submissions: the form's own checks send none
+    const countPosts = r => { if (r.method() === 'POST' && r.url().endsWith('/api/campaigns')) ++posts; };
+    page.on('request', countPosts);
     await page.fill('input[name=hi]', '');
     await page.click('#submit');
     check(await wait(page, () => /δmax is required/.test(document.getElementById('f-hi-msg').textContent), null, 'the δmax message', 10000) &&
           await page.getAttribute('input[name=hi]', 'aria-invalid') === 'true', 'a blank δmax is named beside its input, marked invalid');
-    await page.waitForTimeout(1500);
-    check(await campaignCount() === before, 'and nothing was submitted');
+    page.off('request', countPosts);
+    check(posts === 0 && await campaignCount() === before, 'and nothing was submitted');
     await page.fill('input[name=hi]', '4');
     check(await wait(page, () => document.getElementById('f-hi-msg').textContent === '' && !document.querySelector('input[name=hi][aria-invalid]'), null, 'the message cleared', 10000),
           'typing a valid δmax clears the message');
@@ -476,7 +515,7 @@ try {
     check(await wait(page, () => window.hystlab.state() === 'running', null, 'running'), 'the second campaign runs');
     // The layout at 800 px: no sideways scrolling, the commands in view; at 2560 px the plots grow.
     await page.setViewportSize({ width: 800, height: 900 });
-    await page.waitForTimeout(1500);
+    await wait(page, () => document.querySelector('#loop-plot canvas').getBoundingClientRect().width <= 800, null, 'the plots at 800 px', 10000);
     const fits = await page.evaluate(() => {
       const inside = el => { const r = el.getBoundingClientRect(); return r.width > 0 && r.left >= 0 && r.top >= 0 && r.right <= innerWidth && r.bottom <= innerHeight; };
       return { scrollWidth: document.documentElement.scrollWidth, pause: inside(document.getElementById('pause')), abort: inside(document.getElementById('abort')),
@@ -485,19 +524,19 @@ try {
     check(fits.scrollWidth <= 800, `no horizontal scrolling at 800 px (scrollWidth ${fits.scrollWidth})`);
     check(fits.pause && fits.abort && fits.estop, `Pause, Abort and E-STOP inside the viewport at 800 px (${JSON.stringify(fits)})`);
     await page.evaluate(() => window.scrollTo(0, 1500));
-    await page.waitForTimeout(500);
+    await wait(page, () => window.scrollY > 0, null, 'scrolled', 10000);
     check(await page.evaluate(() => { const r = document.getElementById('abort').getBoundingClientRect(); return r.top >= 0 && r.bottom <= innerHeight; }),
           'Abort stays in view when the page is scrolled');
     await page.screenshot({ path: path.join(outDir, 'layout-800.png') });
     await page.evaluate(() => window.scrollTo(0, 0));
     await page.setViewportSize({ width: 2560, height: 1300 });
-    await page.waitForTimeout(1500);
+    await wait(page, w => document.querySelector('#loop-plot canvas').getBoundingClientRect().width > w, fits.loop, 'the plots at 2560 px', 10000);
     const wide = await page.evaluate(() => ({ scrollWidth: document.documentElement.scrollWidth, loop: document.getElementById('loop-plot').getBoundingClientRect().width,
                                               canvas: document.querySelector('#loop-plot canvas').getBoundingClientRect().width }));
     check(wide.loop > fits.loop && wide.canvas > fits.loop * 0.9 && wide.scrollWidth <= 2560, `the loop plot is wider at 2560 px (${Math.round(wide.canvas)} px) than at 800 px (${Math.round(fits.loop)} px)`);
     await page.screenshot({ path: path.join(outDir, 'layout-2560.png') });
     await page.setViewportSize({ width: 1400, height: 1100 });
-    await page.waitForTimeout(500);
+    await wait(page, () => document.querySelector('#loop-plot canvas').getBoundingClientRect().width <= 1400, null, 'the plots at 1400 px', 10000);
 
     await page.click('#pause');
     check(await wait(page, () => window.hystlab.state() === 'paused', null, 'paused', 20000), 'Pause holds the campaign');

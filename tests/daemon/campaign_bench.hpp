@@ -14,8 +14,8 @@
 
 #include "../support/temp_dir.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
+#include "hystlab/domain/envelope.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 
 namespace hystlab::test {
@@ -33,7 +33,7 @@ struct Bench {  // a db file, a writer, and a campaign row
     writer.reset();
     store.reset();
   }
-  std::int64_t submit(const nlohmann::json& plan) { return store->create_campaign(rig_id, daemon::parse_plan(plan).kind, plan.dump(), "t"); }
+  std::int64_t submit(const nlohmann::json& plan) { return store->create_campaign(rig_id, domain::parse_plan(plan).kind, plan.dump(), "t"); }
   test_support::TempDir tmp{"campaign"};
   fs::path dir = tmp.path();
   std::string path;
@@ -71,7 +71,7 @@ std::unique_ptr<drivers::Rig> tcp_rig(int port) {
 }
 
 daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale, bool shaker = false) {
-  b.sup = std::make_unique<daemon::Supervisor>(rig, daemon::SupervisionSettings{}, shaker, [](const daemon::RigTransition& t) {
+  b.sup = std::make_unique<daemon::Supervisor>(rig, domain::SupervisionSettings{}, shaker, [](const daemon::RigTransition& t) {
     if (std::getenv("HYSTLAB_TRACE"))
       std::fprintf(stderr, "%.3f %s -> %s: %s\n", t.t, std::string(daemon::to_string(t.from)).c_str(), std::string(daemon::to_string(t.to)).c_str(),
                    t.reason.c_str());
@@ -83,8 +83,8 @@ daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double s
   return ctx;
 }
 // Limits for the envelope tests: -1..5 mm, 100 N, and the rate limit given.
-daemon::Limits envelope_limits(double rate_mm_s) {
-  daemon::Limits l;
+domain::Limits envelope_limits(double rate_mm_s) {
+  domain::Limits l;
   l.displacement_min_mm = -1;
   l.displacement_max_mm = 5;
   l.force_max_N = 100;
@@ -93,11 +93,11 @@ daemon::Limits envelope_limits(double rate_mm_s) {
 }
 
 // A campaign as the daemon hands it over: the plan within the rig's envelope (the defaults).
-daemon::RunnerResult run(std::int64_t id, const daemon::Plan& plan, daemon::RunnerContext& ctx) {
+daemon::RunnerResult run(std::int64_t id, const domain::Plan& plan, daemon::RunnerContext& ctx) {
   daemon::CampaignJob j;
   j.id = id;
   j.plan = plan;
-  j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, plan.kind == domain::CampaignKind::sine);
+  j.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, plan.kind == domain::CampaignKind::sine);
   return daemon::run_campaign(j, ctx);
 }
 std::string end_of(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }

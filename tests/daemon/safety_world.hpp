@@ -16,8 +16,8 @@
 #include "../support/temp_dir.hpp"
 #include "fake_rig.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/supervisor.hpp"
+#include "hystlab/domain/envelope.hpp"
 #include "rig_worker.hpp"
 
 namespace hystlab::test {
@@ -60,8 +60,8 @@ struct SafetyWorld {
 
   daemon::CampaignJob job(const nlohmann::json& plan_json) {
     daemon::CampaignJob j;
-    j.plan = daemon::parse_plan(plan_json);
-    j.plan.limits = daemon::check_plan_against(j.plan, daemon::RigEnvelope{}, settings, rig->shaker);
+    j.plan = domain::parse_plan(plan_json);
+    j.plan.limits = domain::check_plan_against(j.plan, domain::RigEnvelope{}, settings, rig->shaker);
     j.id = store->create_campaign(rig_id, j.plan.kind, plan_json.dump(), "t");
     return j;
   }
@@ -123,7 +123,7 @@ struct SafetyWorld {
   std::unique_ptr<db::Store> store;
   std::unique_ptr<db::SampleWriter> writer;
   std::int64_t rig_id = 0;
-  daemon::SupervisionSettings settings;
+  domain::SupervisionSettings settings;
   daemon::FakeClock clock;
   double t0 = 0;
   FakeRig* rig = nullptr;

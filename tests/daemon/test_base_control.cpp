@@ -8,6 +8,7 @@
 #include "hystlab/daemon/base_control.hpp"
 
 using namespace hystlab::daemon;
+using namespace hystlab::domain;
 
 TEST_CASE("base control: reaches the demand on any table response within its windows, seeded") {
   std::mt19937 rng(3);

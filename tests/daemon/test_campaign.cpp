@@ -19,11 +19,11 @@
 #include "campaign_bench.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
 #include "hystlab/daemon/daemon.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/daemon/safety.hpp"
 #include "hystlab/daemon/supervisor.hpp"
+#include "hystlab/domain/envelope.hpp"
 #include "hystlab/drivers/can_rig.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
 #include "hystlab/models/formats.hpp"
@@ -42,7 +42,7 @@ namespace {
 // Runs a campaign while another thread sends the simulator faults: (wait in ms, command) in turn,
 // counted from the campaign's "running" (arming takes a database round trip first, and a starved
 // machine may take longer than a fixed wait).
-daemon::RunnerResult run_with_faults(std::int64_t id, const daemon::Plan& plan, daemon::RunnerContext& ctx, SimProcess& sim,
+daemon::RunnerResult run_with_faults(std::int64_t id, const domain::Plan& plan, daemon::RunnerContext& ctx, SimProcess& sim,
                                      const std::vector<std::pair<int, std::string>>& schedule) {
   std::atomic<bool> running{false}, over{false};
   auto before = ctx.on_state;
@@ -69,7 +69,7 @@ TEST_CASE("fot campaign n = 12: the online table equals the offline one and the 
   SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0.05", "--corner-width", "0"});
   Bench b;
   auto rig = tcp_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan(fot_plan(12));
+  const auto plan = domain::parse_plan(fot_plan(12));
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
   const daemon::RunnerResult r = run(id, plan, ctx);
@@ -121,7 +121,7 @@ TEST_CASE("safety: a force-limit trip aborts to the safe position, with the reas
   auto rig = tcp_rig(sim.modbus_port);
   auto j = fot_plan(4, 0.2);
   j["limits"]["force_N"] = 60;
-  const auto plan = daemon::parse_plan(j);
+  const auto plan = domain::parse_plan(j);
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
   const auto r = run(id, plan, ctx);
@@ -138,7 +138,7 @@ TEST_CASE("operator: pause, a long pause's memory-aware resume, then abort") {
   SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
   Bench b;
   auto rig = tcp_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan(fot_plan(6, 0.1));
+  const auto plan = domain::parse_plan(fot_plan(6, 0.1));
   const auto id = b.submit(plan.source);
   Controls c;
   auto ctx = context(*rig, b, &c, 200);
@@ -170,7 +170,7 @@ TEST_CASE("operator e-stop: passed to the rig at once, the campaign aborted") {
   SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
   Bench b;
   auto rig = tcp_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan(fot_plan(6, 0.1));
+  const auto plan = domain::parse_plan(fot_plan(6, 0.1));
   const auto id = b.submit(plan.source);
   Controls c;
   auto ctx = context(*rig, b, &c, 200);
@@ -191,7 +191,7 @@ TEST_CASE("watchdog: a dropped connection holds and fails; a short drop recovers
   SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
   Bench b;
   auto rig = tcp_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan(fot_plan(4, 0.2));
+  const auto plan = domain::parse_plan(fot_plan(4, 0.2));
   {
     const auto id = b.submit(plan.source);
     auto ctx = context(*rig, b, nullptr, 200);
@@ -221,7 +221,7 @@ TEST_CASE("a stalled controller answers late: the campaign goes on, no false rat
   auto rig = tcp_rig(sim.modbus_port);
   nlohmann::json source = fot_plan(4, 1.0);
   source["limits"]["rate_mm_s"] = 5;
-  const auto plan = daemon::parse_plan(source);
+  const auto plan = domain::parse_plan(source);
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 10);
   std::vector<std::pair<int, std::string>> stalls;  // eight stalls of 35 ms within the campaign's first 2 s
@@ -236,7 +236,7 @@ TEST_CASE("a full writer queue is counted and never blocks acquisition") {
   SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0"});
   Bench b(8);  // far smaller than the 100 samples of one 100 ms batch window
   auto rig = tcp_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan(fot_plan(3, 0.4));
+  const auto plan = domain::parse_plan(fot_plan(3, 0.4));
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
   const auto r = run(id, plan, ctx);
@@ -254,7 +254,7 @@ TEST_CASE("fot campaign over CAN (socketpair)") {
   close(sv[1]);
   drivers::CanRig rig(std::make_unique<drivers::FdCanChannel>(sv[0], "socketpair"), drivers::CanRigConfig{});
   Bench b;
-  const auto plan = daemon::parse_plan(fot_plan(4, 0.2));
+  const auto plan = domain::parse_plan(fot_plan(4, 0.2));
   const auto id = b.submit(plan.source);
   auto ctx = context(rig, b, nullptr, 20);
   const auto r = run(id, plan, ctx);
@@ -267,7 +267,7 @@ TEST_CASE("fot campaign over CAN (socketpair)") {
 }
 
 TEST_CASE("safety envelope: limits on every sample; the rate over a window, not between two reads") {
-  const daemon::Limits l = envelope_limits(10);
+  const domain::Limits l = envelope_limits(10);
   daemon::SafetyEnvelope env(l);
   // Steady 2 mm/s sampled with a jittery clock, the rig moving in 1 ms steps: reads 5 µs apart
   // may straddle one step (0.002 mm / 5 µs = 400 mm/s between them). Must not trip.
@@ -291,7 +291,7 @@ TEST_CASE("safety envelope: limits on every sample; the rate over a window, not 
 }
 
 TEST_CASE("safety envelope: a slow answer is no fast motion; a runaway with slow answers still trips") {
-  const daemon::Limits l = envelope_limits(5);
+  const domain::Limits l = envelope_limits(5);
   // 1 mm/s, polled every 10 ms of rig time; one request waits 440 ms (a starved controller at
   // time scale 10, seen in CI) and comes back with the position of that moment.
   auto run = [&](bool bracketed) {
@@ -323,7 +323,7 @@ TEST_CASE("safety envelope: a slow answer is no fast motion; a runaway with slow
 TEST_CASE("plans: an error names the field and the reason") {
   auto bad = [](nlohmann::json j, const char* needle) {
     CAPTURE(needle);
-    CHECK_THROWS_WITH_AS((void)daemon::parse_plan(j), doctest::Contains(needle), daemon::PlanError);
+    CHECK_THROWS_WITH_AS((void)domain::parse_plan(j), doctest::Contains(needle), domain::PlanError);
   };
   bad({{"kind", "fot"}, {"subdivisions", 4}}, "range_mm is required");
   bad({{"kind", "fot"}, {"range_mm", {4, 0}}, {"subdivisions", 4}}, "range_mm must be [low, high]");
@@ -335,11 +335,11 @@ TEST_CASE("plans: an error names the field and the reason") {
   bad({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"ramp_rate_mm_s", 30}, {"limits", {{"rate_mm_s", 10}}}},
       "ramp_rate_mm_s is above limits.rate_mm_s");
   // Without a rate of its own the plan parses; the rig's envelope refuses it, naming its maximum.
-  const auto fast = daemon::parse_plan({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"ramp_rate_mm_s", 30}});
+  const auto fast = domain::parse_plan({{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}, {"ramp_rate_mm_s", 30}});
   try {
-    (void)daemon::check_plan_against(fast, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, false);
+    (void)domain::check_plan_against(fast, domain::RigEnvelope{}, domain::SupervisionSettings{}, false);
     FAIL("a ramp of 30 mm/s passed an envelope of 20 mm/s");
-  } catch (const daemon::PlanError& e) {
+  } catch (const domain::PlanError& e) {
     CHECK(std::string(e.what()).find("ramp_rate_mm_s 30 exceeds the rig's maximum speed 20 mm/s") != std::string::npos);
   }
 }
@@ -407,7 +407,7 @@ TEST_CASE("training until stable on an untrained specimen: the plateau settles, 
   j["training"] = {{"max_cycles", 25}, {"until", {{"peak_force_change", "0.5 %"}, {"energy_change", "2 %"}, {"consecutive", 3}}}};
   j["validation"] = {{"reversals", 6}, {"seed", 3}};
   j["plateaus_mm"] = {1.0, 3.0};
-  const auto plan = daemon::parse_plan(j);
+  const auto plan = domain::parse_plan(j);
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
   const daemon::RunnerResult r = run(id, plan, ctx);
@@ -465,7 +465,7 @@ TEST_CASE("fot campaign on a grid of its own: the rows go to its nodes, the tabl
   j.erase("subdivisions");
   j["nodes_mm"] = {0.0, 1.0, 1.6, 2.0, 2.4, 4.0};
   j["validation"] = {{"reversals", 4}};
-  const auto plan = daemon::parse_plan(j);
+  const auto plan = domain::parse_plan(j);
   REQUIRE(plan.subdivisions == 5);
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
@@ -502,7 +502,7 @@ TEST_CASE("training until stable: at its maximum the campaign says the loop did 
   auto j = fot_plan(3, 0.5);
   j["training"] = {{"max_cycles", 3}, {"until", {{"energy_change", 2}, {"consecutive", 2}}}};
   j["validation"] = false;
-  const auto plan = daemon::parse_plan(j);
+  const auto plan = domain::parse_plan(j);
   const auto id = b.submit(plan.source);
   auto ctx = context(*rig, b, nullptr, 200);
   const daemon::RunnerResult r = run(id, plan, ctx);

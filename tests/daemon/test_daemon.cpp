@@ -217,8 +217,7 @@ TEST_CASE("hystlabd: kill -9 after the last node (in the validation run), restar
   kill(pid, SIGTERM);
   CHECK(wait_exit(pid) == 0);
   pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log3");
-  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  (void)daemon_at(d.path / "log3");           // serving: its start-up pass over the stored campaigns is done
   CHECK(state_of(d.db(), 1) == "completed");  // a restart leaves an ended campaign alone
   CHECK(tables().first == 2);
   kill(pid, SIGTERM);
@@ -264,7 +263,9 @@ TEST_CASE("hystlabd: a campaign still queued when the daemon died is held at res
   const Reaper reaper{pid};
   REQUIRE(eventually([&] { return state_of(d.db(), 2) == "held"; }));
   CHECK(state_of(d.db(), 1) == "interrupted");
-  std::this_thread::sleep_for(std::chrono::seconds(2));
+  // Serving: start-up (the only time the daemon dispatches from the database without being
+  // asked) is over, and the held campaign is still held.
+  (void)daemon_at(d.path / "log");
   CHECK(state_of(d.db(), 2) == "held");  // nothing moved by itself
   {
     db::Store s(d.db());
@@ -314,10 +315,10 @@ TEST_CASE("hystlabd: the supervised simulator killed; the next campaign runs on 
   d.write("plan.json", kShortPlan);
   const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", "0"}, d.path / "log");
   const Reaper reaper{pid};
-  REQUIRE(eventually([&] { return daemon_ready(d.db()); }));
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const std::string sim = "pgrep -P " + std::to_string(pid) + " hystlab-sim > /dev/null";
+  REQUIRE(eventually([&] { return daemon_ready(d.db()) && std::system(sim.c_str()) == 0; }));
   REQUIRE(std::system(("pkill -KILL -P " + std::to_string(pid) + " hystlab-sim").c_str()) == 0);
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  REQUIRE(eventually([&] { return log_of(d.path / "log").find("the simulator died") != std::string::npos; }));
   REQUIRE(cli("campaign submit --plan " + (d.path / "plan.json").string() + daemon_at(d.path / "log")).code == 0);
   CHECK(eventually([&] { return state_of(d.db(), 1) == "completed"; }));
   CHECK(log_of(d.path / "log").find("the simulator died") != std::string::npos);

@@ -30,7 +30,7 @@ TEST_CASE("operator e-stop over CAN in every phase: written within two periods, 
   w.rig = std::make_unique<drivers::CanRig>(std::make_unique<drivers::FdCanChannel>(sv[0], "socketpair"), drivers::CanRigConfig{});
   w.info.kind = domain::RigKind::load_frame;
   w.entry.name = "can frame";
-  w.supervisor = std::make_unique<daemon::Supervisor>(*w.rig, daemon::SupervisionSettings{}, false, [&w](const daemon::RigTransition& t) { w.record(t); });
+  w.supervisor = std::make_unique<daemon::Supervisor>(*w.rig, domain::SupervisionSettings{}, false, [&w](const daemon::RigTransition& t) { w.record(t); });
   Bench b;
   daemon::SteadyClock clock;
   const double t0 = clock.now();
@@ -49,12 +49,12 @@ TEST_CASE("operator e-stop over CAN in every phase: written within two periods, 
   for (const std::string phase : {"just submitted", "ramping", "dwelling", "paused", "safing"}) {
     CAPTURE(phase);
     Controls controls;
-    const auto plan = daemon::parse_plan(plan_json);
+    const auto plan = domain::parse_plan(plan_json);
     const auto id = b.submit(plan.source);
     daemon::CampaignJob j;
     j.id = id;
     j.plan = plan;
-    j.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, false);
+    j.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, false);
     daemon::RunnerContext ctx{*w.rig, *w.supervisor, *b.writer, clock};
     ctx.now_iso = [] { return std::string("2026-11-25T00:00:00Z"); };
     ctx.next_control = [&controls] { return controls.pop(); };

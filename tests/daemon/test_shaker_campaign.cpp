@@ -55,7 +55,7 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   // The isolator rings at 17.7 Hz for 1/(ζω_n) = 0.45 s after each change: the settle criterion
   // waits until the mass amplitude stops changing (a fixed 10 cycles at 60 Hz measured a 16 %
   // high ratio with 9 % "distortion": the free vibration beating with the response).
-  const auto plan = daemon::parse_plan({{"kind", "sine"},
+  const auto plan = domain::parse_plan({{"kind", "sine"},
                                         {"frequencies_hz", {12, 30, 60}},
                                         {"amplitude_mm", 0.005},
                                         {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
@@ -67,7 +67,7 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   daemon::CampaignJob job;
   job.id = id;
   job.plan = plan;
-  job.plan.limits = daemon::check_plan_against(plan, daemon::RigEnvelope{}, daemon::SupervisionSettings{}, true);
+  job.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, true);
   job.isolator = std::make_shared<const daemon::IsolatorModel>(daemon::simulated_isolator());
   const auto r = daemon::run_campaign(job, ctx);
   CAPTURE(r.reason);
@@ -104,7 +104,7 @@ TEST_CASE("sine campaign with linear springs: the transmissibility of the analyt
   SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25", "--linear", "40"});
   Bench b;
   auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan({{"kind", "sine"},
+  const auto plan = domain::parse_plan({{"kind", "sine"},
                                         {"frequencies_hz", {12, 16, 30}},
                                         {"amplitude_mm", 0.05},
                                         {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
@@ -136,7 +136,7 @@ TEST_CASE("sine campaign: beyond the abort band the shaker is stopped, at zero d
   auto rig = shaker_rig(sim.modbus_port);
   // 110 Hz is beyond the table's servo (60 Hz): the base follows a third of the drive, and the
   // plan allows the drive only 1.5 times the demand, so the base stays about 45 % short.
-  const auto plan = daemon::parse_plan({{"kind", "sine"},
+  const auto plan = domain::parse_plan({{"kind", "sine"},
                                         {"frequencies_hz", {110}},
                                         {"amplitude_mm", 0.005},
                                         {"sample_rate_hz", 1000},
@@ -165,7 +165,7 @@ TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rat
   SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5"});
   Bench b;
   auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = daemon::parse_plan({{"kind", "sine"},
+  const auto plan = domain::parse_plan({{"kind", "sine"},
                                         {"sweep", {{"from_hz", 8}, {"to_hz", 11}, {"rate_hz_s", 1.5}}},
                                         {"amplitude_mm", 0.005},
                                         {"settle_cycles", 20},
@@ -180,7 +180,7 @@ TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rat
   const auto pts = points_of(*b.store, id);
   // 2 s from 8 to 11 Hz: about 19 cycles, 4 a point (the last window may cross the end).
   CHECK(pts.size() >= 4);
-  CHECK(pts.size() <= daemon::step_count(plan.sine) + 1);
+  CHECK(pts.size() <= domain::step_count(plan.sine) + 1);
   double last = 0;
   for (const auto& p : pts) {
     CAPTURE(p.dump());
@@ -195,28 +195,28 @@ TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rat
 }
 
 TEST_CASE("sine plans: sweeps, directions, amplitudes, settle and control, with errors that name the field") {
-  const auto p = daemon::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60, "steps": 12},
+  const auto p = domain::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60, "steps": 12},
       "direction": "up-down", "amplitudes_mm": [0.005, 0.05], "settle": {"change": "2 %"}, "control": {"tolerance": 4}})"));
   CHECK(p.sine.frequencies_hz.size() == 12);
   CHECK(p.sine.frequencies_hz.front() == doctest::Approx(5));
   CHECK(p.sine.frequencies_hz.back() == doctest::Approx(60));
-  const auto passes = daemon::sweep_passes(p.sine);
+  const auto passes = domain::sweep_passes(p.sine);
   REQUIRE(passes.size() == 4);
   CHECK((passes[0].up && !passes[1].up && passes[2].amplitude_mm == 0.05));
-  CHECK(daemon::pass_frequencies(p.sine, passes[1]).front() == doctest::Approx(60));
-  CHECK(daemon::step_count(p.sine) == 48);
+  CHECK(domain::pass_frequencies(p.sine, passes[1]).front() == doctest::Approx(60));
+  CHECK(domain::step_count(p.sine) == 48);
   CHECK(p.sine.settle.until);
   CHECK(p.sine.control.tolerance_pct == 4);
   const auto c =
-      daemon::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "rate_oct_min": 2}, "amplitude_mm": 0.01})"));
+      domain::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "rate_oct_min": 2}, "amplitude_mm": 0.01})"));
   CHECK(c.sine.continuous);
-  CHECK(daemon::nominal_duration_s(c.sine) > 120);  // 4 octaves at 2 oct/min
+  CHECK(domain::nominal_duration_s(c.sine) > 120);  // 4 octaves at 2 oct/min
   auto bad = [](const char* text, const char* what) {
     CAPTURE(text);
     try {
-      (void)daemon::parse_plan(nlohmann::json::parse(text));
+      (void)domain::parse_plan(nlohmann::json::parse(text));
       FAIL("accepted");
-    } catch (const daemon::PlanError& e) {
+    } catch (const domain::PlanError& e) {
       CHECK(std::string(e.what()).find(what) != std::string::npos);
     }
   };

@@ -12,10 +12,10 @@
 #include "../support/temp_dir.hpp"
 #include "fake_rig.hpp"
 #include "hystlab/daemon/campaign_runner.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/sequencer.hpp"
 #include "hystlab/daemon/supervisor.hpp"
+#include "hystlab/domain/envelope.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystlab;
@@ -26,7 +26,7 @@ using test::FaultEvent;
 
 namespace {
 struct Harness {
-  explicit Harness(daemon::SupervisionSettings s = {}) : settings(s) {
+  explicit Harness(domain::SupervisionSettings s = {}) : settings(s) {
     path = (dir / "hystlab.db").string();
     store = std::make_unique<db::Store>(path);
     writer = std::make_unique<db::SampleWriter>(path, db::WriterOptions{1U << 16, 0.05, 50'000, false});
@@ -39,8 +39,8 @@ struct Harness {
   }
   daemon::CampaignJob job(const nlohmann::json& plan_json) {
     daemon::CampaignJob j;
-    j.plan = daemon::parse_plan(plan_json);
-    j.plan.limits = daemon::check_plan_against(j.plan, envelope, settings, false);
+    j.plan = domain::parse_plan(plan_json);
+    j.plan.limits = domain::check_plan_against(j.plan, envelope, settings, false);
     j.id = store->create_campaign(rig_id, j.plan.kind, plan_json.dump(), "t");
     return j;
   }
@@ -69,8 +69,8 @@ struct Harness {
 
   FakeRig rig;
   daemon::FakeClock clock;
-  daemon::SupervisionSettings settings;
-  daemon::RigEnvelope envelope;
+  domain::SupervisionSettings settings;
+  domain::RigEnvelope envelope;
   test_support::TempDir tmp{"super"};
   fs::path dir = tmp.path();
   std::string path;
@@ -196,7 +196,7 @@ TEST_CASE("loop: a dead band beyond the in-position tolerance fails the segment 
     CHECK(r.reason.find("stopped at 1.98") != std::string::npos);
     CHECK(h.rig.held());
     // The deadline: 2 mm at 2 mm/s, plus lag, settle and the host-stall allowance (at 1 kHz).
-    const double deadline_s = 2.0 / 2.0 + h.settings.lag_s + h.settings.settle_s + daemon::kHostStallAllowance_s;
+    const double deadline_s = 2.0 / 2.0 + h.settings.lag_s + h.settings.settle_s + domain::kHostStallAllowance_s;
     CHECK(static_cast<double>(r.samples) < (deadline_s + 0.1) * 1000);
     CHECK(static_cast<double>(r.samples) > (deadline_s - 0.1) * 1000);
   }

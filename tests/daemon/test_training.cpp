@@ -6,9 +6,9 @@
 #include <cmath>
 #include <random>
 
-#include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/sequencer.hpp"
 #include "hystlab/daemon/shakedown.hpp"
+#include "hystlab/domain/plan.hpp"
 
 using namespace hystlab;
 using nlohmann::json;
@@ -23,9 +23,9 @@ json training_plan(json extra) {
 void refused(const json& extra, const std::string& field, const std::string& part) {
   CAPTURE(extra.dump());
   try {
-    (void)daemon::parse_plan(training_plan(extra));
+    (void)domain::parse_plan(training_plan(extra));
     FAIL("accepted");
-  } catch (const daemon::PlanError& e) {
+  } catch (const domain::PlanError& e) {
     CHECK(e.field == field);
     CHECK(std::string(e.what()).find(part) != std::string::npos);
   }
@@ -37,7 +37,7 @@ TEST_CASE("plan: training until stable, validation and plateaus, each refusal na
   extra["training"] = {{"max_cycles", 40}, {"until", {{"peak_force_change", "0.5 %"}, {"energy_change", 2}, {"consecutive", 3}}}};
   extra["validation"] = {{"reversals", 20}, {"range_mm", {0.5, 3.5}}, {"seed", 7}};
   extra["plateaus_mm"] = {1, 3};
-  const auto p = daemon::parse_plan(training_plan(extra));
+  const auto p = domain::parse_plan(training_plan(extra));
   CHECK(p.training.max_cycles == 40);
   CHECK(p.training.until);
   CHECK(p.training.peak_force_change_pct == 0.5);
@@ -49,12 +49,12 @@ TEST_CASE("plan: training until stable, validation and plateaus, each refusal na
   CHECK(p.validation.rate_mm_s == p.ramp_rate_mm_s);
   CHECK(p.plateaus_mm == std::vector<double>{1, 3});
   // Defaults: validation on over the plan's range; training_cycles is a fixed count.
-  const auto d = daemon::parse_plan(training_plan({{"training_cycles", 3}}));
+  const auto d = domain::parse_plan(training_plan({{"training_cycles", 3}}));
   CHECK(d.validation.enabled);
   CHECK(d.validation.hi_mm == 4.0);
   CHECK(d.training.max_cycles == 3);
   CHECK_FALSE(d.training.until);
-  CHECK_FALSE(daemon::parse_plan(training_plan({{"validation", false}})).validation.enabled);
+  CHECK_FALSE(domain::parse_plan(training_plan({{"validation", false}})).validation.enabled);
   refused({{"training", {{"max_cycles", 0}}}}, "training.max_cycles", "from 1 to 1000");
   refused({{"training", {{"max_cycles", 5}, {"until", {{"energy_change", "two"}}}}}}, "training.until.energy_change", "percentage");
   refused({{"training", {{"max_cycles", 5}, {"until", {{"peak_force_change", -1}}}}}}, "training.until.peak_force_change", "percentage");
@@ -70,7 +70,7 @@ TEST_CASE("plan: training until stable, validation and plateaus, each refusal na
 }
 
 TEST_CASE("shakedown rule: stable after `consecutive` cycles below both thresholds, any change above resets the count") {
-  daemon::Training t;
+  domain::Training t;
   t.max_cycles = 20;
   t.until = true;
   t.peak_force_change_pct = 0.5;
@@ -116,7 +116,7 @@ TEST_CASE("shakedown rule: stable after `consecutive` cycles below both threshol
     }
   }
   // Without `until`: every planned cycle, never "stable".
-  daemon::Training fixed;
+  domain::Training fixed;
   fixed.max_cycles = 2;
   daemon::ShakedownRule f(fixed);
   CHECK_FALSE(f.add(1, 1).last);
@@ -127,7 +127,7 @@ TEST_CASE("shakedown rule: stable after `consecutive` cycles below both threshol
 TEST_CASE("validation input: seeded, inside its range, alternating, each move at least a tenth of the range") {
   for (std::uint64_t seed = 0; seed < 30; ++seed) {
     CAPTURE(seed);
-    daemon::Validation v{true, 25, 0.5, 3.5, 1.0, seed};
+    domain::Validation v{true, 25, 0.5, 3.5, 1.0, seed};
     const auto a = daemon::validation_points(v), b = daemon::validation_points(v);
     CHECK(a == b);
     REQUIRE(a.size() == 27);
@@ -146,7 +146,7 @@ TEST_CASE("validation input: seeded, inside its range, alternating, each move at
 }
 
 TEST_CASE("schedule: training cycles, the rows, then the validation segments at their own rate") {
-  auto p = daemon::parse_plan(training_plan({{"training_cycles", 2}, {"validation", {{"reversals", 4}, {"rate_mm_s", 2}}}}));
+  auto p = domain::parse_plan(training_plan({{"training_cycles", 2}, {"validation", {{"reversals", 4}, {"rate_mm_s", 2}}}}));
   const auto s = daemon::fot_schedule(p);
   REQUIRE(s.size() == 1 + 4 + 8 + 6);
   CHECK(s[1].kind == daemon::SegmentKind::training);

@@ -104,6 +104,7 @@ def cli_ok(needle):
 
 CHECKS = {
     "curl -s $H/api/status": ok_json(lambda j: len(j["rigs"]) == 2, "two rigs"),
+    "curl -s $H/api/plans/form": ok_json(lambda j: any(f["path"] == "dwell_s" and f["max"] == 3600 for f in j["fields"]), "the plan's fields, dwell_s up to 3600 s"),
     "curl -s $H/api/rigs": ok_json(lambda j: [r["kind"] for r in j] == ["load_frame", "shaker"], "a load frame and a shaker"),
     'curl -s -X POST -d \'\' "$H/api/rigs/%s/estop"' % FRAME: ok_json(lambda j: j["result"] == "done" and j["latched"] and j["confirmed"], "latched and confirmed"),
     'curl -s -X POST -d \'\' "$H/api/rigs/%s/reset"' % FRAME: ok_json(lambda j: j["result"] == "done" and not j["latched"], "reset: not latched"),

@@ -10,7 +10,7 @@
 #include <string_view>
 
 #include "../../web/src/request_body.hpp"
-#include "hystlab/daemon/plan.hpp"
+#include "hystlab/domain/plan.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/simplified_sma.hpp"
@@ -41,11 +41,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       evaluate(body);
     } else {
       const web::PlanRequest r = web::decode_plan_request(body);
-      (void)daemon::parse_plan(r.plan);
+      (void)domain::parse_plan(r.plan);
     }
   } catch (const web::ApiError& e) {
     if (e.status != 400 && e.status != 413) std::abort();
-  } catch (const daemon::PlanError&) {
+  } catch (const domain::PlanError&) {
   } catch (const models::FormatError&) {
   } catch (const std::invalid_argument&) {  // a model's own validation (SmaParameters)
   }

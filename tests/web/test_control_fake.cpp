@@ -52,7 +52,6 @@ class FakeDaemon final : public control::DaemonInterface {
     return s.create_campaign(s.upsert_rig("fake frame", "{}", "t"), domain::CampaignKind::fot, plan.dump(), "t");
   }
   control::PlanPreview preview(const std::string&, const nlohmann::json&, models::HysteresisModel*) const override { return {}; }
-  std::optional<control::FotGrid> fot_grid(const nlohmann::json&) const override { return control::FotGrid{0, 4, 2, {}}; }
   control::CommandOutcome command(std::int64_t campaign, control::CampaignCommand c) override {
     std::lock_guard lk(mu);
     commands.emplace_back(campaign, c);

@@ -97,7 +97,7 @@ json body_object(const httplib::Request& req, bool allow_empty) { return parse_b
 
 void set_thread_nice(int nice) noexcept { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), nice); }
 
-db::Store& reader(const std::string& db_path) {
+db::Reads& reader(const std::string& db_path) {
   thread_local std::unique_ptr<db::Store> store;
   if (!store || store->database().path() != db_path) store = std::make_unique<db::Store>(db_path);
   return *store;

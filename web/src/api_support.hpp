@@ -42,7 +42,7 @@ double query_number(const httplib::Request& req, const char* name, double def, d
 json body_object(const httplib::Request& req, bool allow_empty = false);
 
 // This thread's read connection (WAL: never blocks the writer).
-db::Store& reader(const std::string& db_path);
+db::Reads& reader(const std::string& db_path);
 
 // HTTP threads yield to acquisition and to the rig's simulator: requests run at nice 5, and a
 // thread streaming events at nice 19 and off the acquisition's CPU (its work is small and its

@@ -27,7 +27,7 @@ struct StreamState {
   bool hello_sent = false;
 };
 
-StreamCursor newest(db::Store& store) { return {store.newest_id("events"), store.newest_id("fot_nodes"), store.newest_id("tables")}; }
+StreamCursor newest(db::Reads& store) { return {store.newest_id("events"), store.newest_id("fot_nodes"), store.newest_id("tables")}; }
 
 std::string frame(const std::string& type, const json& data, const std::string& id = {}) {
   std::string f = id.empty() ? "" : "id: " + id + "\n";
@@ -35,7 +35,7 @@ std::string frame(const std::string& type, const json& data, const std::string& 
 }
 
 // Records stored since the cursor, as frames; advances the cursor.
-std::string records(db::Store& store, StreamCursor& cur) {
+std::string records(db::Reads& store, StreamCursor& cur) {
   std::string out;
   for (const db::EventInfo& e : store.events_after(cur.event, 500)) {
     cur.event = e.id;

@@ -27,8 +27,8 @@ std::int64_t own_run(const json& campaign) {
   return run;
 }
 
-json report_document(ApiContext& c, db::Store& store, const db::CampaignRow& row, XYCache& cache) {
-  json doc{{"campaign", campaign_json(c.daemon, store, row, true)},
+json report_document(ApiContext& c, db::Reads& store, const db::CampaignRow& row, XYCache& cache) {
+  json doc{{"campaign", campaign_json(store, row, true)},
            {"software", std::string("hystlab ") + HYSTLAB_VERSION},
            {"generated_at", utc_now()},
            {"events", events_json(store, row.id)},
@@ -41,7 +41,7 @@ json report_document(ApiContext& c, db::Store& store, const db::CampaignRow& row
     doc["sweep"] = sweep_json(store, row);
     return doc;
   }
-  if (row.kind == domain::CampaignKind::fot) doc["nodes"] = nodes_json(c.daemon, store, row);
+  if (row.kind == domain::CampaignKind::fot) doc["nodes"] = nodes_json(store, row);
   json provenance = json::object();  // each table's own account of how it was made (method, prior, folds, ...)
   for (const json& t : doc["campaign"]["tables"])
     if (const auto text = store.table_document(t.value("id", std::int64_t{0}))) {

@@ -1,14 +1,14 @@
 // Campaigns: submit, list, get, commands; their events, FOT nodes (coverage) and runs.
 #include <algorithm>
-#include <set>
 
 #include "hystlab/db/campaign_record.hpp"
-#include "hystlab/models/grid.hpp"
+#include "hystlab/domain/plan.hpp"
+#include "hystlab/models/online_table_builder.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
 
 namespace hystlab::web {
-db::CampaignRow campaign_or_404(db::Store& store, std::int64_t id) {
+db::CampaignRow campaign_or_404(db::Reads& store, std::int64_t id) {
   auto row = store.campaign(id);
   if (!row) throw ApiError(404, "not found", "no campaign " + std::to_string(id));
   return *row;
@@ -16,7 +16,7 @@ db::CampaignRow campaign_or_404(db::Store& store, std::int64_t id) {
 
 namespace {
 
-json runs_of(db::Store& store, std::int64_t campaign) {
+json runs_of(db::Reads& store, std::int64_t campaign) {
   json runs = json::array();
   for (const db::RunInfo& r : store.runs(campaign))
     runs.push_back({{"id", r.id},
@@ -31,7 +31,7 @@ json runs_of(db::Store& store, std::int64_t campaign) {
 }
 
 // Each table with the warnings of the run it was computed over (the campaign's last).
-json tables_of(db::Store& store, std::int64_t campaign, const json& runs) {
+json tables_of(db::Reads& store, std::int64_t campaign, const json& runs) {
   json out = json::array();
   for (const db::TableInfo& t : store.tables(campaign)) {
     json j = table_json(t);
@@ -53,42 +53,39 @@ json tables_of(db::Store& store, std::int64_t campaign, const json& runs) {
 }
 
 // The newest online evaluation of the partial table ("fit" event), if any.
-json last_fit(db::Store& store, std::int64_t campaign) {
+json last_fit(db::Reads& store, std::int64_t campaign) {
   const auto fits = db::events_of<domain::FitEvent>(store, campaign);
   return fits.empty() ? json(nullptr) : domain::detail_json(fits.back());
 }
 
 }  // namespace
 
-json nodes_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row) {
+json nodes_json(db::Reads& store, const db::CampaignRow& row) {
   json nodes = json::array();
-  for (const db::NodeInfo& n : store.nodes(row.id)) nodes.push_back(node_json(n));
+  const std::vector<db::NodeInfo> measured = store.nodes(row.id);
+  for (const db::NodeInfo& n : measured) nodes.push_back(node_json(n));
   json out{{"campaign", row.id}, {"nodes", nodes}};
-  const auto grid = row.kind == domain::CampaignKind::fot ? d.fot_grid(json::parse(row.plan)) : std::nullopt;
-  if (!grid) return out;
-  const models::Grid g = grid->nodes_mm.empty() ? models::Grid::make(grid->lo_mm, grid->hi_mm, grid->subdivisions) : models::Grid::from_nodes(grid->nodes_mm);
-  std::set<std::pair<int, int>> seen;  // a resumed campaign may measure a node twice
-  const double tol = 0.25 * g.step();
-  for (const json& n : nodes) {
-    const int i = g.node_near(n["alpha"].get<double>(), tol), j = g.node_near(n["beta"].get<double>(), tol);
-    if (i > 0 && j >= 0 && j < i) seen.insert({i, j});
-  }
-  const std::size_t required = static_cast<std::size_t>(g.n) * static_cast<std::size_t>(g.n + 1) / 2;
+  if (row.kind != domain::CampaignKind::fot) return out;
+  // The stored plan through the one parser; the coverage counted by the table builder the daemon
+  // fits with (a resumed campaign's node measured twice counts once), at the daemon's snapping.
+  const models::Grid g = domain::fot_grid(domain::parse_plan(json::parse(row.plan)));
+  models::OnlineTableBuilder builder(g, 0.25 * g.step());
+  for (const db::NodeInfo& n : measured) (void)builder.add({n.alpha, n.beta, n.force_alpha, n.force_alpha_beta});
   out["grid"] = {{"n", g.n}, {"lo_mm", g.lo}, {"hi_mm", g.hi}, {"nodes_mm", g.nodes()}};
-  out["identified"] = seen.size();
-  out["required"] = required;
-  out["coverage"] = static_cast<double>(seen.size()) / static_cast<double>(required);
+  out["identified"] = builder.identified_nodes();
+  out["required"] = builder.required_nodes();
+  out["coverage"] = static_cast<double>(builder.identified_nodes()) / static_cast<double>(builder.required_nodes());
   return out;
 }
 
-json events_json(db::Store& store, std::int64_t campaign) {
+json events_json(db::Reads& store, std::int64_t campaign) {
   json out = json::array();
   for (const auto& e : store.events(campaign))
     out.push_back({{"id", e.id}, {"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", event_detail(e.kind, e.detail)}});
   return out;
 }
 
-json loops_json(db::Store& store, std::int64_t campaign) {
+json loops_json(db::Reads& store, std::int64_t campaign) {
   json out = json::array();
   for (const db::LoopInfo& l : store.loops(campaign)) {
     json j = parse_or_text(l.figures_json);
@@ -101,7 +98,7 @@ json loops_json(db::Store& store, std::int64_t campaign) {
   return out;
 }
 
-json campaign_json(const control::DaemonInterface& d, db::Store& store, const db::CampaignRow& row, bool details) {
+json campaign_json(db::Reads& store, const db::CampaignRow& row, bool details) {
   json j{{"id", row.id},
          {"rig", store.rig_name(row.rig_id)},
          {"kind", domain::to_string(row.kind)},
@@ -140,7 +137,7 @@ json campaign_json(const control::DaemonInterface& d, db::Store& store, const db
   const auto rec = db::events_of<domain::RecommendationEvent>(store, row.id);
   j["recommendation"] = rec.empty() ? json(nullptr) : domain::detail_json(rec.back());
   if (row.kind == domain::CampaignKind::fot) {
-    const json nodes = nodes_json(d, store, row);
+    const json nodes = nodes_json(store, row);
     j["progress"] = {{"nodes", nodes["identified"]}, {"required", nodes["required"]}};
   }
   return j;
@@ -157,18 +154,18 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
           }
           json out = json::array();
           for (const auto& row : store.campaigns())
-            if (state.empty() || domain::to_string(row.state) == state) out.push_back(campaign_json(c.daemon, store, row, false));
+            if (state.empty() || domain::to_string(row.state) == state) out.push_back(campaign_json(store, row, false));
           send_json(res, out);
         }));
   post_route(s, c, "/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
                const PlanRequest r = decode_plan_request(body_object(req));
                const std::int64_t id = c.daemon.submit(r.rig, r.plan);
                res.set_header("Location", "/api/campaigns/" + std::to_string(id));
-               send_json(res, campaign_json(c.daemon, reader(c.db_path), campaign_or_404(reader(c.db_path), id), false), 201);
+               send_json(res, campaign_json(reader(c.db_path), campaign_or_404(reader(c.db_path), id), false), 201);
              }));
   s.Get(R"(/api/campaigns/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
           auto& store = reader(c.db_path);
-          send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, path_id(req)), true));
+          send_json(res, campaign_json(store, campaign_or_404(store, path_id(req)), true));
         }));
   // The specimen and notes, changed after submission (any state): {"specimen": ..., "notes": ...}.
   post_route(s, c, R"(/api/campaigns/(\d+)/record)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
@@ -181,7 +178,7 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
                  throw ApiError(404, "not found", e.what());
                }
                auto& store = reader(c.db_path);
-               send_json(res, campaign_json(c.daemon, store, campaign_or_404(store, row.id), false));
+               send_json(res, campaign_json(store, campaign_or_404(store, row.id), false));
              }));
   post_route(s, c, R"(/api/campaigns/(\d+)/([a-z_]+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
                const std::string verb = req.matches[2].str();
@@ -205,7 +202,7 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
         }));
   s.Get(R"(/api/campaigns/(\d+)/nodes)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
           auto& store = reader(c.db_path);
-          send_json(res, nodes_json(c.daemon, store, campaign_or_404(store, path_id(req))));
+          send_json(res, nodes_json(store, campaign_or_404(store, path_id(req))));
         }));
   s.Get(R"(/api/campaigns/(\d+)/loops)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
           auto& store = reader(c.db_path);

@@ -16,20 +16,20 @@
 
 namespace hystlab::web {
 namespace {
-db::RunInfo run_or_404(db::Store& store, std::int64_t id) {
+db::RunInfo run_or_404(db::Reads& store, std::int64_t id) {
   auto r = store.run(id);
   if (!r) throw ApiError(404, "not found", "no run " + std::to_string(id));
   return *r;
 }
 
-std::string table_document(db::Store& store, std::int64_t id) {
+std::string table_document(db::Reads& store, std::int64_t id) {
   auto doc = store.table_document(id);
   if (!doc) throw ApiError(404, "not found", "no table " + std::to_string(id));
   return *doc;
 }
 
 // The model named by the body: a stored table, a table document, or simplified-model parameters.
-std::unique_ptr<models::HysteresisModel> model_of(const json& body, db::Store& store) {
+std::unique_ptr<models::HysteresisModel> model_of(const json& body, db::Reads& store) {
   const ModelSource source = decode_model_source(body);
   if (source == ModelSource::stored_table) {
     const auto doc = models::table_from_json(table_document(store, body["table_id"].get<std::int64_t>()));
@@ -53,7 +53,7 @@ void stream_csv(httplib::Response& res, const std::string& db_path, std::int64_t
       *next = 0;
       return sink.write(head.data(), head.size());
     }
-    db::Store& store = reader(db_path);
+    db::Reads& store = reader(db_path);
     std::string chunk;
     const std::int64_t rows = db::append_csv_rows(store, run, shaker, *next, *next + db::kRunCsvWindow - 1, chunk);
     *next += db::kRunCsvWindow;
@@ -66,7 +66,7 @@ void stream_csv(httplib::Response& res, const std::string& db_path, std::int64_t
 }
 
 // A shaker's run (its campaign is a sine sweep).
-bool shaker_run(db::Store& store, const db::RunInfo& r) {
+bool shaker_run(db::Reads& store, const db::RunInfo& r) {
   const auto c = store.campaign(r.campaign);
   return c && c->kind == domain::CampaignKind::sine;
 }

@@ -11,7 +11,7 @@
 
 namespace hystlab::web {
 namespace {
-std::map<std::string, std::int64_t> campaigns_by_state(db::Store& store) {
+std::map<std::string, std::int64_t> campaigns_by_state(db::Reads& store) {
   std::map<std::string, std::int64_t> out;
   for (const domain::CampaignState s : domain::kCampaignStates) out[domain::to_string(s)] = 0;
   for (const auto& [state, n] : store.campaign_counts()) out[domain::to_string(state)] = n;

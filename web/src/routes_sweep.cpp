@@ -124,7 +124,7 @@ std::string points_csv(const std::vector<db::TransmissibilityInfo>& rows) {
 }
 }  // namespace
 
-json sweep_json(db::Store& store, const db::CampaignRow& row) {
+json sweep_json(db::Reads& store, const db::CampaignRow& row) {
   const auto rows = store.transmissibility(row.id);
   const double threshold = jump_threshold(row.plan);
   json points = json::array();

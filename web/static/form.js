@@ -2,56 +2,39 @@
 // (in the form's words, beside the input at fault), the server's own plan errors mapped back to
 // the input its `field` names, and a preview of the plan (duration, nodes, peak speed and force)
 // from POST /api/plans/preview as the form changes.
-import { post } from './api.js';
+import { api, post } from './api.js';
 import { el, num, round2, count, duration } from './fmt.js';
 
-// Each input: where it goes in the plan, its words and units, and what it accepts (the plan
-// parser's limits, daemon/src/plan.cpp). `optional` fields may be left blank (the rig decides).
-const FIELDS = [
-  { name: 'lo', group: 'fot', label: 'δmin', unit: 'mm', value: '0', min: -1e4, max: 1e4, plan: 'range_mm' },
-  { name: 'hi', group: 'fot', label: 'δmax', unit: 'mm', value: '4', min: -1e4, max: 1e4, plan: 'range_mm' },
-  { name: 'n', group: 'fot', label: 'subdivisions n', value: '8', int: true, min: 1, max: 200, plan: 'subdivisions' },
-  { name: 'rate', group: 'fot', label: 'ramp rate', unit: 'mm/s', value: '0.5', min: 1e-4, max: 1e3, plan: 'ramp_rate_mm_s' },
-  { name: 'dwell', group: 'fot', label: 'dwell', unit: 's', value: '0.2', min: 0, max: 3600, plan: 'dwell_s' },
-  { name: 'training', group: 'fot', label: 'training cycles (at most)', value: '0', int: true, min: 0, max: 1000, plan: 'training.max_cycles' },
-  { name: 'stable', group: 'fot', label: 'train until energy changes less than', unit: '% per cycle', value: '', optional: true, placeholder: 'all cycles', min: 0.01, max: 100, plan: 'training.until.energy_change' },
-  { name: 'reversals', group: 'fot', label: 'validation reversals (0: none)', value: '12', int: true, min: 0, max: 10000, plan: 'validation.reversals' },
-  { name: 'plateaus', group: 'fot', label: 'plateau forces at', unit: 'mm', value: '', optional: true, list: true, placeholder: 'none', min: -1e4, max: 1e4, plan: 'plateaus_mm', type: 'text' },
-  { name: 'repeats', group: 'fot', label: 'repeats', value: '1', int: true, min: 1, max: 100, plan: 'repeats' },
-  // A sine sweep: log-spaced steps from … to, or a list of its own; each amplitude swept in the
-  // direction(s) given. Defaults that show the simulated isolator's resonance (17.7 Hz) and its
-  // amplitude dependence in about 4 minutes.
-  { name: 'fromhz', group: 'sine', label: 'sweep from', unit: 'Hz', value: '5', min: 1e-3, max: 1000, plan: 'sweep.from_hz', sweep: true },
-  { name: 'tohz', group: 'sine', label: 'sweep to', unit: 'Hz', value: '60', min: 1e-3, max: 1000, plan: 'sweep.to_hz', sweep: true },
-  { name: 'steps', group: 'sine', label: 'steps (log spaced)', value: '24', int: true, min: 2, max: 1000, plan: 'sweep.steps', sweep: true },
-  { name: 'freqs', group: 'sine', label: 'or these frequencies', unit: 'Hz', value: '', optional: true, list: true, placeholder: 'the steps above', min: 1e-3, max: 1000, plan: 'frequencies_hz', type: 'text' },
-  { name: 'direction', group: 'sine', label: 'direction', value: 'up-down', options: [['up', 'up'], ['down', 'down'], ['up-down', 'up-down']], plan: 'direction' },
-  { name: 'amps', group: 'sine', label: 'base amplitudes (peak)', unit: 'mm', value: '0.005, 0.05', list: true, min: 1e-4, max: 100, plan: 'amplitudes_mm', type: 'text' },
-  { name: 'settlechange', group: 'sine', label: 'settle until the response changes less than', unit: '%', value: '2', optional: true, placeholder: 'settle cycles', min: 0.01, max: 100, plan: 'settle.change' },
-  { name: 'settle', group: 'sine', label: 'or settle cycles (instead)', value: '', optional: true, int: true, placeholder: 'until settled', min: 0, max: 100000, plan: 'settle_cycles' },
-  { name: 'measured', group: 'sine', label: 'measured cycles', value: '10', int: true, min: 1, max: 100000, plan: 'measured_cycles' },
-  { name: 'tol', group: 'sine', label: 'control tolerance', unit: '%', value: '5', min: 0.01, max: 100, plan: 'control.tolerance' },
-  { name: 'warn', group: 'sine', label: 'control warning beyond', unit: '%', value: '', optional: true, placeholder: "daemon's: 10", min: 0.01, max: 1000, plan: 'control.warning' },
-  { name: 'abortpct', group: 'sine', label: 'control abort beyond', unit: '%', value: '', optional: true, placeholder: "daemon's: 30", min: 0.01, max: 1000, plan: 'control.abort' },
-  { name: 'hz', group: 'common', label: 'sample rate', unit: 'Hz', value: '1000', min: 1, max: 10000, plan: 'sample_rate_hz' },
-  { name: 'dlo', group: 'limits', label: 'lower displacement limit', unit: 'mm', value: '', optional: true, placeholder: 'δmin − 0.5', min: -1e4, max: 1e4, plan: 'limits.displacement_mm' },
-  { name: 'dhi', group: 'limits', label: 'upper displacement limit', unit: 'mm', value: '', optional: true, placeholder: 'δmax + 0.5', min: -1e4, max: 1e4, plan: 'limits.displacement_mm' },
-  { name: 'force', group: 'limits', label: 'force limit', unit: 'N', value: '400', optional: true, placeholder: "rig's", min: 1e-6, max: 1e7, plan: 'limits.force_N' },
-  { name: 'ratelim', group: 'limits', label: 'rate limit', unit: 'mm/s', value: '', optional: true, placeholder: "rig's", min: 1e-6, max: 1e4, plan: 'limits.rate_mm_s' },
-  // What the lab records with the campaign (shown in the lists, the report and the exports; it
-  // can be changed later under the plots).
-  { name: 'specimen', group: 'record', label: 'specimen', value: '', optional: true, text: true, maxlength: 200, placeholder: 'e.g. NiTi spring S-07', plan: 'specimen' },
-  { name: 'notes', group: 'record', label: 'notes', value: '', optional: true, text: true, textarea: true, maxlength: 4000, placeholder: 'operator, set-up, anything seen', plan: 'notes' },
-];
+// The inputs come from the daemon (GET /api/plans/form): the plan parser's own table of fields
+// (protocols/domain/src/plan_fields.cpp) with where each goes in the plan, its words and unit,
+// what it accepts and what the form proposes. A field given an input there appears here and is
+// sent at its path; the page has no list of its own.
+function inputsOf(table) {
+  return table.fields.filter(f => f.group).map(f => ({
+    name: f.input, group: f.group, label: f.label || f.words, unit: f.unit, value: f.value, placeholder: f.placeholder, optional: f.optional,
+    min: f.min, max: f.max, plan: f.path, kind: f.type, int: f.type === 'integer', list: f.type === 'list', text: f.type === 'text',
+    textarea: f.type === 'text' && f.max > 1000, maxlength: f.type === 'text' ? f.max : null,
+    options: f.type === 'choice' ? f.choices.map(c => [c, c]) : null, sweep: f.path.startsWith('sweep.'),
+  }));
+}
 const GROUP_TITLES = { fot: null, sine: null, common: null, limits: 'Limits (blank: the rig’s own)', record: 'Record (optional)' };
-// The server's field names, as the form says them (for its messages).
-const WORDS = [['sweep.from_hz', 'sweep from'], ['sweep.to_hz', 'sweep to'], ['sweep.steps', 'steps'], ['frequencies_hz', 'frequencies'],
-  ['amplitudes_mm', 'amplitudes'], ['settle.change', 'settle change'], ['settle_cycles', 'settle cycles'], ['control.tolerance', 'control tolerance'],
-  ['control.warning', 'control warning'], ['control.abort', 'control abort'], ['limits.displacement_mm', 'displacement limits'], ['limits.safe_position_mm', 'safe position'],
-  ['limits.force_N', 'force limit'], ['limits.rate_mm_s', 'rate limit'], ['range_mm', 'δmin … δmax'],
-  ['training.until.energy_change', 'energy change per cycle'], ['training.until.consecutive', 'cycles in a row'],
-  ['training.max_cycles', 'training cycles'], ['validation.reversals', 'validation reversals'], ['validation.rate_mm_s', 'validation rate'],
-  ...FIELDS.filter(f => !f.plan.includes('.') && f.plan !== 'range_mm').map(f => [f.plan, f.label])];
+// The server's field names, as the form says them (for its messages): every field's words, the
+// longest names first (settle_cycles before settle).
+let WORDS = [];
+function wordsOf(table) {
+  const pairs = [['range_mm', 'δmin … δmax'], ['limits.displacement_mm', 'displacement limits']];
+  for (const f of table.fields) if (!f.path.includes('[')) pairs.push([f.path, f.words]);
+  return pairs.sort((a, b) => b[0].length - a[0].length);
+}
+const base = path => path.replace(/\[\d+\]$/, '');
+// Sets plan[a][b]... at "a.b" (or "a[1]": one end of a pair).
+function setPath(plan, path, value) {
+  const keys = path.split('.');
+  let o = plan;
+  for (const k of keys.slice(0, -1)) o = (o[k] = o[k] || {});
+  const last = keys[keys.length - 1], m = /^(.*)\[(\d+)\]$/.exec(last);
+  if (m) { o[m[1]] = o[m[1]] || []; o[m[1]][Number(m[2])] = value; } else o[last] = value;
+}
 
 export function humanize(text) {
   let s = String(text || '').replace(/^plan: /, '');
@@ -63,7 +46,7 @@ export class PlanForm {
   constructor(form, { rigPanel, onSubmitted }) {
     this.form = form; this.rigPanel = rigPanel; this.onSubmitted = onSubmitted;
     this.previewSeq = 0; this.previewTimer = null;
-    this.build();
+    this.fields = [];
     this.error = form.querySelector('#form-error');
     this.preview = form.querySelector('#preview');
     this.why = form.querySelector('#submit-why');
@@ -73,18 +56,35 @@ export class PlanForm {
     form.addEventListener('input', e => { this.clearField(e.target.name); this.error.textContent = ''; this.schedulePreview(); });
     form.addEventListener('change', () => this.schedulePreview());
     form.addEventListener('submit', e => { e.preventDefault(); this.send(); });
-    this.showKind();
+    this.ready = this.load();
   }
-  // The inputs, from FIELDS: label with unit, input, and the message slot beside it.
+  // The daemon's table of plan fields, then the inputs; again after a failure (a daemon starting).
+  async load() {
+    for (let wait = 500; ; wait = Math.min(2 * wait, 5000)) {
+      try {
+        const table = await api('/api/plans/form');
+        this.fields = inputsOf(table); WORDS = wordsOf(table);
+        break;
+      } catch (err) {
+        this.error.textContent = `the form's fields could not be read from the daemon (${err.message}); trying again`;
+        await new Promise(r => setTimeout(r, wait));
+      }
+    }
+    this.error.textContent = '';
+    this.build();
+    this.showKind();
+    this.schedulePreview();
+  }
+  // The inputs, from the fields: label with unit, input, and the message slot beside it.
   build() {
     for (const g of Object.keys(GROUP_TITLES)) {
       const box = this.form.querySelector(`fieldset.${g}`);
       if (GROUP_TITLES[g]) box.append(el('legend', { text: GROUP_TITLES[g] }));
-      for (const f of FIELDS.filter(x => x.group === g)) {
+      for (const f of this.fields.filter(x => x.group === g)) {
         const id = 'f-' + f.name;
         const input = f.options ? el('select', { id, name: f.name, 'aria-describedby': id + '-msg' }, ...f.options.map(([v, text]) => el('option', { value: v, text })))
           : f.textarea ? el('textarea', { id, name: f.name, rows: 2, maxlength: f.maxlength, placeholder: f.placeholder, 'aria-describedby': id + '-msg' })
-          : el('input', { id, name: f.name, type: f.type || 'text', inputmode: f.type ? null : 'decimal',
+          : el('input', { id, name: f.name, type: 'text', inputmode: f.list || f.text ? null : 'decimal',
                           value: f.value, placeholder: f.placeholder || null, 'aria-describedby': id + '-msg', autocomplete: 'off', maxlength: f.maxlength || null });
         if (f.options) input.value = f.value;
         box.append(el('div', { class: 'field' + (f.text ? ' text' : '') },
@@ -134,7 +134,7 @@ export class PlanForm {
     const key = String(field || '').replace(/^plan\./, '').replace(/\[\d+\]$/, '');
     if (key === 'range_mm') return ['lo', 'hi'];
     if (key === 'limits.displacement_mm' || key === 'limits.safe_position_mm') return ['dlo', 'dhi'];
-    const f = FIELDS.find(x => x.plan === key && !this.inputOf(x.name).closest('fieldset').hidden);
+    const f = this.fields.find(x => base(x.plan) === key && !this.inputOf(x.name).closest('fieldset').hidden);
     if (f) return [f.name];
     // Fields without an input of their own: the nearest input that sets them.
     if (key === 'sweep' || key.startsWith('sweep.')) return [this.inputOf('freqs').value.trim() ? 'freqs' : 'fromhz'];
@@ -167,7 +167,7 @@ export class PlanForm {
     for (const n of pair) { this.inputOf(n).removeAttribute('aria-invalid'); this.form.querySelector(`#f-${n}-msg`).textContent = ''; }
   }
   clearAll() {
-    for (const f of [...FIELDS, { name: 'json' }]) { this.inputOf(f.name).removeAttribute('aria-invalid'); this.form.querySelector(`#f-${f.name}-msg`).textContent = ''; }
+    for (const f of [...this.fields, { name: 'json' }]) { this.inputOf(f.name).removeAttribute('aria-invalid'); this.form.querySelector(`#f-${f.name}-msg`).textContent = ''; }
     if (this.error) this.error.textContent = '';
   }
   // A 400 from the server: its `field` (or the "plan: FIELD ..." of its detail) marks the input.
@@ -188,11 +188,12 @@ export class PlanForm {
     if (form.json.value.trim()) {
       try { return { plan: JSON.parse(form.json.value) }; } catch (e) { return { errors: [['json', `the pasted plan is not valid JSON (${e.message})`]] }; }
     }
+    if (!this.fields.length) return { errors: [[null, 'the form is still being read from the daemon']] };
     const sine = form.kind.value === 'sine';
     const groups = sine ? ['sine', 'common', 'record'] : ['fot', 'common', 'limits', 'record'];
     const errors = [], v = {};
     const list = sine && this.inputOf('freqs').value.trim() !== '';  // a list of frequencies: the steps' fields are not used
-    for (const f of FIELDS.filter(x => groups.includes(x.group) && !(list && x.sweep))) {
+    for (const f of this.fields.filter(x => groups.includes(x.group) && !(list && x.sweep))) {
       const raw = this.inputOf(f.name).value.trim();
       const what = f.label;
       if (f.options) { v[f.name] = raw; continue; }
@@ -203,7 +204,8 @@ export class PlanForm {
       const unit = f.unit ? ' ' + f.unit : '';
       if (vals.some(x => !Number.isFinite(x))) errors.push([f.name, f.list ? `${what}: each must be a number (separate them with commas)` : `${what} must be a number`]);
       else if (f.int && vals.some(x => !Number.isInteger(x))) errors.push([f.name, `${what} must be a whole number`]);
-      else if (vals.some(x => x < f.min || x > f.max)) errors.push([f.name, `${what} must be from ${num(f.min)} to ${num(f.max)}${unit}`]);
+      else if (f.kind === 'percent' && vals.some(x => !(x > f.min) || x > f.max)) errors.push([f.name, `${what} must be above ${num(f.min)} and at most ${num(f.max)}${unit}`]);
+      else if (vals.some(x => x < (f.plan === 'validation.reversals' ? 0 : f.min) || x > f.max)) errors.push([f.name, `${what} must be from ${num(f.min)} to ${num(f.max)}${unit}`]);
       else v[f.name] = f.list ? vals : vals[0];
     }
     if (!sine) {
@@ -215,26 +217,22 @@ export class PlanForm {
     }
     if (sine) errors.push(...sineErrors(v));
     if (v.specimen && v.specimen.includes('\n')) errors.push(['specimen', 'specimen must be one line']);
+    if (v.reversals === 1) errors.push(['reversals', 'at least 2 reversals, or 0 for no validation run']);
     if (errors.length) return { errors };
-    const record = plan => { if (v.specimen) plan.specimen = v.specimen; if (v.notes) plan.notes = v.notes; return plan; };
-    if (sine) return { plan: record(sinePlan(v)) };
-    const limits = {};
-    if (v.dlo != null) limits.displacement_mm = [v.dlo, v.dhi];
-    if (v.force != null) limits.force_N = v.force;
-    if (v.ratelim != null) limits.rate_mm_s = v.ratelim;
-    const plan = { kind: 'fot', range_mm: [v.lo, v.hi], subdivisions: v.n, ramp_rate_mm_s: v.rate, dwell_s: v.dwell, sample_rate_hz: v.hz };
-    if (v.training) {
-      plan.training = { max_cycles: v.training };
+    // Each input's value at its field's path; then what chooses between fields.
+    const plan = { kind: sine ? 'sine' : 'fot' };
+    const own = new Set(sine ? (v.settle != null ? ['settlechange'] : []) : ['training', 'stable', 'reversals']);
+    for (const f of this.fields.filter(x => groups.includes(x.group) && !(list && x.sweep) && v[x.name] != null && !own.has(x.name)))
+      setPath(plan, f.plan, f.kind === 'percent' ? `${v[f.name]} %` : v[f.name]);
+    if (plan.sweep) plan.sweep.spacing = 'log';
+    if (!sine && v.training) {
       // Until stable: the energy's change per cycle below the given %, the peak force's below 0.5 %, 3 cycles in a row.
-      if (v.stable != null) plan.training.until = { energy_change: v.stable, peak_force_change: 0.5, consecutive: Math.min(3, Math.max(1, v.training - 1)) };
+      if (v.stable != null) plan.training = { max_cycles: v.training, until: { energy_change: v.stable, peak_force_change: 0.5, consecutive: Math.min(3, Math.max(1, v.training - 1)) } };
+      else plan.training_cycles = v.training;
     }
-    if (v.reversals === 1) return { errors: [['reversals', 'at least 2 reversals, or 0 for no validation run']] };
-    if (v.reversals === 0) plan.validation = false;
-    else if (v.reversals !== 12) plan.validation = { reversals: v.reversals };
-    if (v.plateaus && v.plateaus.length) plan.plateaus_mm = v.plateaus;
-    if (v.repeats !== 1) plan.repeats = v.repeats;
-    if (Object.keys(limits).length) plan.limits = limits;
-    return { plan: record(plan) };
+    if (!sine && v.reversals === 0) plan.validation = false;
+    else if (!sine && v.reversals !== 12) plan.validation = { reversals: v.reversals };
+    return { plan };
   }
   body(plan) { const b = { plan }; if (this.form.rig.value) b.rig = this.form.rig.value; return b; }
   showErrors(errors) {
@@ -280,7 +278,7 @@ export class PlanForm {
   }
 }
 
-// A sine plan's own checks (the daemon's, daemon/src/sine_plan.cpp), in the form's words.
+// A sine plan's own checks (the parser's, protocols/domain/src/sine_plan.cpp), in the form's words.
 function sineErrors(v) {
   const errors = [], highest = v.freqs ? Math.max(...v.freqs) : v.tohz;
   if (!v.freqs && v.fromhz != null && v.tohz != null && !(v.tohz > v.fromhz)) errors.push(['tohz', 'sweep to must be above sweep from']);
@@ -291,19 +289,6 @@ function sineErrors(v) {
   if (v.warn != null && v.tol != null && v.warn < v.tol) errors.push(['warn', 'the control warning must be at least the tolerance']);
   if (v.abortpct != null && !(v.abortpct > Math.max(v.warn ?? 10, v.tol ?? 0))) errors.push(['abortpct', `the control abort must be above the warning (${num(v.warn ?? 10)} %)`]);
   return errors;
-}
-
-// The plan from the checked values: a settle criterion unless settle cycles are given; the
-// control's warning and abort bands left to the daemon when blank.
-function sinePlan(v) {
-  const plan = { kind: 'sine', direction: v.direction, amplitudes_mm: v.amps, measured_cycles: v.measured, sample_rate_hz: v.hz };
-  if (v.freqs) plan.frequencies_hz = v.freqs; else plan.sweep = { from_hz: v.fromhz, to_hz: v.tohz, steps: v.steps, spacing: 'log' };
-  if (v.settle != null) plan.settle_cycles = v.settle;
-  else if (v.settlechange != null) plan.settle = { change: `${v.settlechange} %` };
-  plan.control = { tolerance: `${v.tol} %` };
-  if (v.warn != null) plan.control.warning = `${v.warn} %`;
-  if (v.abortpct != null) plan.control.abort = `${v.abortpct} %`;
-  return plan;
 }
 
 // "about 2 min 10 s · 45 nodes · peak speed 0.5 mm/s · peak force ≈ 380 N (from table #3)"; a sweep: steps and peak acceleration.

@@ -5,7 +5,7 @@
 // with the load, so it is learnt as it goes, and a new step starts from the last one learnt.
 #include <cstdint>
 
-#include "hystlab/daemon/sine_plan.hpp"
+#include "hystlab/domain/sine_plan.hpp"
 
 namespace hystlab::daemon {
 
@@ -21,7 +21,7 @@ struct ControlVerdict {
 
 class BaseControl {
  public:
-  explicit BaseControl(const SineControl& c) noexcept : c_(c) {}
+  explicit BaseControl(const domain::SineControl& c) noexcept : c_(c) {}
   // The drive to start a step at: start_level × the demand over the response last learnt (open loop: the demand).
   [[nodiscard]] double start(double demand_mm) const noexcept;
   // A window measured at `drive` gave `measured`: its band and the drive for the next window.
@@ -30,7 +30,7 @@ class BaseControl {
   [[nodiscard]] double response() const noexcept { return response_; }  // base per unit of drive
 
  private:
-  SineControl c_;
+  domain::SineControl c_;
   double response_ = 1.0;
 };
 

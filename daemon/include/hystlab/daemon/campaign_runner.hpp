@@ -16,11 +16,11 @@
 #include "hystlab/daemon/clock.hpp"
 #include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/live_feed.hpp"
-#include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/run_series.hpp"
 #include "hystlab/daemon/supervisor.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/domain/campaign.hpp"
+#include "hystlab/domain/plan.hpp"
 #include "hystlab/drivers/rig.hpp"
 #include "hystlab/models/fot_node.hpp"
 #include "hystlab/models/online_table_builder.hpp"
@@ -62,7 +62,7 @@ enum class CampaignEnd { none, completed, failed, aborted, interrupted };
 struct CampaignJob {
   std::int64_t id = 0;
   double submitted_mono = 0;  // monotonic seconds at submit() (0: dispatched from the database)
-  Plan plan;
+  domain::Plan plan;
   std::shared_ptr<const IsolatorModel> isolator;  // a shaker's, when the daemon has a model of it (sine)
   std::vector<models::FotNode> prior_nodes;
   RunSeries prior_series;
@@ -92,7 +92,7 @@ struct RunnerResult {
 // What finishing a run needs, handed off the acquisition thread.
 struct FinishJob {
   std::int64_t campaign = 0;
-  Plan plan;
+  domain::Plan plan;
   RunnerResult result;
   std::shared_ptr<const models::OnlineTableBuilder> builder;     // every node of the campaign (fot)
   RunSeries series;                                              // every sample of every campaign run of the campaign (fot, waveform)

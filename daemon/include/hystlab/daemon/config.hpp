@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "hystlab/control/http_config.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/realtime.hpp"
+#include "hystlab/domain/envelope.hpp"
 
 namespace hystlab::daemon {
 
@@ -48,8 +48,8 @@ struct RigEntry {
   double time_scale = 1.0;
   bool simulated = false;
   SimulatorOptions sim;
-  RigEnvelope envelope;             // "envelope": what the rig can do (plans are checked against it)
-  SupervisionSettings supervision;  // "supervision": dead band, lag, settle, mode, heartbeat, ...
+  domain::RigEnvelope envelope;             // "envelope": what the rig can do (plans are checked against it)
+  domain::SupervisionSettings supervision;  // "supervision": dead band, lag, settle, mode, heartbeat, ...
   // "isolator" (a shaker's; a simulated shaker's is the simulator's own): sine points are predicted with it
   std::shared_ptr<const IsolatorModel> isolator;
 };

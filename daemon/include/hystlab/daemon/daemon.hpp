@@ -16,12 +16,12 @@
 #include "hystlab/control/http_config.hpp"
 #include "hystlab/control/values.hpp"
 #include "hystlab/daemon/config.hpp"
-#include "hystlab/daemon/envelope.hpp"
 #include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/live_feed.hpp"
-#include "hystlab/daemon/plan.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/db/sample_writer.hpp"
+#include "hystlab/domain/envelope.hpp"
+#include "hystlab/domain/plan.hpp"
 #include "hystlab/drivers/io_health.hpp"
 
 namespace hystlab::daemon {
@@ -64,9 +64,9 @@ class Daemon {
   // what is wrong (the plan's field, an unknown rig, a plan the rig cannot run).
   std::int64_t submit(const std::string& rig_name, const nlohmann::json& plan);
   // What submit checks, without queuing: the plan parsed, for the rig (its index) it would run on.
-  [[nodiscard]] std::pair<Plan, std::size_t> check_plan(const std::string& rig_name, const nlohmann::json& plan) const;
+  [[nodiscard]] std::pair<domain::Plan, std::size_t> check_plan(const std::string& rig_name, const nlohmann::json& plan) const;
   // The limits a checked plan runs under on rig k: the tighter of the plan's and the rig's.
-  [[nodiscard]] Limits applied_limits(const Plan& plan, std::size_t k) const;
+  [[nodiscard]] domain::Limits applied_limits(const domain::Plan& plan, std::size_t k) const;
   // A running campaign's command goes straight to its rig's thread (never through the database,
   // which may be busy); a queued or held one's through the main loop. An e-stop latches the
   // campaign's rig first (as rig_command), whatever the campaign's state.

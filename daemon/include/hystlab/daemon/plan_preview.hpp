@@ -5,7 +5,7 @@
 #include <string>
 
 #include "hystlab/control/values.hpp"
-#include "hystlab/daemon/plan.hpp"
+#include "hystlab/domain/plan.hpp"
 #include "hystlab/models/hysteresis_model.hpp"
 
 namespace hystlab::daemon {
@@ -14,6 +14,6 @@ using control::PlanPreview;
 
 // model: the force model for the rig (the newest table, or the simplified model); null for a
 // shaker plan. The model is reset and driven along the plan's input.
-[[nodiscard]] PlanPreview preview_plan(const Plan& plan, models::HysteresisModel* model);
+[[nodiscard]] PlanPreview preview_plan(const domain::Plan& plan, models::HysteresisModel* model);
 
 }  // namespace hystlab::daemon

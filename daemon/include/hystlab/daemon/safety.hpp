@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "hystlab/daemon/plan.hpp"
+#include "hystlab/domain/plan.hpp"
 
 namespace hystlab::daemon {
 
@@ -13,16 +13,16 @@ class SafetyEnvelope {
  public:
   // rate_window_s: the rate is measured over at least this much rig time. Two reads can come
   // microseconds apart yet straddle one of the rig's own steps; their quotient is no velocity.
-  explicit SafetyEnvelope(Limits limits, double rate_window_s = 0.02) : l_(limits), window_(rate_window_s) {}
+  explicit SafetyEnvelope(domain::Limits limits, double rate_window_s = 0.02) : l_(limits), window_(rate_window_s) {}
   // A reason to trip, or nothing. asked_s: rig seconds when the sample was asked for;
   // answered_s: when its answer came. A polled value was taken somewhere between the two; a
   // sample timed by the controller's own clock has them equal.
   [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double asked_s, double answered_s);
   [[nodiscard]] std::optional<std::string> check(double displacement_mm, double force_N, double t_s) { return check(displacement_mm, force_N, t_s, t_s); }
-  [[nodiscard]] const Limits& limits() const noexcept { return l_; }
+  [[nodiscard]] const domain::Limits& limits() const noexcept { return l_; }
 
  private:
-  Limits l_;
+  domain::Limits l_;
   double window_, ref_x_ = 0, ref_t_ = 0;
   bool have_ref_ = false;
 };

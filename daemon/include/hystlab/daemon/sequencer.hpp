@@ -5,7 +5,7 @@
 #include <optional>
 #include <vector>
 
-#include "hystlab/daemon/plan.hpp"
+#include "hystlab/domain/plan.hpp"
 
 namespace hystlab::daemon {
 
@@ -21,12 +21,12 @@ struct Segment {
 // each i = 1..n: rise to δ_i, descend to δmin. Starts with a preamble to δmin. Then, when the plan
 // asks (the default), the validation input: validation_points, each a validation segment.
 // Training holds training.max_cycles cycles: a rule that ends it early skips the rest.
-[[nodiscard]] std::vector<Segment> fot_schedule(const Plan& plan);
-[[nodiscard]] std::vector<Segment> waveform_schedule(const Plan& plan);
+[[nodiscard]] std::vector<Segment> fot_schedule(const domain::Plan& plan);
+[[nodiscard]] std::vector<Segment> waveform_schedule(const domain::Plan& plan);
 // The validation input (the paper's Fig. 18): from δmin of its range, `reversals` turning points
 // drawn from the plan's seed, alternately up and down, each at least a tenth of the range away
 // from the last, then back to δmin. The same plan gives the same points on every machine.
-[[nodiscard]] std::vector<double> validation_points(const Validation& v);
+[[nodiscard]] std::vector<double> validation_points(const domain::Validation& v);
 
 struct SetpointCommand {
   double target_mm, rate_mm_s;

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "hystlab/daemon/plan.hpp"
+#include "hystlab/domain/plan.hpp"
 
 namespace hystlab::daemon {
 
@@ -21,7 +21,7 @@ struct ShakedownStep {
 
 class ShakedownRule {
  public:
-  explicit ShakedownRule(const Training& t) : t_(t) {}
+  explicit ShakedownRule(const domain::Training& t) : t_(t) {}
   ShakedownStep add(double peak_force_N, double energy_Nmm) noexcept;
   [[nodiscard]] int cycles() const noexcept { return cycles_; }
   [[nodiscard]] bool stable() const noexcept { return stable_; }
@@ -29,7 +29,7 @@ class ShakedownRule {
   [[nodiscard]] std::string summary() const;
 
  private:
-  Training t_;
+  domain::Training t_;
   int cycles_ = 0, consecutive_ = 0;
   bool stable_ = false;
   double last_peak_ = 0, last_energy_ = 0;

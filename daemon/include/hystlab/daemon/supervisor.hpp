@@ -12,7 +12,7 @@
 #include <string_view>
 #include <system_error>
 
-#include "hystlab/daemon/envelope.hpp"
+#include "hystlab/domain/envelope.hpp"
 #include "hystlab/drivers/rig.hpp"
 
 namespace hystlab::daemon {
@@ -38,13 +38,13 @@ struct StatusView {
 class Supervisor {
  public:
   using Observer = std::function<void(const RigTransition&)>;
-  Supervisor(drivers::Rig& rig, SupervisionSettings settings, bool shaker, Observer observer = {});
+  Supervisor(drivers::Rig& rig, domain::SupervisionSettings settings, bool shaker, Observer observer = {});
 
   [[nodiscard]] RigState state() const noexcept { return state_; }
   [[nodiscard]] bool latched() const noexcept { return state_ == RigState::estopped || state_ == RigState::faulted; }
   [[nodiscard]] const std::string& latch_reason() const noexcept { return latch_reason_; }
   [[nodiscard]] std::uint16_t fault_code() const noexcept { return fault_code_; }
-  [[nodiscard]] const SupervisionSettings& settings() const noexcept { return s_; }
+  [[nodiscard]] const domain::SupervisionSettings& settings() const noexcept { return s_; }
   [[nodiscard]] std::uint64_t link_losses() const noexcept { return link_losses_; }
   // A campaign counts its time from its own start; the supervisor's deadlines (heartbeat, verify,
   // reset) run on the rig's time across campaigns: offset = the campaign's start in rig time.
@@ -131,7 +131,7 @@ class Supervisor {
   drivers::Rig* rig_;
   double offset_ = 0;
   double time_scale_ = 1.0;
-  SupervisionSettings s_;
+  domain::SupervisionSettings s_;
   bool shaker_;
   Observer observer_;
   RigState state_ = RigState::disconnected;

@@ -48,8 +48,6 @@ class DaemonInterface {
   // What submit checks, and what the plan would do; model: the force model for the peak force
   // (load frames), or null.
   [[nodiscard]] virtual PlanPreview preview(const std::string& rig, const nlohmann::json& plan, models::HysteresisModel* model) const = 0;
-  // A stored FOT plan's grid (nullopt for other kinds); throws PlanError for a plan it cannot read.
-  [[nodiscard]] virtual std::optional<FotGrid> fot_grid(const nlohmann::json& stored_plan) const = 0;
   // A campaign's command. conflict when it does not apply to the campaign's state (the reason
   // says why); an e-stop latches the campaign's rig as rig_command does, then ends the campaign.
   virtual CommandOutcome command(std::int64_t campaign, CampaignCommand c) = 0;

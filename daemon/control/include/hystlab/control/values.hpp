@@ -12,18 +12,13 @@
 #include <vector>
 
 #include "hystlab/domain/campaign.hpp"
+#include "hystlab/domain/plan_error.hpp"
 #include "hystlab/domain/signals.hpp"
 
 namespace hystlab::control {
 
-// A plan the daemon refuses: what (in the form's words: "ramp rate must be between 0.0001 and
-// 20 mm/s"), and the plan's field alone ("ramp_rate_mm_s", "limits.force_N") so that a form
-// can mark the input it came from.
-struct PlanError : std::invalid_argument {
-  explicit PlanError(const std::string& what) : std::invalid_argument(what) {}
-  PlanError(std::string field_name, const std::string& what) : std::invalid_argument(what), field(std::move(field_name)) {}
-  std::string field;
-};
+// A plan the daemon refuses (the domain's: what() in the form's words, field the plan's field).
+using domain::PlanError;
 
 struct RigInfo {
   std::int64_t id = 0;
@@ -132,14 +127,6 @@ struct PlanPreview {
   double time_scale = 1;
   // The plan's limits that the rig's envelope tightens, in sentences (what applies instead).
   std::vector<std::string> limits_applied;
-};
-
-// A FOT plan's grid: its nodes are on n = subdivisions steps of [lo_mm, hi_mm], or nodes_mm (a
-// grid of its own, n + 1 nodes from lo_mm to hi_mm).
-struct FotGrid {
-  double lo_mm = 0, hi_mm = 0;
-  int subdivisions = 0;
-  std::vector<double> nodes_mm;  // empty: uniform
 };
 
 }  // namespace hystlab::control

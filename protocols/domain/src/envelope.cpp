@@ -1,11 +1,11 @@
-#include "hystlab/daemon/envelope.hpp"
+#include "hystlab/domain/envelope.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
 
-namespace hystlab::daemon {
+namespace hystlab::domain {
 namespace {
 using nlohmann::json;
 
@@ -182,4 +182,4 @@ Limits check_plan_against(const Plan& p, const RigEnvelope& e, const Supervision
   return l;
 }
 
-}  // namespace hystlab::daemon
+}  // namespace hystlab::domain

@@ -1,11 +1,11 @@
-#include "hystlab/daemon/sine_plan.hpp"
+#include "hystlab/domain/sine_plan.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "plan_fields.hpp"
+#include "field_reader.hpp"
 
-namespace hystlab::daemon {
+namespace hystlab::domain {
 using nlohmann::json;
 
 const char* to_string(SweepDirection d) noexcept {
@@ -27,9 +27,7 @@ std::vector<double> frequency_list(const json& a) {
   if (!a.is_array() || a.empty() || a.size() > 1000) fields::fail("frequencies_hz", "must be an array of 1 to 1000 frequencies");
   std::vector<double> out;
   for (std::size_t k = 0; k < a.size(); ++k) {
-    if (!a[k].is_number() || !(a[k].get<double>() > 0) || a[k].get<double>() > 1000)
-      fields::fail("frequencies_hz[" + std::to_string(k) + "]", "must be a frequency above 0 and at most 1000 Hz");
-    out.push_back(a[k].get<double>());
+    out.push_back(fields::element(a[k], "frequencies_hz", "frequencies_hz[" + std::to_string(k) + "]"));
   }
   std::sort(out.begin(), out.end());  // the direction says the order
   if (std::adjacent_find(out.begin(), out.end()) != out.end()) fields::fail("frequencies_hz", "must not repeat a frequency");
@@ -40,19 +38,19 @@ void parse_sweep(const json& s, SinePlan& p) {
   if (!s.is_object()) fields::fail("sweep", "must be an object: {\"from_hz\": 5, \"to_hz\": 80, \"steps\": 24} or {..., \"rate_oct_min\": 2}");
   fields::only(s, "sweep.", {"from_hz", "to_hz", "steps", "spacing", "rate_oct_min", "rate_hz_s"});
   if (!s.contains("from_hz") || !s.contains("to_hz")) fields::fail("sweep", "needs from_hz and to_hz");
-  p.from_hz = fields::number(s, "from_hz", 0, 1e-3, 1000, "sweep.");
-  p.to_hz = fields::number(s, "to_hz", 0, 1e-3, 1000, "sweep.");
+  p.from_hz = fields::number(s, "from_hz", 0, "sweep.");
+  p.to_hz = fields::number(s, "to_hz", 0, "sweep.");
   if (!(p.to_hz > p.from_hz)) fields::fail("sweep.to_hz", "must be above sweep.from_hz");
   const bool rate = s.contains("rate_oct_min") || s.contains("rate_hz_s");
   if (rate) {
     if (s.contains("rate_oct_min") && s.contains("rate_hz_s")) fields::fail("sweep.rate_hz_s", "and sweep.rate_oct_min: give one rate");
     if (s.contains("steps") || s.contains("spacing")) fields::fail("sweep.steps", "is for a stepped sweep; a continuous one has a rate only");
     p.continuous = true;
-    p.rate_oct_min = fields::number(s, "rate_oct_min", 0, 1e-3, 100, "sweep.");
-    p.rate_hz_s = fields::number(s, "rate_hz_s", 0, 1e-4, 100, "sweep.");
+    p.rate_oct_min = fields::number(s, "rate_oct_min", 0, "sweep.");
+    p.rate_hz_s = fields::number(s, "rate_hz_s", 0, "sweep.");
     return;
   }
-  const int n = fields::integer(s, "steps", 24, 2, 1000, "sweep.");
+  const int n = fields::integer(s, "steps", 24, "sweep.");
   const std::string spacing = s.value("spacing", std::string("log"));
   if (spacing != "log" && spacing != "linear") fields::fail("sweep.spacing", "must be \"log\" or \"linear\"");
   for (int k = 0; k < n; ++k) {
@@ -64,14 +62,12 @@ void parse_sweep(const json& s, SinePlan& p) {
 std::vector<double> amplitudes(const json& j) {
   if (j.contains("amplitude_mm") == j.contains("amplitudes_mm"))
     fields::fail("amplitudes_mm", "or amplitude_mm: exactly one is required (the base amplitude, peak, mm)");
-  if (j.contains("amplitude_mm")) return {fields::number(j, "amplitude_mm", 0, 1e-4, 100)};
+  if (j.contains("amplitude_mm")) return {fields::number(j, "amplitude_mm", 0)};
   const json& a = j["amplitudes_mm"];
   if (!a.is_array() || a.empty() || a.size() > 20) fields::fail("amplitudes_mm", "must be an array of 1 to 20 base amplitudes (mm)");
   std::vector<double> out;
   for (std::size_t k = 0; k < a.size(); ++k) {
-    if (!a[k].is_number() || !(a[k].get<double>() >= 1e-4) || a[k].get<double>() > 100)
-      fields::fail("amplitudes_mm[" + std::to_string(k) + "]", "must be an amplitude from 0.0001 to 100 mm");
-    out.push_back(a[k].get<double>());
+    out.push_back(fields::element(a[k], "amplitudes_mm", "amplitudes_mm[" + std::to_string(k) + "]"));
   }
   return out;
 }
@@ -80,7 +76,7 @@ SineSettle parse_settle(const json& j) {
   SineSettle s;
   if (j.contains("settle") && j.contains("settle_cycles")) fields::fail("settle", "and settle_cycles: give one of them");
   if (!j.contains("settle")) {
-    s.cycles = fields::integer(j, "settle_cycles", 10, 0, 100000);
+    s.cycles = fields::integer(j, "settle_cycles", 10);
     return s;
   }
   const json& b = j["settle"];
@@ -89,9 +85,9 @@ SineSettle parse_settle(const json& j) {
   s.until = true;
   s.cycles = 0;
   s.change_pct = fields::percent(b, "change", s.change_pct, "settle.");
-  s.consecutive = fields::integer(b, "consecutive", s.consecutive, 1, 100, "settle.");
-  s.min_cycles = fields::integer(b, "min_cycles", s.min_cycles, 0, 100000, "settle.");
-  s.max_cycles = fields::integer(b, "max_cycles", s.max_cycles, 1, 100000, "settle.");
+  s.consecutive = fields::integer(b, "consecutive", s.consecutive, "settle.");
+  s.min_cycles = fields::integer(b, "min_cycles", s.min_cycles, "settle.");
+  s.max_cycles = fields::integer(b, "max_cycles", s.max_cycles, "settle.");
   if (s.max_cycles < s.min_cycles) fields::fail("settle.max_cycles", "must be at least settle.min_cycles");
   return s;
 }
@@ -107,16 +103,16 @@ SineControl parse_control(const json& j) {
   if (!b.is_object()) fields::fail("control", "must be an object ({\"tolerance\": \"5 %\", ...}) or false (open loop)");
   fields::only(b, "control.", {"tolerance", "warning", "abort", "gain", "window_cycles", "max_windows", "max_drive_ratio", "start_level", "abort_windows"});
   c.tolerance_pct = fields::percent(b, "tolerance", c.tolerance_pct, "control.");
-  c.warning_pct = fields::percent(b, "warning", std::max(c.warning_pct, c.tolerance_pct), "control.", 1000);
-  c.abort_pct = fields::percent(b, "abort", std::max(c.abort_pct, c.warning_pct), "control.", 1000);
+  c.warning_pct = fields::percent(b, "warning", std::max(c.warning_pct, c.tolerance_pct), "control.");
+  c.abort_pct = fields::percent(b, "abort", std::max(c.abort_pct, c.warning_pct), "control.");
   if (c.warning_pct < c.tolerance_pct) fields::fail("control.warning", "must be at least control.tolerance");
   if (c.abort_pct <= c.warning_pct) fields::fail("control.abort", "must be above control.warning");
-  c.gain = fields::number(b, "gain", c.gain, 0.05, 1, "control.");
-  c.window_cycles = fields::integer(b, "window_cycles", c.window_cycles, 1, 1000, "control.");
-  c.max_windows = fields::integer(b, "max_windows", c.max_windows, 1, 1000, "control.");
-  c.max_drive_ratio = fields::number(b, "max_drive_ratio", c.max_drive_ratio, 1, 100, "control.");
-  c.start_level = fields::number(b, "start_level", c.start_level, 0.05, 1, "control.");
-  c.abort_windows = fields::integer(b, "abort_windows", c.abort_windows, 1, 100, "control.");
+  c.gain = fields::number(b, "gain", c.gain, "control.");
+  c.window_cycles = fields::integer(b, "window_cycles", c.window_cycles, "control.");
+  c.max_windows = fields::integer(b, "max_windows", c.max_windows, "control.");
+  c.max_drive_ratio = fields::number(b, "max_drive_ratio", c.max_drive_ratio, "control.");
+  c.start_level = fields::number(b, "start_level", c.start_level, "control.");
+  c.abort_windows = fields::integer(b, "abort_windows", c.abort_windows, "control.");
   return c;
 }
 }  // namespace
@@ -144,7 +140,7 @@ SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   }
   p.amplitudes_mm = amplitudes(j);
   p.settle = parse_settle(j);
-  p.measured_cycles = fields::integer(j, "measured_cycles", 10, 1, 100000);
+  p.measured_cycles = fields::integer(j, "measured_cycles", 10);
   p.control = parse_control(j);
   p.jump_threshold_pct = fields::percent(j, "jump_threshold", p.jump_threshold_pct, "");
   if (p.highest_hz() > sample_rate_hz / 8)
@@ -205,4 +201,4 @@ std::size_t step_count(const SinePlan& p) {
   return passes * static_cast<std::size_t>(std::max(1.0, std::floor(cycles / p.measured_cycles)));
 }
 
-}  // namespace hystlab::daemon
+}  // namespace hystlab::domain

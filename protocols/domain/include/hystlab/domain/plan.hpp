@@ -22,22 +22,15 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "hystlab/control/values.hpp"
-#include "hystlab/daemon/sine_plan.hpp"
 #include "hystlab/domain/campaign.hpp"
+#include "hystlab/domain/plan_error.hpp"
+#include "hystlab/domain/sine_plan.hpp"
 #include "hystlab/models/grid.hpp"
 
-namespace hystlab::daemon {
-
-// A refused plan: what() is the whole sentence ("plan: ramp_rate_mm_s must be between 0.0001 and
-// 20"), field the plan's field alone ("ramp_rate_mm_s", "limits.force_N"), so that a form can
-// mark the input it came from.
-using control::PlanError;
-
-// A number as people write it: 0.0001, 20, 1e+06 (not std::to_string's 0.000100).
-[[nodiscard]] std::string plan_number(double v);
+namespace hystlab::domain {
 
 struct Limits {
   double displacement_min_mm = -1.0, displacement_max_mm = 10.0;
@@ -84,4 +77,4 @@ struct Plan {
 // A fot plan's grid: subdivisions equal steps of range_mm, or its nodes_mm.
 [[nodiscard]] models::Grid fot_grid(const Plan& p);
 
-}  // namespace hystlab::daemon
+}  // namespace hystlab::domain

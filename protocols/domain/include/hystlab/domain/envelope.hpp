@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "hystlab/daemon/plan.hpp"
 #include "hystlab/domain/events.hpp"
+#include "hystlab/domain/plan.hpp"
 
-namespace hystlab::daemon {
+namespace hystlab::domain {
 
 // Wall time the host may be starved without that being a servo or controller failure. Seen on
 // the 2-core CI and work VMs: a 1 ms sleep loop woke up to 0.73 s late with the machine idle (p99
@@ -71,4 +71,4 @@ struct RigConfigError : std::invalid_argument {
 // than the rig's, but the operator is told which one holds.
 [[nodiscard]] std::vector<std::string> limits_tightened(const Plan& plan, const Limits& applied);
 
-}  // namespace hystlab::daemon
+}  // namespace hystlab::domain

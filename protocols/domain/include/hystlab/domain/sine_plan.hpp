@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace hystlab::daemon {
+namespace hystlab::domain {
 
 enum class SweepDirection : std::uint8_t { up, down, up_down };
 [[nodiscard]] const char* to_string(SweepDirection d) noexcept;
@@ -93,4 +93,4 @@ struct SweepPass {
 // the frequencies (at least 8 samples a cycle).
 [[nodiscard]] SinePlan parse_sine_plan(const nlohmann::json& j, double sample_rate_hz);
 
-}  // namespace hystlab::daemon
+}  // namespace hystlab::domain
