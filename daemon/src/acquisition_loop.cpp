@@ -109,11 +109,14 @@ void Loop::publish(const drivers::ShakerSample& s) {
 }
 
 bool Loop::command_drive(double t, double f_hz, double amplitude_mm) {
+  // As the load frame's commands: a lost answer (a busy controller answering late, a dropped
+  // link) holds the table and the step is taken again when the rig answers, kMaxLostCommands in
+  // a row fail the campaign; a refusal fails it at once (stop 31: one late answer ended a sweep).
   if (auto ec = ctx.rig.command_shaker(f_hz, amplitude_mm, true)) {
-    ctx.supervisor.hold(t, "shaker command refused: no drive");
-    end(CampaignEnd::failed, "shaker command refused: " + ec.message());
+    (void)command_failed(t, ec, "shaker command");
     return false;
   }
+  command_taken();
   drive_hz = f_hz;
   drive_mm = amplitude_mm;
   return true;
@@ -281,6 +284,7 @@ bool handle_control(Loop& L, Strategy& strategy, double t, double x) {
     if (sup.state() != RigState::armed) return true;  // still held (the link): resumed when it answers
     L.paused = false;
     strategy.on_resume(L, t, false);
+    return L.result.end == CampaignEnd::none;  // the resumed step's command refused: ended there
   }
   return true;
 }
@@ -381,7 +385,14 @@ bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double
     if (auto ec = c.rig.read_shaker(t, s)) return on_missed(L, t, ec);
     if (rd.fresh(s.sample_counter)) {  // time_s is the rig's: on the controller's clock when its map gives one
       fresh = true;
-      if (L.link_held) L.link_held = false, strategy.on_resume(L, t, true);
+      if (L.link_held && !L.paused && !L.safing) {  // the link is back and the hold re-asserted: the step taken again
+        (void)c.supervisor.on_status(s.time_s, view_of(s));
+        c.supervisor.release(s.time_s, "link back: the step is taken again");
+        if (c.supervisor.state() == RigState::armed) L.link_held = false, strategy.on_resume(L, t, true);
+        if (L.result.end != CampaignEnd::none) return false;  // the step's drive refused again: ended there
+      } else if (L.link_held) {
+        L.link_held = false;
+      }
       if (!shaker_sample(L, strategy, s)) return false;
     }
   } else {
@@ -396,6 +407,7 @@ bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double
         (void)c.supervisor.on_status(s.time_s, view_of(s));
         c.supervisor.release(s.time_s, "link back: the segment is taken again");
         if (c.supervisor.state() == RigState::armed) L.link_held = false, strategy.on_resume(L, s.time_s, true);
+        if (L.result.end != CampaignEnd::none) return false;  // the segment refused again: ended there
       } else if (L.link_held) {
         L.link_held = false;
       }

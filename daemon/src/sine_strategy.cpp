@@ -74,10 +74,10 @@ class SineStrategy final : public Strategy {
   // A step (stepped pass) or the start of a continuous pass: drive at the learnt response.
   bool begin_step(Loop& L, double t) {
     f_ = s_.continuous ? (up() ? s_.from_hz : s_.to_hz) : domain::pass_frequencies(s_, passes_[pass_])[step_];
-    drive_ = control_.start(demand());
+    drive_ = control_.start(f_, demand());
     control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false, established_ = !s_.control.closed;
     prev_mass_ = NAN;
-    if (!L.command_drive(t, f_, drive_)) return false;
+    if (!L.command_drive(t, f_, drive_)) return going(L);
     L.event(domain::SineStepEvent{points_ + 1, static_cast<std::int64_t>(total_), static_cast<std::int64_t>(pass_) + 1,
                                   static_cast<std::int64_t>(passes_.size()), f_, demand(), drive_, eta(t), up() ? "up" : "down"});
     if (s_.control.closed) return open(Mode::control, 1, s_.control.window_cycles);
@@ -117,7 +117,7 @@ class SineStrategy final : public Strategy {
     if (const std::string hole = w_.hole(); !hole.empty()) return retake(L, t, hole);
     const models::HarmonicFit b = w_.fit_base(), m = w_.fit_mass(harmonics(f_));
     if (!b.fundamental.ok || !m.fundamental.ok) return retake(L, t, "no sine fit");
-    const ControlVerdict v = control_.update(demand(), drive_, b.fundamental.amplitude);
+    const ControlVerdict v = control_.update(s_.continuous ? w_.mean_frequency() : f_, demand(), drive_, b.fundamental.amplitude);
     if (!check_band(L, t, v, b.fundamental.amplitude)) return false;
     switch (mode_) {
       case Mode::control:
@@ -162,9 +162,13 @@ class SineStrategy final : public Strategy {
 
   bool redrive(Loop& L, double t, const ControlVerdict& v) {
     drive_ = v.next_drive_mm;
-    if (!L.command_drive(t, f_, drive_)) return false;
+    if (!L.command_drive(t, f_, drive_)) return going(L);
     return open(Mode::control, 1, s_.control.window_cycles);
   }
+
+  // A drive write the rig did not take: a lost answer holds the table and the step is taken again
+  // when the rig answers (Loop::command_failed); the campaign goes on unless it was ended.
+  static bool going(const Loop& L) { return L.result.end == CampaignEnd::none; }
 
   // The measured window is the step's point, if its base was within tolerance (a 10-cycle
   // window read 5.00 % where the 4-cycle control windows had read 4.9 %: CI's bench_shaker);
@@ -181,10 +185,11 @@ class SineStrategy final : public Strategy {
     return next_step(L, t);
   }
 
+  // Corrected until the base is within control.converge of the demand (open loop: at once).
   bool after_control(Loop& L, double t, const ControlVerdict& v) {
-    if (v.band == ControlBand::within) return to_settle();
+    if (v.converged || !s_.control.closed) return to_settle();
     if (++control_windows_ >= s_.control.max_windows) {
-      L.event(domain::ControlUnreachedEvent{f_, demand(), v.error_pct, drive_, control_windows_, v.limited, std::nullopt});
+      if (v.band != ControlBand::within) L.event(domain::ControlUnreachedEvent{f_, demand(), v.error_pct, drive_, control_windows_, v.limited, std::nullopt});
       return to_settle();
     }
     return redrive(L, t, v);
@@ -196,6 +201,14 @@ class SineStrategy final : public Strategy {
       ++control_windows_;
       stable_ = 0, prev_mass_ = NAN;
       return redrive(L, t, v);
+    }
+    // Within tolerance but not at the demand: corrected as the response settles (a small change:
+    // the settling goes on), as a controller's loop never stops.
+    if (s_.control.closed && !v.converged && v.band == ControlBand::within && control_windows_ < s_.control.max_windows) {
+      ++control_windows_;
+      drive_ = v.next_drive_mm;
+      if (!L.command_drive(t, f_, drive_)) return going(L);
+      if (!s_.settle.until) return open(Mode::settle, 1, s_.settle.cycles);  // settled again at the new drive
     }
     if (!s_.settle.until) return to_measure();
     settled_cycles_ += s_.control.window_cycles;
@@ -218,9 +231,9 @@ class SineStrategy final : public Strategy {
       sweep_over_ = false;
       return pass_ < passes_.size() ? begin_step(L, t) : true;
     }
-    if (s_.control.closed && v.band != ControlBand::within) {
+    if (s_.control.closed && !v.converged) {
       drive_ = v.next_drive_mm;
-      if (!L.command_drive(t, f_, drive_)) return false;
+      if (!L.command_drive(t, f_, drive_)) return going(L);
     }
     return open(Mode::sweep, 0, s_.measured_cycles);
   }

@@ -41,6 +41,9 @@ class FakeRig final : public drivers::Rig {
   double heartbeat_timeout_s = 0;  // > 0: the controller's host watchdog (fault 4), timed while enabled
   double stroke_mm = 1e9;          // beyond ±stroke_mm: fault 1; a reset there enters limit recovery (1 mm/s, inward only)
   bool shaker = false;
+  // The next this many non-zero drive writes are taken but answered late (a timeout), as a busy
+  // controller's: the host does not know the write was taken.
+  int late_drive_answers = 0;
   std::uint16_t required_mode = 1;
   std::vector<FaultEvent> plan;
 
@@ -107,6 +110,7 @@ class FakeRig final : public drivers::Rig {
     if (!enable) ++log.disables;
     enable_ = enable;
     f_hz_ = f_hz, drive_mm_ = amplitude_mm;
+    if (amplitude_mm > 0 && late_drive_answers > 0) return --late_drive_answers, RigError::timeout;
     return {};
   }
   std::error_code read_shaker(double now, drivers::ShakerSample& out) noexcept override {
@@ -148,7 +152,8 @@ class FakeRig final : public drivers::Rig {
   [[nodiscard]] bool latched() const { return estop_ || fault_ != 0; }
   [[nodiscard]] double position() const { return x_; }
   [[nodiscard]] bool moving() const { return moving_; }
-  [[nodiscard]] double amplitude() const { return amp_; }  // the shaker table's
+  [[nodiscard]] double amplitude() const { return amp_; }   // the shaker table's
+  [[nodiscard]] double drive() const { return drive_mm_; }  // the drive last written
   [[nodiscard]] double now() const { return now_; }
   [[nodiscard]] bool estop_commanded() const { return estop_cmd_; }
   [[nodiscard]] bool recovering() const { return recovering_; }

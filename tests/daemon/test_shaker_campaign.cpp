@@ -79,7 +79,9 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   for (const auto& p : pts) {
     CAPTURE(p.dump());
     const double f = p["frequency_hz"];
-    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 3.0);  // within tolerance at every step
+    // Held at the demand, not at the tolerance's edge: the loop converges within 1 % (stop 31's
+    // stopped inside the tolerance, approached from below, and measured 3.8 to 4.5 % low).
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
     CHECK(p["band"] == "within tolerance");
     loop_had_work = loop_had_work || std::fabs(p["drive_mm"].get<double>() / 0.005 - 1) > 0.05;
     const double ratio = p["ratio"].get<double>();

@@ -70,6 +70,7 @@ constexpr std::array kFields{
   field("settle.consecutive", "settle windows in a row", "", 1, 100, T::integer),
   field("settle.min_cycles", "settle cycles at least", "", 0, 100000, T::integer),
   field("settle.max_cycles", "settle cycles at most", "", 1, 100000, T::integer),
+  field("control.converge", "control convergence", "%", 0, 100, T::percent),
   field("control.gain", "control gain", "", 0.05, 1, T::number),
   field("control.window_cycles", "control window", "cycles", 1, 1000, T::integer),
   field("control.max_windows", "control windows at most", "", 1, 1000, T::integer),

@@ -101,8 +101,11 @@ SineControl parse_control(const json& j) {
     return c;
   }
   if (!b.is_object()) fields::fail("control", "must be an object ({\"tolerance\": \"5 %\", ...}) or false (open loop)");
-  fields::only(b, "control.", {"tolerance", "warning", "abort", "gain", "window_cycles", "max_windows", "max_drive_ratio", "start_level", "abort_windows"});
+  fields::only(b, "control.",
+               {"tolerance", "warning", "abort", "converge", "gain", "window_cycles", "max_windows", "max_drive_ratio", "start_level", "abort_windows"});
   c.tolerance_pct = fields::percent(b, "tolerance", c.tolerance_pct, "control.");
+  c.converge_pct = fields::percent(b, "converge", std::min(c.converge_pct, c.tolerance_pct), "control.");
+  if (c.converge_pct > c.tolerance_pct) fields::fail("control.converge", "must be at most control.tolerance");
   c.warning_pct = fields::percent(b, "warning", std::max(c.warning_pct, c.tolerance_pct), "control.");
   c.abort_pct = fields::percent(b, "abort", std::max(c.abort_pct, c.warning_pct), "control.");
   if (c.warning_pct < c.tolerance_pct) fields::fail("control.warning", "must be at least control.tolerance");
@@ -174,10 +177,12 @@ double continuous_seconds(const SinePlan& p) {
 }  // namespace
 
 double step_nominal_s(const SinePlan& p, double f) {
-  // The control windows (each with its cycle of transient) from the start level down to the
-  // tolerance when the table's response is as learnt: the error shrinks by (1 − gain) a window.
+  // The control windows (each with its cycle of transient) from a step's start to the convergence
+  // band when the table's response is as learnt: a step starts at the drive learnt at its
+  // frequency, about 10 % off where the response changes fastest (the isolator's resonance), and
+  // the error shrinks by (1 − gain) a window.
   const SineControl& c = p.control;
-  const double e0 = std::fabs(c.start_level - 1), tol = c.tolerance_pct / 100;
+  const double e0 = 0.1, tol = c.converge_pct / 100;
   const int windows = e0 <= tol ? 1 : 1 + static_cast<int>(std::ceil(std::log(tol / e0) / std::log(std::max(1e-9, 1 - c.gain))));
   const int control = c.closed ? std::min(windows, c.max_windows) * (c.window_cycles + 1) : 0;
   const int settle = p.settle.until ? p.settle.min_cycles + (p.settle.consecutive + 1) * std::max(1, p.control.window_cycles) : p.settle.cycles;

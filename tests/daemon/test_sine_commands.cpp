@@ -1,0 +1,55 @@
+// A shaker's drive writes against a busy controller (in process: the fake controller, a fake
+// clock, the real loop and writer): a late answer is a lost command, as the load frame's are: the
+// table is held and the step taken again when the rig answers, a bounded number in a row, then
+// the sweep fails with the reason and the table is left at zero drive.
+#include <doctest/doctest.h>
+
+#include "safety_world.hpp"
+
+using namespace hystlab;
+using namespace hystlab::test;
+
+namespace {
+nlohmann::json two_step_sweep() {  // two steps, about 1.5 s of rig time
+  return {{"kind", "sine"},
+          {"frequencies_hz", {20, 30}},
+          {"amplitude_mm", 0.05},
+          {"sample_rate_hz", 1000},
+          {"measured_cycles", 4},
+          {"settle", {{"change", "5 %"}, {"consecutive", 1}, {"min_cycles", 2}}},
+          {"control", {{"tolerance", "5 %"}, {"window_cycles", 2}}}};
+}
+}  // namespace
+
+TEST_CASE("sine: a drive write answered late is taken again, the sweep goes on") {
+  SafetyWorld w(true, 1 << 16);
+  w.idle(2);
+  w.rig->late_drive_answers = 1;  // the sweep's first drive write: taken, answered late
+  const auto job = w.job(two_step_sweep());
+  const int holds_before = w.rig->log.zero_drives, disables_before = w.rig->log.disables;
+  int disables_while_driving = 0;  // every period with a drive on the table: the disables so far
+  const auto r = w.run(job, [&] {
+    if (w.rig->drive() > 0) disables_while_driving = w.rig->log.disables - disables_before;
+  });
+  CAPTURE(r.reason);
+  CHECK(r.end == daemon::CampaignEnd::completed);
+  w.writer->flush();
+  CHECK(w.store->transmissibility(job.id).size() == 2);  // both steps measured
+  CHECK(w.rig->log.zero_drives > holds_before);          // held (zero drive) while it was unanswered
+  CHECK(disables_while_driving == 0);                    // enable never dropped on the way (only at the end)
+}
+
+TEST_CASE("sine: a controller that keeps answering late fails the sweep after three lost writes, at zero drive") {
+  SafetyWorld w(true, 1 << 16);
+  w.idle(2);
+  w.rig->late_drive_answers = 1000;
+  const auto job = w.job(two_step_sweep());
+  const auto r = w.run(job, {});
+  CAPTURE(r.reason);
+  CHECK(r.end == daemon::CampaignEnd::failed);
+  CHECK(r.reason.find("shaker command refused") != std::string::npos);
+  CHECK(r.reason.find("3 times in a row") != std::string::npos);
+  CHECK(w.rig->drive() == 0.0);  // left without drive
+  w.writer->flush();
+  CHECK(w.store->transmissibility(job.id).empty());
+}
