@@ -6,7 +6,7 @@
 #include <cstdint>
 
 namespace hystlab::db {
-class Store;
+class Reads;
 }
 
 namespace hystlab::db::h5_layout {
