@@ -4,7 +4,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fstream>
+#include <sstream>
+
 #include "hystlab/models/formats.hpp"
+#include "hystlab/models/linear_spring.hpp"
+#include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/sdof.hpp"
 #include "hystlab/models/simplified_sma.hpp"
 
@@ -20,13 +25,57 @@ double isolator_positive(const nlohmann::json& j, const char* f, double def, con
   return j[f].get<double>();
 }
 
-IsolatorModel with_spring(IsolatorModel m, const models::SmaParameters& p, const std::string& what) {
-  m.spring = std::make_shared<models::SimplifiedSmaModel>(p);
-  m.max_stiffness_N_per_mm = std::max(p.KA, p.KM);
-  char buf[160];
+IsolatorModel with_spring(IsolatorModel m, std::shared_ptr<const models::HysteresisModel> spring, double max_stiffness, const std::string& what) {
+  m.spring = std::move(spring);
+  m.max_stiffness_N_per_mm = max_stiffness;
+  char buf[400];
   std::snprintf(buf, sizeof buf, "%g kg on %d springs (%s), %g N·s/m", m.mass_kg, m.springs, what.c_str(), m.damping_N_s_per_m);
   m.describe = buf;
   return m;
+}
+IsolatorModel with_spring(IsolatorModel m, const models::SmaParameters& p, const std::string& what) {
+  return with_spring(std::move(m), std::make_shared<models::SimplifiedSmaModel>(p), std::max(p.KA, p.KM), what);
+}
+
+// The steepest slope of a spring's force over [lo, hi], loaded and unloaded (the integrator's
+// time step is chosen from it): a Preisach table's is that of its steepest cell.
+double steepest(const models::HysteresisModel& spring, double lo, double hi) {
+  auto s = spring.clone();
+  s->reset();
+  double x0 = lo, f0 = s->step(lo), most = 0;
+  for (int k = 1; k <= 800; ++k) {
+    const double u = k <= 400 ? k / 400.0 : (800 - k) / 400.0;
+    const double x = lo + (hi - lo) * u, f = s->step(x);
+    if (x != x0) most = std::max(most, std::fabs(f - f0) / std::fabs(x - x0));
+    x0 = x, f0 = f;
+  }
+  return most;
+}
+
+// A table identified on the load frame (a table document, docs/FORMATS.md): inline, or a file.
+IsolatorModel with_table(IsolatorModel m, const nlohmann::json& j, const std::string& where) {
+  std::string text, from = "inline";
+  if (j.is_string()) {
+    std::ifstream in(j.get<std::string>());
+    if (!in) isolator_fail(where, "names a file that cannot be read: " + j.get<std::string>());
+    std::ostringstream all;
+    all << in.rdbuf();
+    text = all.str(), from = j.get<std::string>();
+  } else if (j.is_object()) {
+    text = j.dump();
+  } else {
+    isolator_fail(where, "must be a table document (as GET /api/tables/ID/export?format=json gives it) or the path of one");
+  }
+  try {
+    models::TableDocument doc = models::table_from_json(text);
+    const models::Grid g = doc.table.grid();
+    auto spring = std::make_shared<models::PreisachModel>(std::move(doc.table));
+    const double k = steepest(*spring, g.lo, g.hi);
+    const std::string what = "Preisach table n = " + std::to_string(g.n) + " (" + doc.provenance.method + ", " + from + ")";
+    return with_spring(std::move(m), spring, std::max(k, 1e-6), what);
+  } catch (const std::exception& e) {
+    isolator_fail(where, std::string("is not a table document: ") + e.what());
+  }
 }
 
 // The compression at which the springs carry the weight (bisection, as the simulator finds it).
@@ -47,8 +96,10 @@ IsolatorModel simulated_isolator() { return with_spring(IsolatorModel{}, models:
 IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where) {
   if (!j.is_object()) isolator_fail(where, "must be an object: {\"mass_kg\": 13, \"springs\": 4, \"damping_N_s_per_m\": 58, \"params\": {...}}");
   for (const auto& [k, _] : j.items())
-    if (k != "mass_kg" && k != "springs" && k != "damping_N_s_per_m" && k != "params")
-      isolator_fail(where + "." + k, "is not a known field (mass_kg, springs, damping_N_s_per_m, params)");
+    if (k != "mass_kg" && k != "springs" && k != "damping_N_s_per_m" && k != "params" && k != "table" && k != "linear_N_per_mm")
+      isolator_fail(where + "." + k, "is not a known field (mass_kg, springs, damping_N_s_per_m, params, table, linear_N_per_mm)");
+  if (int(j.contains("params")) + int(j.contains("table")) + int(j.contains("linear_N_per_mm")) > 1)
+    isolator_fail(where, "gives its springs one way: params, table or linear_N_per_mm");
   IsolatorModel m;
   m.mass_kg = isolator_positive(j, "mass_kg", m.mass_kg, where);
   if (j.contains("springs") && (!j["springs"].is_number_integer() || j["springs"] < 1 || j["springs"] > 1000))
@@ -56,6 +107,13 @@ IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where) 
   m.springs = j.value("springs", m.springs);
   m.damping_N_s_per_m =
       j.contains("damping_N_s_per_m") && j["damping_N_s_per_m"] == 0 ? 0.0 : isolator_positive(j, "damping_N_s_per_m", m.damping_N_s_per_m, where);
+  if (j.contains("table")) return with_table(m, j["table"], where + ".table");
+  if (j.contains("linear_N_per_mm")) {
+    const double k = isolator_positive(j, "linear_N_per_mm", 0, where);
+    char what[64];
+    std::snprintf(what, sizeof what, "linear, %g N/mm", k);
+    return with_spring(m, std::make_shared<models::LinearSpring>(k), k, what);
+  }
   if (!j.contains("params")) return with_spring(m, models::table1_parameters(), "simplified model, Table 1");
   try {
     return with_spring(m, models::params_from_json(j["params"].dump()), "simplified model, the rig's parameters");

@@ -72,7 +72,10 @@ void Supervisor::latch(double now, RigState to, const std::string& reason, std::
 }
 
 bool Supervisor::write_hold() noexcept {
-  if (shaker_) return !rig_->command_shaker(0.0, 0.0, true);  // zero drive, still enabled
+  // A shaker's hold is zero drive with enable as the controller last reported it: never a pulse
+  // of enable (stop 31 wrote enable with the zero drive, then disabled: 1-2 ms of enable at
+  // start-up and after every failure); before any report (start-up), not enabled.
+  if (shaker_) return !rig_->command_shaker(0.0, 0.0, have_last_ && (last_.status & st::enabled) != 0);
   return !rig_->hold(true);
 }
 
@@ -193,8 +196,9 @@ Supervisor::Arming Supervisor::arming_step(double now, const StatusView& v, std:
   }
   if (!arming_written_) {
     arming_written_ = true;
-    if (auto ec = rig_->set_mode(s_.mode); ec && ec != drivers::RigError::unsupported)
-      return failed("cannot write mode " + std::to_string(s_.mode) + ": " + ec.message());
+    const std::error_code mode = rig_->set_mode(s_.mode);
+    if (mode && mode != drivers::RigError::unsupported) return failed("cannot write mode " + std::to_string(s_.mode) + ": " + mode.message());
+    mode_written_ = !mode;  // a map without a mode register: none is said to be set
     // The setpoint is where the rig is, before enable: a stale setpoint from an earlier campaign
     // must never become motion the moment the drive is enabled.
     std::error_code ec = shaker_ ? rig_->command_shaker(0.0, 0.0, true) : rig_->command(v.position_mm, s_.safe_rate_mm_s);
@@ -207,14 +211,14 @@ Supervisor::Arming Supervisor::arming_step(double now, const StatusView& v, std:
     if (!shaker_)
       if (auto ec = rig_->hold(false)) return failed("cannot release the hold: " + ec.message());
     intended_ = RigState::armed;
-    go(now, RigState::armed, "armed: ready, mode " + std::to_string(s_.mode) + ", enabled");
+    go(now, RigState::armed, mode_written_ ? "armed: ready, mode " + std::to_string(s_.mode) + ", enabled" : std::string("armed: ready, enabled"));
     return Arming::armed;
   }
   if (now > arming_deadline_) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.3g", s_.arm_timeout_s);
     return failed("the rig did not report enabled within " + std::string(buf) + " s of enable (" + describe_status(v.status, v.fault_code, text) +
-                  "; is it in mode " + std::to_string(s_.mode) + "?)");
+                  (mode_written_ ? "; is it in mode " + std::to_string(s_.mode) + "?)" : std::string(")")));
   }
   return Arming::pending;
 }

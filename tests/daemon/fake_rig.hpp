@@ -32,7 +32,8 @@ class FakeRig final : public drivers::Rig {
   struct Log {
     int setpoints_while_latched = 0, enables_while_latched = 0, resets = 0, hold_writes = 0, estop_writes = 0;
     int mode_writes = 0, heartbeats = 0, disables = 0, drive_writes = 0, drives_while_latched = 0;
-    int zero_drives = 0;  // a shaker's drive written with zero amplitude (its hold)
+    int zero_drives = 0;    // a shaker's drive written with zero amplitude (its hold)
+    int enable_writes = 0;  // enable written on (arm(true), or a shaker's drive with enable)
     std::vector<double> setpoints;
   } log;
   double deadband_mm = 0, rate_cap_mm_s = 500, dt = 0.001;
@@ -54,6 +55,7 @@ class FakeRig final : public drivers::Rig {
     if (on && (estop_ || fault_)) ++log.enables_while_latched;
     if (!on) ++log.disables;
     if (on && !enable_) enabled_at_ = now_;
+    if (on) ++log.enable_writes;
     enable_ = on;
     return {};
   }
@@ -107,6 +109,7 @@ class FakeRig final : public drivers::Rig {
     if (amplitude_mm == 0) ++log.zero_drives;
     if ((estop_ || fault_) && amplitude_mm > 0) ++log.drives_while_latched;
     if (enable && !enable_) enabled_at_ = now_;
+    if (enable) ++log.enable_writes;
     if (!enable) ++log.disables;
     enable_ = enable;
     f_hz_ = f_hz, drive_mm_ = amplitude_mm;

@@ -53,3 +53,33 @@ TEST_CASE("sine: a controller that keeps answering late fails the sweep after th
   w.writer->flush();
   CHECK(w.store->transmissibility(job.id).empty());
 }
+
+TEST_CASE("a shaker's hold is zero drive with enable as the controller reported it: never a pulse of enable") {
+  namespace st = protocols::status;
+  FakeRig rig;
+  rig.shaker = true;
+  domain::SupervisionSettings settings;
+  daemon::Supervisor sup(rig, settings, true, [](const daemon::RigTransition&) {});
+  const daemon::StatusView ready{static_cast<std::uint16_t>(st::ready), 0, 0.0}, enabled{static_cast<std::uint16_t>(st::ready | st::enabled), 0, 0.0};
+  // Start-up: the first answer re-asserts held and disabled, without enabling on the way (stop
+  // 31 wrote the zero drive with enable on, then disabled: 1-2 ms of enable).
+  CHECK_FALSE(sup.on_status(0.0, ready));
+  CHECK(sup.state() == daemon::RigState::idle);
+  CHECK(rig.log.enable_writes == 0);
+  CHECK(rig.drive() == 0.0);
+  // Armed (the arming writes enable once), then held: zero drive, still enabled.
+  std::string reason;
+  REQUIRE_FALSE(sup.begin_arming(0.1));
+  CHECK(sup.arming_step(0.1, ready, reason) == daemon::Supervisor::Arming::pending);
+  CHECK(rig.log.enable_writes == 1);
+  CHECK(sup.arming_step(0.12, enabled, reason) == daemon::Supervisor::Arming::armed);
+  (void)sup.on_status(0.13, enabled);
+  sup.hold(0.14, "test: held");
+  CHECK(rig.drive() == 0.0);
+  CHECK(rig.enabled());  // as it was
+  // The controller drops enable: held, and enable is not written back on.
+  const int before = rig.log.enable_writes;
+  CHECK(sup.on_status(0.15, ready));
+  CHECK(rig.log.enable_writes == before);
+  CHECK(rig.drive() == 0.0);
+}

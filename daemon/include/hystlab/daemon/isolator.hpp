@@ -5,8 +5,11 @@
 // base amplitude and the step's frequency, carrying the springs' memory from step to step in the
 // order the rig took them.
 //
-// Rig config: "isolator": {"mass_kg": 13, "springs": 4, "damping_N_s_per_m": 58,
-//                          "params": {...simplified-model parameters...}}  (params: Table 1 when absent)
+// Rig config: "isolator": {"mass_kg": 13, "springs": 4, "damping_N_s_per_m": 58, and its springs
+//   "params": {...simplified-model parameters...}   (Table 1 when no spring is given), or
+//   "table": "S-07.json" or {...a table document...} (a Preisach table identified on a load frame:
+//            the mission's chain, identify the springs on the frame, predict the isolator), or
+//   "linear_N_per_mm": 40}
 // A simulated shaker without one is predicted with the simulator's own isolator.
 #include <memory>
 #include <nlohmann/json.hpp>
