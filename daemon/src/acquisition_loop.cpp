@@ -376,6 +376,19 @@ struct Reader {  // the rig's samples, fresh ones only, at the plan's rate on th
   }
 };
 
+// A fresh sample while the link was held (a lost read or a lost command): once the hold is
+// re-asserted and released, the strategy takes its segment or step again (resumed at resume_t);
+// false when that ended the campaign (its command refused again).
+bool link_back(Loop& L, Strategy& strategy, double sample_t, double resume_t, const StatusView& v, const char* what) {
+  if (!L.link_held) return true;
+  if (L.paused || L.safing) return L.link_held = false, true;
+  Supervisor& sup = L.ctx.supervisor;
+  (void)sup.on_status(sample_t, v);
+  sup.release(sample_t, std::string("link back: the ") + what + " is taken again");
+  if (sup.state() == RigState::armed) L.link_held = false, strategy.on_resume(L, resume_t, true);
+  return L.result.end == CampaignEnd::none;
+}
+
 // One tick's reading and processing; false when the campaign ends.
 bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double period) {
   RunnerContext& c = L.ctx;
@@ -385,14 +398,7 @@ bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double
     if (auto ec = c.rig.read_shaker(t, s)) return on_missed(L, t, ec);
     if (rd.fresh(s.sample_counter)) {  // time_s is the rig's: on the controller's clock when its map gives one
       fresh = true;
-      if (L.link_held && !L.paused && !L.safing) {  // the link is back and the hold re-asserted: the step taken again
-        (void)c.supervisor.on_status(s.time_s, view_of(s));
-        c.supervisor.release(s.time_s, "link back: the step is taken again");
-        if (c.supervisor.state() == RigState::armed) L.link_held = false, strategy.on_resume(L, t, true);
-        if (L.result.end != CampaignEnd::none) return false;  // the step's drive refused again: ended there
-      } else if (L.link_held) {
-        L.link_held = false;
-      }
+      if (!link_back(L, strategy, s.time_s, t, view_of(s), "step")) return false;
       if (!shaker_sample(L, strategy, s)) return false;
     }
   } else {
@@ -403,14 +409,7 @@ bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double
       fresh = true;
       if (blocks && s.time_s - rd.last_kept < period * c.time_scale * (1 - 1e-6)) continue;  // a faster controller
       rd.last_kept = s.time_s;
-      if (L.link_held && !L.paused && !L.safing) {  // the link is back and the hold re-asserted: go on
-        (void)c.supervisor.on_status(s.time_s, view_of(s));
-        c.supervisor.release(s.time_s, "link back: the segment is taken again");
-        if (c.supervisor.state() == RigState::armed) L.link_held = false, strategy.on_resume(L, s.time_s, true);
-        if (L.result.end != CampaignEnd::none) return false;  // the segment refused again: ended there
-      } else if (L.link_held) {
-        L.link_held = false;
-      }
+      if (!link_back(L, strategy, s.time_s, s.time_s, view_of(s), "segment")) return false;
       if (!frame_sample(L, strategy, s)) return false;
     }
   }
