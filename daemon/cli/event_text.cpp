@@ -133,6 +133,10 @@ std::string say(const domain::ControlUnreachedEvent& d) {
 std::string say(const domain::UnsettledEvent& d) {
   return "at " + n(d.frequency_hz) + " Hz: not settled after " + n(d.cycles) + " cycles (still changing " + n(d.change_pct) + " %)";
 }
+std::string say(const domain::ResonanceUnresolvedEvent& d) {
+  return "pass " + n(d.pass) + ": the resonance near " + n(d.frequency_hz) + " Hz not resolved (" + n(d.band_points) + " of " + n(d.wanted) +
+         " points in its half-power band, " + count(static_cast<double>(d.added), "step") + " added): " + d.why;
+}
 
 // The specimen and notes as changed (db/campaign_record.hpp): the notes on one line.
 std::string say(const domain::RecordEvent& d) {

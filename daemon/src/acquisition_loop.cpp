@@ -364,10 +364,14 @@ void count_tick(Loop& L, double now, double next, double period, bool blocks) {
 
 struct Reader {  // the rig's samples, fresh ones only, at the plan's rate on the controller's clock
   std::vector<drivers::RigSample> block;
+  std::vector<drivers::ShakerSample> shaker_block;
   std::uint32_t last_counter = 0;
   bool have_counter = false;
   double last_kept = -1e300;
-  Reader() { block.reserve(4096); }  // the rig fills it without allocating
+  Reader() {  // the rig fills them without allocating
+    block.reserve(4096);
+    shaker_block.reserve(4096);
+  }
   bool fresh(std::uint32_t counter) {
     if (have_counter && counter == last_counter) return false;
     have_counter = true;
@@ -393,12 +397,14 @@ bool link_back(Loop& L, Strategy& strategy, double sample_t, double resume_t, co
 bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double period) {
   RunnerContext& c = L.ctx;
   bool fresh = false;
-  if (L.shaker) {
-    drivers::ShakerSample s;
-    if (auto ec = c.rig.read_shaker(t, s)) return on_missed(L, t, ec);
-    if (rd.fresh(s.sample_counter)) {  // time_s is the rig's: on the controller's clock when its map gives one
+  if (L.shaker) {  // time_s is the rig's: on the controller's clock when its map gives one
+    if (auto ec = c.rig.read_shaker_samples(t, rd.shaker_block)) return on_missed(L, t, ec);
+    for (const drivers::ShakerSample& s : rd.shaker_block) {
+      if (!rd.fresh(s.sample_counter)) continue;
       fresh = true;
-      if (!link_back(L, strategy, s.time_s, t, view_of(s), "step")) return false;
+      if (blocks && s.time_s - rd.last_kept < period * c.time_scale * (1 - 1e-6)) continue;  // a faster controller
+      rd.last_kept = s.time_s;
+      if (!link_back(L, strategy, s.time_s, blocks ? s.time_s : t, view_of(s), "step")) return false;
       if (!shaker_sample(L, strategy, s)) return false;
     }
   } else {
@@ -428,7 +434,7 @@ void run_ticks(Loop& L, Strategy& strategy) {
   // motion) is polled as much slower, or 3 of 4 reads would find nothing new at time scale 0.25
   // and the watchdog would take that for a silent rig. A faster rig is polled at the plan's rate.
   const double period = 1.0 / (L.plan.sample_rate_hz * std::min(1.0, c.time_scale));
-  const bool blocks = !L.shaker && c.rig.block_reads();
+  const bool blocks = c.rig.block_reads();
   const std::uint64_t lost_before = c.rig.health().lost_samples;
   L.spacing = period * c.time_scale;
   Reader rd;

@@ -21,7 +21,7 @@ void RigWorker::build_rig(const std::string& base) {
     // own sample buffer. Faster than real time its clock outruns any reader; the latest value then.
     cfg = json{{"name", entry.name},   {"transport", "modbus-tcp"},
                {"host", "127.0.0.1"},  {"port", sim->ensure_running()},
-               {"rig", entry.sim.rig}, {"block_reads", entry.sim.rig == "load_frame" && entry.sim.time_scale <= 1}};
+               {"rig", entry.sim.rig}, {"block_reads", entry.sim.time_scale <= 1}};
     entry.time_scale = entry.sim.time_scale;
   }
   cfg["name"] = entry.name;

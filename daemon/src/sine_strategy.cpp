@@ -14,6 +14,7 @@
 #include "acquisition_loop.hpp"
 #include "hystlab/daemon/base_control.hpp"
 #include "hystlab/models/sine_fit.hpp"
+#include "hystlab/models/sweep_analysis.hpp"
 #include "sine_window.hpp"
 
 namespace hystlab::daemon {
@@ -23,7 +24,12 @@ constexpr double kTwoPi = 2 * std::numbers::pi;
 class SineStrategy final : public Strategy {
  public:
   explicit SineStrategy(const domain::Plan& p)
-      : plan_(p), s_(p.sine), control_(p.sine.control), passes_(domain::sweep_passes(p.sine)), total_(domain::step_count(p.sine)) {}
+      : plan_(p), s_(p.sine), control_(p.sine.control), passes_(domain::sweep_passes(p.sine)), total_(domain::step_count(p.sine)) {
+    // Every buffer a pass fills at its largest, here: none grows on the acquisition thread.
+    const std::size_t most = s_.frequencies_hz.size() + static_cast<std::size_t>(s_.resonance.refine ? s_.resonance.max_steps : 0);
+    freqs_.reserve(most), pass_points_.reserve(most), refine_next_.reserve(static_cast<std::size_t>(s_.resonance.half_power_points) + 2);
+    load_pass();
+  }
 
   bool on_shaker(Loop& L, const drivers::ShakerSample& s) override {
     if (!started_) {
@@ -73,7 +79,7 @@ class SineStrategy final : public Strategy {
 
   // A step (stepped pass) or the start of a continuous pass: drive at the learnt response.
   bool begin_step(Loop& L, double t) {
-    f_ = s_.continuous ? (up() ? s_.from_hz : s_.to_hz) : domain::pass_frequencies(s_, passes_[pass_])[step_];
+    f_ = s_.continuous ? (up() ? s_.from_hz : s_.to_hz) : freqs_[step_];
     drive_ = control_.start(f_, demand());
     control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false, established_ = !s_.control.closed;
     prev_mass_ = NAN;
@@ -106,7 +112,7 @@ class SineStrategy final : public Strategy {
   // longer the steps done took than theirs (per step: a 5 Hz step is ten times a 50 Hz one, and
   // counting steps alike put the default sweep's first estimate at 513 s for 282 s).
   double eta(double t) const {
-    const double nominal = domain::nominal_duration_s(s_);
+    const double nominal = domain::nominal_duration_s(s_) + added_nominal_;
     const double done = s_.continuous ? (total_ > 0 ? nominal * static_cast<double>(points_) / static_cast<double>(total_) : 0.0) : nominal_done_;
     const double pace = done > 0 ? std::max(1.0, (t - t0_) / done) : 1.0;
     return std::max(0.0, nominal - done) * pace;
@@ -249,9 +255,54 @@ class SineStrategy final : public Strategy {
   }
 
   bool next_step(Loop& L, double t) {
-    if (step_ >= s_.frequencies_hz.size()) step_ = 0, ++pass_;
+    if (step_ >= freqs_.size() && !refine(L)) {
+      step_ = 0, ++pass_;
+      if (pass_ < passes_.size()) load_pass();
+    }
     if (pass_ >= passes_.size()) return true;
     return begin_step(L, t);
+  }
+
+  // A stepped pass's frequencies in the order driven (into reserved storage).
+  void load_pass() {
+    freqs_.clear(), pass_points_.clear(), added_ = 0;
+    if (s_.continuous || pass_ >= passes_.size()) return;
+    if (up())
+      freqs_.insert(freqs_.end(), s_.frequencies_hz.begin(), s_.frequencies_hz.end());
+    else
+      freqs_.insert(freqs_.end(), s_.frequencies_hz.rbegin(), s_.frequencies_hz.rend());
+  }
+
+  // After a pass's steps, the plan's resonance refinement: the next round of steps around the
+  // pass's peak, driven in the pass's direction (true: some were added). A round costs a sort of
+  // the pass's points (tens), once per round, not per sample.
+  bool refine(Loop& L) {
+    if (!s_.resonance.refine || s_.continuous) return false;
+    const int want = s_.resonance.half_power_points, room = s_.resonance.max_steps - added_;
+    models::next_resonance_steps(pass_points_, want, refine_next_);
+    if (refine_next_.empty() || room <= 0) return unresolved(L, want), false;
+    if (!up()) std::reverse(refine_next_.begin(), refine_next_.end());
+    const auto n = std::min(refine_next_.size(), static_cast<std::size_t>(room));
+    for (std::size_t k = 0; k < n; ++k) freqs_.push_back(refine_next_[k]), added_nominal_ += domain::step_nominal_s(s_, refine_next_[k]);
+    added_ += static_cast<int>(n), total_ += n;
+    return true;
+  }
+
+  // The refinement is over: said when the band does not hold the points asked, with why.
+  void unresolved(Loop& L, int want) {
+    const auto r = models::find_resonance(pass_points_);
+    const int in_band = r ? models::points_in_band(*r, pass_points_) : 0;
+    if (r && r->resolved && in_band >= want) return;
+    const char* why = !r                                     ? "fewer than 3 points"
+                      : r->at_edge                           ? "the peak is at the sweep's edge (it may lie beyond)"
+                      : added_ >= s_.resonance.max_steps     ? "resonance.max_steps reached"
+                      : r->lower_hz <= 0 || r->upper_hz <= 0 ? "a side of the peak never falls to half power inside the sweep"
+                                                             : "no room left between the points measured";
+    domain::ResonanceUnresolvedEvent ev;
+    ev.pass = static_cast<std::int64_t>(pass_) + 1, ev.frequency_hz = r ? r->frequency_hz : NAN, ev.amplitude_mm = demand();
+    ev.band_points = in_band, ev.wanted = want, ev.added = added_, ev.why = why;
+    L.event(ev);
+    ++warnings_;
   }
 
   bool retake(Loop& L, double t, const std::string& hole) {
@@ -284,6 +335,7 @@ class SineStrategy final : public Strategy {
     rec.control_error_pct = v.error_pct, rec.band = to_string(v.band), rec.control_windows = control_windows_;
     rec.settle_cycles = s_.settle.until ? settled_cycles_ : s_.settle.cycles, rec.t_s = t, rec.eta_s = eta(t);
     steps_.push_back({points_, PredictStep{f, b.fundamental.amplitude, settled_cycles_ + s_.settle.cycles, s_.measured_cycles}});
+    if (!s_.continuous && pass_points_.size() < pass_points_.capacity()) pass_points_.push_back({f, ratio, phase});
     db::SinePointRow row{points_, f, demand(), b.fundamental.amplitude, m.fundamental.amplitude, ratio, phase, rec.direction, domain::encode(rec)};
     const auto run = L.result.run_id, id = L.job.id;
     const std::string now = L.ctx.now_iso();
@@ -298,6 +350,10 @@ class SineStrategy final : public Strategy {
   BaseControl control_;
   std::vector<domain::SweepPass> passes_;
   std::vector<std::pair<std::int64_t, PredictStep>> steps_;
+  std::vector<double> freqs_, refine_next_;      // this pass's frequencies (planned, then refined); a round's
+  std::vector<models::SweepPoint> pass_points_;  // this pass's measured points (resonance refinement)
+  int added_ = 0;                                // steps added to this pass
+  double added_nominal_ = 0;                     // their nominal seconds (the ETA)
   std::size_t total_ = 0, pass_ = 0, step_ = 0;
   std::int64_t points_ = 0;
   static constexpr int kMaxRetakes = 3;

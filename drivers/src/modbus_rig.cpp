@@ -45,8 +45,10 @@ ModbusRig::ModbusRig(ModbusRigConfig config) : cfg_(std::move(config)) {
   if (cfg_.block_reads) {
     const auto& w = cfg_.map.sample_window();
     if (!w) throw std::invalid_argument(cfg_.name + ": block reads need a register map with a sample_window");
-    if (cfg_.map.kind() != protocols::RigKind::load_frame) throw std::invalid_argument(cfg_.name + ": block reads are for load frames");
-    for (const Signal s : {Signal::displacement_mm, Signal::force_N, Signal::status_word})
+    const bool frame = cfg_.map.kind() == protocols::RigKind::load_frame;
+    const std::initializer_list<Signal> needed = {Signal::displacement_mm, Signal::force_N, Signal::status_word};
+    const std::initializer_list<Signal> shaker_needed = {Signal::base_displacement_mm, Signal::mass_displacement_mm, Signal::status_word};
+    for (const Signal s : frame ? needed : shaker_needed)
       if (std::find(w->fields.begin(), w->fields.end(), s) == w->fields.end())
         throw std::invalid_argument(cfg_.name + ": block reads need " + std::string(protocols::signal_name(s)) + " in the map's sample_window.fields");
     window_words_.assign(static_cast<std::size_t>(w->records * w->record_width), 0);
@@ -75,6 +77,7 @@ std::error_code ModbusRig::connect(double now_s) noexcept {
   last_now_ = now_s;
   have_window_counter_ = false;  // block reads start afresh: what came before is not "lost"
   have_poll_anchor_ = false;
+  enable_known_ = false;
   ctx_ = cfg_.transport == ModbusRigConfig::Transport::tcp ? modbus_new_tcp(cfg_.host.c_str(), cfg_.port)
                                                            : modbus_new_rtu(cfg_.device.c_str(), cfg_.baud, cfg_.parity, cfg_.data_bits, cfg_.stop_bits);
   if (!ctx_) return fail(errno, "create context");
@@ -103,6 +106,7 @@ std::error_code ModbusRig::ensure_connected(double now_s) noexcept {
 
 std::error_code ModbusRig::fail(int err, const char* op) noexcept {
   const RigError kind = classify(err);
+  enable_known_ = false;
   health_.record_error(kind);
   if (kind == RigError::connection_lost && ctx_) {
     modbus_close(ctx_);
@@ -298,38 +302,82 @@ std::error_code ModbusRig::take_window(double now_s, int& fresh, bool& reached) 
   return {};
 }
 
+// The controller's time of the next fresh record (oldest first): its counter extended to 64
+// bits from the anchor.
+double ModbusRig::record_time(std::uint32_t c) noexcept {
+  window_counter64_ += static_cast<std::int32_t>(c - window_counter_);
+  window_counter_ = c;
+  return anchor_time_s_ + static_cast<double>(window_counter64_ - anchor_counter64_) * cfg_.map.sample_window()->period_s;
+}
+
+namespace {
+double at(const protocols::SignalArray& r, Signal s) { return r[static_cast<std::size_t>(s)]; }
+// How many of the fresh records the caller's buffer takes (it never grows on this thread).
+template <class Sample>
+int room_for(int fresh, const std::vector<Sample>& out, IoHealth& health) noexcept {
+  const int room = static_cast<int>(std::min<std::size_t>(out.capacity(), static_cast<std::size_t>(fresh)));
+  if (room < fresh) health.record_lost(static_cast<std::uint64_t>(fresh - room));
+  return room;
+}
+}  // namespace
+
 // Fresh records to samples, oldest first, timed by the controller's counter.
 void ModbusRig::emit_window(int fresh, std::vector<RigSample>& out) noexcept {
-  const protocols::SampleWindow& w = *cfg_.map.sample_window();
-  const auto at = [](const protocols::SignalArray& r, Signal s) { return r[static_cast<std::size_t>(s)]; };
-  const int room = static_cast<int>(std::min<std::size_t>(out.capacity(), static_cast<std::size_t>(fresh)));
-  if (room < fresh) health_.record_lost(static_cast<std::uint64_t>(fresh - room));  // the caller's buffer is the limit
-  for (int k = room - 1; k >= 0; --k) {
+  const bool has_command = cfg_.map.find(Signal::command_mm) != nullptr;
+  for (int k = room_for(fresh, out, health_) - 1; k >= 0; --k) {
     const protocols::SignalArray& r = window_records_[static_cast<std::size_t>(k)];
     const auto c = static_cast<std::uint32_t>(at(r, Signal::sample_counter));
-    window_counter64_ += static_cast<std::int32_t>(c - window_counter_);
-    window_counter_ = c;
-    const double command = cfg_.map.find(Signal::command_mm) && !std::isnan(at(r, Signal::command_mm)) ? at(r, Signal::command_mm) : 0.0;
-    out.push_back(RigSample{anchor_time_s_ + static_cast<double>(window_counter64_ - anchor_counter64_) * w.period_s, command, at(r, Signal::displacement_mm),
-                            at(r, Signal::force_N), static_cast<std::uint16_t>(at(r, Signal::status_word)),
-                            static_cast<std::uint16_t>(at(r, Signal::fault_code)), c, c});
+    const double command = has_command && !std::isnan(at(r, Signal::command_mm)) ? at(r, Signal::command_mm) : 0.0;
+    out.push_back(RigSample{record_time(c), command, at(r, Signal::displacement_mm), at(r, Signal::force_N),
+                            static_cast<std::uint16_t>(at(r, Signal::status_word)), static_cast<std::uint16_t>(at(r, Signal::fault_code)), c, c});
   }
+}
+
+// A shaker's record: a field the window does not carry (the accelerations, say) reads 0, as
+// the records start (window_records_ is zeroed once, and decode_record leaves other fields).
+void ModbusRig::emit_window(int fresh, std::vector<ShakerSample>& out) noexcept {
+  for (int k = room_for(fresh, out, health_) - 1; k >= 0; --k) {
+    const protocols::SignalArray& r = window_records_[static_cast<std::size_t>(k)];
+    const auto c = static_cast<std::uint32_t>(at(r, Signal::sample_counter));
+    out.push_back(ShakerSample{record_time(c), at(r, Signal::base_accel_m_s2), at(r, Signal::mass_accel_m_s2), at(r, Signal::base_displacement_mm),
+                               at(r, Signal::mass_displacement_mm), static_cast<std::uint16_t>(at(r, Signal::status_word)),
+                               static_cast<std::uint16_t>(at(r, Signal::fault_code)), c, c});
+  }
+}
+
+// The window's fresh records; when the whole window is newer than what was taken, the rest is
+// gone: counted, and the time axis keeps the gap.
+std::error_code ModbusRig::take_fresh(double now_s, int& fresh) noexcept {
+  fresh = 0;
+  if (auto ec = ensure_connected(now_s)) return ec;
+  bool reached = false;
+  const std::uint32_t before = window_counter_;
+  if (auto ec = take_window(now_s, fresh, reached)) return ec;
+  if (!reached && fresh > 0) {
+    const auto newest = static_cast<std::uint32_t>(window_records_[0][static_cast<std::size_t>(Signal::sample_counter)]);
+    health_.record_lost(static_cast<std::uint64_t>(static_cast<std::uint32_t>(newest - before)) - static_cast<std::uint64_t>(fresh));
+    window_counter_ = newest - static_cast<std::uint32_t>(fresh);
+    window_counter64_ += static_cast<std::int32_t>(window_counter_ - before);
+  }
+  return {};
 }
 
 std::error_code ModbusRig::read_samples(double now_s, std::vector<RigSample>& out) noexcept {
   if (!cfg_.block_reads) return Rig::read_samples(now_s, out);
+  if (cfg_.map.kind() != protocols::RigKind::load_frame) return out.clear(), RigError::unsupported;
   out.clear();
-  if (auto ec = ensure_connected(now_s)) return ec;
   int fresh = 0;
-  bool reached = false;
-  const std::uint32_t before = window_counter_;
-  if (auto ec = take_window(now_s, fresh, reached)) return ec;
-  if (!reached && fresh > 0) {  // the whole window is newer than what was taken: the rest is gone
-    const auto newest = static_cast<std::uint32_t>(window_records_[0][static_cast<std::size_t>(Signal::sample_counter)]);
-    health_.record_lost(static_cast<std::uint64_t>(static_cast<std::uint32_t>(newest - before)) - static_cast<std::uint64_t>(fresh));
-    window_counter_ = newest - static_cast<std::uint32_t>(fresh);  // the gap is counted, the time axis keeps it
-    window_counter64_ += static_cast<std::int32_t>(window_counter_ - before);
-  }
+  if (auto ec = take_fresh(now_s, fresh)) return ec;
+  emit_window(fresh, out);
+  return check_stale(now_s, window_counter_);
+}
+
+std::error_code ModbusRig::read_shaker_samples(double now_s, std::vector<ShakerSample>& out) noexcept {
+  if (!cfg_.block_reads) return Rig::read_shaker_samples(now_s, out);
+  out.clear();
+  if (cfg_.map.kind() != protocols::RigKind::shaker) return RigError::unsupported;
+  int fresh = 0;
+  if (auto ec = take_fresh(now_s, fresh)) return ec;
   emit_window(fresh, out);
   return check_stale(now_s, window_counter_);
 }
@@ -403,7 +451,10 @@ std::error_code ModbusRig::write_signals(std::initializer_list<Write> writes) no
 
 std::error_code ModbusRig::arm(bool enable) noexcept { return write_signals({{Signal::enable, enable ? 1.0 : 0.0}}); }
 std::error_code ModbusRig::hold(bool on) noexcept { return write_signals({{Signal::hold, on ? 1.0 : 0.0}}); }
-std::error_code ModbusRig::estop(bool on) noexcept { return write_signals({{Signal::estop, on ? 1.0 : 0.0}}); }
+std::error_code ModbusRig::estop(bool on) noexcept {
+  enable_known_ = false;
+  return write_signals({{Signal::estop, on ? 1.0 : 0.0}});
+}
 std::error_code ModbusRig::command(double setpoint_mm, double rate) noexcept {
   return write_signals({{Signal::setpoint_mm, setpoint_mm}, {Signal::ramp_rate_mm_s, rate}});
 }
@@ -424,8 +475,14 @@ std::error_code ModbusRig::write_host_heartbeat(std::uint32_t value) noexcept {
   // A counter wraps: a 16-bit register carries the low 16 bits.
   return write_signals({{Signal::host_heartbeat, static_cast<double>(e->width() == 1 ? value & 0xFFFFU : value)}});
 }
+// The drive alone while enable is as last written (a controller that took the enable coil
+// once needs no rewrite of it 1,000 times a sweep); anything that may have changed it on the
+// controller side (a reconnect, a failed transaction, an e-stop, a reset) writes it again.
 std::error_code ModbusRig::command_shaker(double f, double a, bool enable) noexcept {
-  return write_signals({{Signal::drive_frequency_hz, f}, {Signal::drive_amplitude_mm, a}, {Signal::shaker_enable, enable ? 1.0 : 0.0}});
+  if (enable_known_ && enable_written_ == enable) return write_signals({{Signal::drive_frequency_hz, f}, {Signal::drive_amplitude_mm, a}});
+  if (auto ec = write_signals({{Signal::drive_frequency_hz, f}, {Signal::drive_amplitude_mm, a}, {Signal::shaker_enable, enable ? 1.0 : 0.0}})) return ec;
+  enable_known_ = true, enable_written_ = enable;
+  return {};
 }
 
 }  // namespace hystlab::drivers

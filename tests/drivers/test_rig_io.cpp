@@ -397,6 +397,52 @@ TEST_CASE("shaker over modbus: base excitation moves the mass") {
   CHECK(s.fault_code == 0);
 }
 
+TEST_CASE("shaker over modbus, block reads: every sample once on the controller's clock, the drive written without enable") {
+  SimProcess sim({"--rig", "shaker", "--port", "0", "--noise", "0"});
+  ModbusRigConfig c = tcp_config(sim.modbus_port, protocols::kDefaultShakerMap);
+  c.block_reads = true;
+  ModbusRig rig(c);
+  REQUIRE(rig.block_reads());
+  REQUIRE_FALSE(rig.connect(steady_now()));
+  std::vector<ShakerSample> block;
+  block.reserve(256);
+  REQUIRE_FALSE(rig.read_shaker_samples(steady_now(), block));
+  REQUIRE(block.size() == 1);  // the first block anchors the controller's clock
+  ShakerSample last = block.back();
+  const std::uint32_t first_counter = last.sample_counter;
+  REQUIRE_FALSE(rig.command_shaker(20.0, 0.5, true));
+  const std::uint64_t writes_enabled = rig.health().writes;
+  REQUIRE_FALSE(rig.command_shaker(20.0, 0.4, true));  // enable unchanged: the drive's registers alone
+  CHECK(rig.health().writes - writes_enabled == 1);
+  std::uint64_t gaps = 0;
+  std::size_t taken = 0, longest_block = 0;
+  double base_max = 0;
+  for (int sleep : {2, 25, 1, 30, 3, 40, 2}) {  // 25 to 40 ms: several pages of 10 records, within the window of 500
+    sleep_ms(sleep);
+    REQUIRE_FALSE(rig.read_shaker_samples(steady_now(), block));
+    CAPTURE(sleep);
+    for (const ShakerSample& s : block) {
+      const std::uint32_t gap = s.sample_counter - last.sample_counter - 1;
+      gaps += gap;
+      CHECK(s.time_s - last.time_s == doctest::Approx(0.001 * (gap + 1)).epsilon(1e-9));
+      base_max = std::max(base_max, std::fabs(s.base_displacement_mm));
+      last = s;
+    }
+    taken += block.size();
+    longest_block = std::max(longest_block, block.size());
+  }
+  CHECK(rig.health().lost_samples == gaps);
+  CHECK(longest_block > 10);                                   // more than one page (10 records of 12 words) in one read
+  CHECK(taken + gaps == last.sample_counter - first_counter);  // every record: taken, or counted lost
+  CHECK(base_max > 0.2);                                       // the table moves: the records carry the measurement
+  // A latch makes the controller forget enable: after reset_faults the next drive writes it again.
+  REQUIRE(sim.control("fault estop").rfind("ok", 0) == 0);
+  REQUIRE_FALSE(rig.reset_faults());
+  const std::uint64_t before_reenable = rig.health().writes;
+  REQUIRE_FALSE(rig.command_shaker(20.0, 0.4, true));
+  CHECK(rig.health().writes - before_reenable == 2);  // the drive's registers, then the enable coil
+}
+
 TEST_CASE("rigs from configuration: a simulated rig is only a different address") {
   SimProcess sim({"--port", "0", "--noise", "0"});
   const nlohmann::json cfg = {{"name", "frame A"},       {"transport", "modbus-tcp"}, {"host", "127.0.0.1"},
@@ -421,7 +467,14 @@ TEST_CASE("rigs from configuration: a simulated rig is only a different address"
   bad({{"transport", "modbus-tcp"}, {"block_reads", "yes"}}, "rigs[1].block_reads must be true or false");
   bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"map", nlohmann::json::parse(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json"))}},
       "rigs[1].block_reads cannot be used: rig: block reads need a register map with a sample_window");
-  bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"rig", "shaker"}}, "rigs[1].block_reads cannot be used");
+  auto windowless_shaker = nlohmann::json::parse(protocols::kDefaultShakerMap);
+  windowless_shaker.erase("sample_window");
+  bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"rig", "shaker"}, {"map", windowless_shaker}},
+      "rigs[1].block_reads cannot be used: rig: block reads need a register map with a sample_window");
+  auto no_mass = nlohmann::json::parse(protocols::kDefaultShakerMap);
+  no_mass["sample_window"]["fields"] = {"sample_counter", "base_displacement_mm", "status_word"};
+  bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"rig", "shaker"}, {"map", no_mass}},
+      "block reads need mass_displacement_mm in the map's sample_window.fields");
   auto no_force = nlohmann::json::parse(protocols::kDefaultLoadFrameMap);
   no_force["sample_window"]["fields"] = {"sample_counter", "displacement_mm", "status_word"};
   bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"map", no_force}}, "block reads need force_N in the map's sample_window.fields");

@@ -105,6 +105,67 @@ TEST_CASE("resonance: the linear curve's peak, half-power points and Q = 1/(2ζ)
   CHECK(edge->q == 0);
 }
 
+TEST_CASE("resonance refinement: steps added around the peak until its half-power band holds the points asked; Q measured, not bounded") {
+  // Seeded: a linear isolator anywhere in the sweep, lightly or moderately damped, on a coarse
+  // log sweep (the page's and the benchmark's kind); rounds of next_resonance_steps measured on
+  // the analytic curve until none is asked.
+  std::mt19937 rng(25);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int trial = 0; trial < 40; ++trial) {
+    const double fn = 9 + 40 * u(rng), zeta = 0.01 + 0.07 * u(rng);
+    const int want = 3 + static_cast<int>(5 * u(rng)), coarse_steps = 8 + static_cast<int>(10 * u(rng));
+    CAPTURE(trial);
+    CAPTURE(fn);
+    CAPTURE(zeta);
+    CAPTURE(want);
+    CAPTURE(coarse_steps);
+    std::vector<SweepPoint> pts;
+    for (const double f : log_steps(5, 80, coarse_steps)) pts.push_back({f, linear_transmissibility(f / fn, zeta), 0});
+    std::vector<double> next;
+    int rounds = 0;
+    std::size_t added = 0;
+    for (;; ++rounds) {
+      REQUIRE(rounds < 12);  // it converges, and fast
+      next_resonance_steps(pts, want, next);
+      if (next.empty()) break;
+      for (std::size_t k = 1; k < next.size(); ++k) CHECK(next[k] > next[k - 1]);  // ascending
+      for (const double f : next) {
+        CHECK(f > 5);
+        CHECK(f < 80);
+        pts.push_back({f, linear_transmissibility(f / fn, zeta), 0});
+      }
+      added += next.size();
+    }
+    CAPTURE(rounds);
+    CAPTURE(added);
+    const auto r = find_resonance(pts);
+    REQUIRE(r);
+    CHECK(r->resolved);
+    CHECK(points_in_band(*r, pts) >= want);
+    CHECK(band_holds(pts, want));
+    CHECK(r->q == doctest::Approx(1 / (2 * zeta)).epsilon(0.1));  // within 10 % of 1/(2ζ), as the issue asks on linear springs
+    CHECK(added <= static_cast<std::size_t>(4 * (want + 1)));     // a few rounds, not a uniform sweep's hundreds
+  }
+  // Nothing to add: a peak at the sweep's edge, or a band already holding the points.
+  std::vector<SweepPoint> rising, fine;
+  for (const double f : log_steps(5, 15, 20)) rising.push_back({f, linear_transmissibility(f / 20.0, 0.05), 0});
+  std::vector<double> next;
+  next_resonance_steps(rising, 5, next);
+  CHECK(next.empty());
+  for (const double f : log_steps(5, 80, 400)) fine.push_back({f, linear_transmissibility(f / 20.0, 0.05), 0});
+  next_resonance_steps(fine, 5, next);
+  CHECK(next.empty());
+  const auto band = find_resonance(fine);
+  REQUIRE(band);
+  next_resonance_steps(fine, 40, next);  // more than it holds: added inside the band, none on a point measured
+  CHECK_FALSE(next.empty());
+  for (const double f : next) {
+    CHECK(f > band->lower_hz);
+    CHECK(f < band->upper_hz);
+  }
+  CHECK(next.size() + static_cast<std::size_t>(points_in_band(*band, fine)) >= 40);
+}
+
 TEST_CASE("jumps: the band where up and down differ, and where each direction changes most") {
   std::vector<SweepPoint> up, down;
   for (const double f : log_steps(10, 30, 21)) {

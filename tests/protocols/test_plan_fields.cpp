@@ -19,7 +19,7 @@ namespace {
 
 bool is_sine(const PlanField& f) {
   if (f.group == "sine") return true;
-  for (const char* p : {"sweep.", "frequencies_hz", "amplitude", "settle", "measured_cycles", "control.", "jump_threshold", "direction"})
+  for (const char* p : {"sweep.", "frequencies_hz", "amplitude", "settle", "measured_cycles", "control.", "jump_threshold", "direction", "resonance."})
     if (f.path.starts_with(p)) return true;
   return false;
 }

@@ -176,7 +176,12 @@ TEST_CASE("sample windows: the shipped map's window, and records that encode and
   CHECK(w.record_width == 10);  // counter, displacement, force, command (2 each), status, fault
   CHECK(w.records_per_read() == 12);
   CHECK(w.period_s == doctest::Approx(0.001));
-  CHECK_FALSE(RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json")).sample_window());
+  const RegisterMap shaker = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json"));
+  REQUIRE(shaker.sample_window());
+  CHECK(shaker.sample_window()->record_width == 12);  // counter, 2 displacements, 2 accelerations (2 each), status, fault
+  CHECK(shaker.sample_window()->records_per_read() == 10);
+  CHECK(shaker.sample_window()->records == 500);  // half a second of a host's absence at 1 kHz
+  CHECK(shaker.sample_period_s() == doctest::Approx(0.001));
   SignalArray in{}, out{};
   out.fill(-7);
   in[static_cast<std::size_t>(Signal::sample_counter)] = 4000000123.0;

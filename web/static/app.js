@@ -18,7 +18,7 @@ const KEEP = 20000;         // live samples kept per plot
 const LOOP_POINTS = 2000;   // the completed loop, from the server (shape-preserving)
 const SHAKER_LOOP_KEEP = 4000;  // a shaker's live loop: its newest cycles (the stream brings up to 1000 samples/s)
 const FRAME_RATE = 50;      // samples/s asked of the stream for a load frame
-const SINE_EVENTS = ['sine_step', 'control_warning', 'control_abort', 'control_unreached', 'unsettled', 'retake', 'gap', 'gaps', 'quality', 'sweep_done'];
+const SINE_EVENTS = ['sine_step', 'control_warning', 'control_abort', 'control_unreached', 'unsettled', 'resonance_unresolved', 'retake', 'gap', 'gaps', 'quality', 'sweep_done'];
 
 const S = {
   campaigns: [], selected: null, follow: true, detail: null, runId: null, events: [],

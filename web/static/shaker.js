@@ -22,6 +22,7 @@ const SAY = {
     `${d.limited ? ', the drive at its limit' : ''}): measured anyway`,
   unsettled: d => `${hz(d.frequency_hz)}: the response had not settled after ${plural(d.cycles, 'cycle')} (last change ${num(d.change_pct, 2)} %): measured anyway`,
   retake: d => `${hz(d.frequency_hz)}: the measurement was taken again (attempt ${d.attempt}: ${d.why})`,
+  resonance_unresolved: d => `the resonance near ${hz(d.frequency_hz)} (pass ${d.pass}) was not resolved: ${d.band_points} of ${d.wanted} points in its half-power band after ${plural(d.added, 'added step')} (${d.why})`,
   gap: d => `no samples for ${num(d.length_ms / 1000, 2)} s of rig time (from ${num(d.from_s)} s)`,
 };
 const SHORT = {
@@ -30,12 +31,14 @@ const SHORT = {
   control_unreached: d => `${hz(d.frequency_hz)} at ${num(d.demand_mm)} mm ${pct(d.error_pct)}`,
   unsettled: d => `${hz(d.frequency_hz)} (${num(d.change_pct, 2)} % after ${d.cycles} cycles)`,
   retake: d => `${hz(d.frequency_hz)} (${d.why})`,
+  resonance_unresolved: d => `${hz(d.frequency_hz)} (${d.band_points} of ${d.wanted} points: ${d.why})`,
   gap: d => `${num(d.length_ms / 1000, 2)} s at ${num(d.from_s)} s`,
 };
 const KIND_WORDS = {
   control_warning: 'control warnings (the base amplitude beyond the warning band in a control window)',
   control_abort: 'control aborts', control_unreached: 'steps whose base amplitude control did not reach (measured anyway)',
-  unsettled: 'steps measured before their response settled', retake: 'measurements taken again', gap: 'holes in the time axis',
+  unsettled: 'steps measured before their response settled', retake: 'measurements taken again',
+  resonance_unresolved: 'resonances not resolved by the steps added', gap: 'holes in the time axis',
 };
 
 export class SweepView {

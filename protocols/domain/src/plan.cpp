@@ -197,7 +197,8 @@ Plan parse_plan(const json& j) {
       if (p.points_mm[k] < p.limits.displacement_min_mm || p.points_mm[k] > p.limits.displacement_max_mm)
         fail("points_mm[" + std::to_string(k) + "]", "lies outside limits.displacement_mm");
   } else {
-    known({"frequencies_hz", "sweep", "amplitude_mm", "amplitudes_mm", "direction", "settle_cycles", "settle", "measured_cycles", "control", "jump_threshold"});
+    known({"frequencies_hz", "sweep", "amplitude_mm", "amplitudes_mm", "direction", "settle_cycles", "settle", "measured_cycles", "control", "jump_threshold",
+           "resonance"});
     parse_sine(j, p);
   }
   // Only against a rate the plan wrote: without one, the rig's envelope decides at submission and

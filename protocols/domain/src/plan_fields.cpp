@@ -47,6 +47,7 @@ constexpr std::array kFields{
   input("settle.change", "settle change", "%", 0, 100, T::percent, "sine", "settlechange", "settle until the response changes less than", "2", "settle cycles", true),
   input("settle_cycles", "settle cycles", "", 0, 100000, T::integer, "sine", "settle", "or settle cycles (instead)", "", "until settled", true),
   input("measured_cycles", "measured cycles", "", 1, 100000, T::integer, "sine", "measured", "", "10"),
+  input("resonance.half_power_points", "points in the half-power band", "", 3, 100, T::integer, "sine", "respts", "refine the resonance until its half-power band holds", "5", "no refinement", true),
   input("control.tolerance", "control tolerance", "%", 0, 100, T::percent, "sine", "tol", "", "5"),
   input("control.warning", "control warning", "%", 0, 1000, T::percent, "sine", "warn", "control warning beyond", "", "daemon's: 10", true),
   input("control.abort", "control abort", "%", 0, 1000, T::percent, "sine", "abortpct", "control abort beyond", "", "daemon's: 30", true),
@@ -78,6 +79,7 @@ constexpr std::array kFields{
   field("control.start_level", "start level", "", 0.05, 1, T::number),
   field("control.abort_windows", "abort windows in a row", "", 1, 100, T::integer),
   field("jump_threshold", "jump threshold", "%", 0, 100, T::percent),
+  field("resonance.max_steps", "resonance steps added at most", "", 1, 1000, T::integer),
 };
 // clang-format on
 }  // namespace

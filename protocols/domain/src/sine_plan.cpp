@@ -92,6 +92,23 @@ SineSettle parse_settle(const json& j) {
   return s;
 }
 
+SineResonance parse_resonance(const json& j, bool continuous) {
+  SineResonance r;
+  if (!j.contains("resonance")) return r;
+  const json& b = j["resonance"];
+  if (b.is_boolean()) {
+    r.refine = b.get<bool>();
+  } else {
+    if (!b.is_object()) fields::fail("resonance", "must be an object ({\"half_power_points\": 5, \"max_steps\": 40}), true or false");
+    fields::only(b, "resonance.", {"half_power_points", "max_steps"});
+    r.refine = true;
+    r.half_power_points = fields::integer(b, "half_power_points", r.half_power_points, "resonance.");
+    r.max_steps = fields::integer(b, "max_steps", r.max_steps, "resonance.");
+  }
+  if (r.refine && continuous) fields::fail("resonance", "refines a stepped sweep's steps; a continuous sweep has none (give steps or frequencies_hz)");
+  return r;
+}
+
 SineControl parse_control(const json& j) {
   SineControl c;
   if (!j.contains("control")) return c;
@@ -146,6 +163,7 @@ SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   p.measured_cycles = fields::integer(j, "measured_cycles", 10);
   p.control = parse_control(j);
   p.jump_threshold_pct = fields::percent(j, "jump_threshold", p.jump_threshold_pct, "");
+  p.resonance = parse_resonance(j, p.continuous);
   if (p.highest_hz() > sample_rate_hz / 8)
     fields::fail(
         p.continuous || j.contains("sweep") ? "sweep.to_hz" : "frequencies_hz",

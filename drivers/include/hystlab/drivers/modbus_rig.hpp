@@ -26,7 +26,7 @@ struct ModbusRigConfig {
   double byte_timeout_s = 0.01;                          // between bytes of one answer
   double reconnect_min_s = 0.05, reconnect_max_s = 2.0;  // back-off, doubling
   double stale_after_s = 0.5;                            // sample counter unchanged this long: stale_data
-  bool block_reads = false;                              // read_samples() reads the map's sample_window (required then)
+  bool block_reads = false;                              // read_samples()/read_shaker_samples() read the map's sample_window (required then)
   protocols::RegisterMap map;
   std::string name = "modbus rig";
 };
@@ -53,6 +53,7 @@ class ModbusRig final : public Rig {
   [[nodiscard]] bool block_reads() const noexcept override { return cfg_.block_reads; }
   std::error_code command_shaker(double frequency_hz, double amplitude_mm, bool enable) noexcept override;
   std::error_code read_shaker(double now_s, ShakerSample& out) noexcept override;
+  std::error_code read_shaker_samples(double now_s, std::vector<ShakerSample>& out) noexcept override;
   [[nodiscard]] IoHealthSnapshot health() const noexcept override { return health_.snapshot(); }
   [[nodiscard]] std::string describe() const override;
 
@@ -73,7 +74,10 @@ class ModbusRig final : public Rig {
   std::error_code check_stale(double now_s, std::uint32_t counter) noexcept;
   std::error_code read_window_page(int first, int count) noexcept;
   std::error_code take_window(double now_s, int& fresh, bool& reached) noexcept;
+  std::error_code take_fresh(double now_s, int& fresh) noexcept;  // the window's fresh records, a gap counted
+  double record_time(std::uint32_t counter) noexcept;             // the controller's clock, record by record
   void emit_window(int fresh, std::vector<RigSample>& out) noexcept;
+  void emit_window(int fresh, std::vector<ShakerSample>& out) noexcept;
 
   ModbusRigConfig cfg_;
   _modbus* ctx_ = nullptr;
@@ -100,6 +104,10 @@ class ModbusRig final : public Rig {
   std::uint32_t poll_counter_ = 0;
   std::int64_t poll_counter64_ = 0, poll_anchor64_ = 0;
   double poll_anchor_s_ = 0;
+  // The shaker's enable as last written: a drive write rewrites it only when it changes (or
+  // after anything that can have changed it on the controller: a reconnect, an error, an
+  // e-stop, a reset), so a running sweep's drive writes are the drive alone.
+  bool enable_known_ = false, enable_written_ = false;
 };
 
 }  // namespace hystlab::drivers

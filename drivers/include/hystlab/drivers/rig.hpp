@@ -63,6 +63,15 @@ class Rig {
   [[nodiscard]] virtual std::string fault_text(std::uint16_t) const { return {}; }
   virtual std::error_code command_shaker(double, double, bool) noexcept { return RigError::unsupported; }
   virtual std::error_code read_shaker(double, ShakerSample&) noexcept { return RigError::unsupported; }
+  // A shaker's read_samples: every sample since the last call, oldest first, as above (a rig
+  // without block reads gives its latest, read_shaker).
+  virtual std::error_code read_shaker_samples(double now_s, std::vector<ShakerSample>& out) noexcept {
+    out.clear();
+    ShakerSample s;
+    const std::error_code ec = read_shaker(now_s, s);
+    if (!ec && out.capacity() > 0) out.push_back(s);
+    return ec;
+  }
   [[nodiscard]] virtual IoHealthSnapshot health() const noexcept = 0;
   [[nodiscard]] virtual std::string describe() const = 0;
 

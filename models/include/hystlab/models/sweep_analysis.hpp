@@ -27,6 +27,27 @@ struct Resonance {
 // is not positive and finite). The half-power points are interpolated in log f, log ratio.
 [[nodiscard]] std::optional<Resonance> find_resonance(std::span<const SweepPoint> points);
 
+// A stepped sweep's resonance refinement (a sine plan's "resonance"): the frequencies to
+// measure next so that the half-power band of the sweep's highest peak holds at least `want`
+// points, the Q then measured rather than bounded. Into `out`, ascending; empty when nothing is
+// left to do: the band holds them (band_holds), the peak is at the sweep's edge (it may lie beyond), or a
+// side never falls to half power inside the sweep. Each round narrows in on the peak:
+// - unresolved (both neighbours of the highest point below half power: the peak lies between
+//   them), want points across the half-power band that the parabola of 1/ratio² through the
+//   three points implies (a linear isolator's 1/ratio² is nearly one near its peak); when that
+//   parabola says nothing (opens downwards, its vertex outside the neighbours), want + 1 points
+//   evenly in log f between the two neighbours, so the bracket shrinks by (want + 2)/2 a round;
+// - resolved, want points evenly in log f across the half-power band as interpolated (the
+//   chord across a peak crosses half power inside the true band: the points land in it);
+//   once it holds want points, the midpoint of each gap still too wide (band_holds).
+// A candidate within a quarter of the round's spacing of a point already measured is not added.
+void next_resonance_steps(std::span<const SweepPoint> points, int want, std::vector<double>& out);
+// How many points lie in r's half-power band (0 unless both half-power points were found).
+[[nodiscard]] int points_in_band(const Resonance& r, std::span<const SweepPoint> points) noexcept;
+// The refinement's goal: the highest peak resolved, its band holding `want` points, none of
+// its neighbouring points (nor the top's) more than 2/want of the bandwidth apart.
+[[nodiscard]] bool band_holds(std::span<const SweepPoint> points, int want);
+
 struct Jump {
   double lo_hz = 0, hi_hz = 0;  // the frequencies between which up and down differ by more than the threshold
   double max_difference = 0;    // the largest |up − down| / max(up, down) there

@@ -110,6 +110,13 @@ struct UnsettledEvent {
   double frequency_hz = NAN, change_pct = NAN;
   std::int64_t cycles = 0;
 };
+// A pass's resonance refinement stopped short of the half-power points asked (the plan's
+// "resonance"): where the peak was, what its band held, and why no more steps were added.
+struct ResonanceUnresolvedEvent {
+  std::int64_t pass = 0, band_points = 0, wanted = 0, added = 0;
+  double frequency_hz = NAN, amplitude_mm = NAN;
+  std::string why;
+};
 // The partial table scored on the run so far (after a descent); accuracy as models::accuracy_json.
 struct FitEvent {
   std::int64_t nodes = 0, required = 0;
@@ -136,7 +143,7 @@ struct CommandEvent {
 
 using CampaignEvent = std::variant<GapEvent, GapsEvent, SafeEvent, LimitsEvent, QualityEvent, ShakedownEvent, TrainingEvent, ValidationEvent, RetakeEvent,
                                    SineStepEvent, TransmissibilityEvent, SweepDoneEvent, ControlAbortEvent, ControlWarningEvent, ControlUnreachedEvent,
-                                   UnsettledEvent, FitEvent, EnvelopeEvent, RecordEvent, RecommendationEvent, CommandEvent>;
+                                   UnsettledEvent, ResonanceUnresolvedEvent, FitEvent, EnvelopeEvent, RecordEvent, RecommendationEvent, CommandEvent>;
 
 // Its stored kind ("gap", "control_unreached").
 [[nodiscard]] std::string_view kind_of(const CampaignEvent& e) noexcept;

@@ -10,7 +10,8 @@
 //    "control": {"tolerance": "5 %", "warning": "10 %", "abort": "30 %", "gain": 0.7, "window_cycles": 4,
 //                "converge": "1 %", "max_windows": 12, "max_drive_ratio": 4, "start_level": 0.5,
 //                "abort_windows": 3} or false (open loop: the drive is the demand)
-//    "jump_threshold": "10 %"}            up and down differing by more than this is a jump
+//    "jump_threshold": "10 %",            up and down differing by more than this is a jump
+//    "resonance": {"half_power_points": 5, "max_steps": 40} or true}   stepped: refine each pass's peak
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -62,6 +63,16 @@ struct SineSettle {
   int consecutive = 2, min_cycles = 30, max_cycles = 400;
 };
 
+// Resonance refinement (stepped passes): after a pass's planned steps, steps are added around
+// its highest peak, round by round (models::next_resonance_steps), until its half-power band
+// holds half_power_points points, so Q is measured rather than bounded; at most max_steps added
+// a pass (then said, with what was reached). The page's default 24 log steps read "Q ≥ 10.5"
+// for the simulated isolator whose Q is about 25.
+struct SineResonance {
+  bool refine = false;
+  int half_power_points = 5, max_steps = 40;
+};
+
 struct SinePlan {
   std::vector<double> frequencies_hz;  // stepped: the frequencies, ascending
   bool continuous = false;
@@ -72,6 +83,7 @@ struct SinePlan {
   int measured_cycles = 10;
   SineControl control;
   double jump_threshold_pct = 10;
+  SineResonance resonance;
   [[nodiscard]] double max_amplitude_mm() const;
   [[nodiscard]] double lowest_hz() const { return continuous ? from_hz : frequencies_hz.front(); }
   [[nodiscard]] double highest_hz() const { return continuous ? to_hz : frequencies_hz.back(); }
