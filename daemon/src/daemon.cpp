@@ -149,9 +149,9 @@ struct Daemon::Impl {
   // A campaign just submitted: its plan, parsed once by submit() and checked against the rig's
   // envelope, goes to the rig's thread as it is (no second parse, no database round trip: the
   // row is the record, and the source only at a restart or a resume).
-  void dispatch_new(RigWorker& w, std::int64_t id, domain::Plan plan, double submitted_mono) {
+  void dispatch_new(RigWorker& w, std::int64_t id, domain::Plan plan, double submitted_mono, std::shared_ptr<const IsolatorModel> isolator) {
     CampaignJob job;
-    job.isolator = w.entry.isolator;
+    job.isolator = std::move(isolator);
     job.id = id;
     job.submitted_mono = submitted_mono;
     job.plan = std::move(plan);
@@ -179,15 +179,26 @@ struct Daemon::Impl {
       }
   }
 
+  // The isolator a sine campaign is predicted with: its plan's own (a stored table by id, read
+  // here on the main loop), else the rig's. A plan's that cannot be built is the plan's error.
+  std::shared_ptr<const IsolatorModel> isolator_for(const RigWorker& w, const domain::Plan& plan) {
+    if (plan.kind != domain::CampaignKind::sine || plan.sine.isolator.is_null()) return w.entry.isolator;
+    try {
+      return std::make_shared<const IsolatorModel>(parse_isolator(plan.sine.isolator, "isolator", [this](std::int64_t t) { return store.table_document(t); }));
+    } catch (const IsolatorError& e) {
+      throw control::PlanError(e.field, e.what());
+    }
+  }
+
   std::optional<CampaignJob> make_job(RigWorker& w, std::int64_t id) {
     const auto row = store.campaign(id);
     if (!row) return std::nullopt;
     CampaignJob job;
-    job.isolator = w.entry.isolator;
     job.id = id;
     try {
       job.plan = domain::parse_plan(json::parse(row->plan));
       job.plan.limits = domain::check_plan_against(job.plan, w.entry.envelope, w.entry.supervision, w.info.kind == domain::RigKind::shaker);
+      job.isolator = isolator_for(w, job.plan);
     } catch (const std::exception& e) {  // a plan stored by an older or foreign tool: fail it, say why
       store.transition(id, domain::CampaignState::failed, e.what(), now_iso());
       return std::nullopt;
@@ -449,8 +460,9 @@ std::int64_t Daemon::submit(const std::string& rig_name, const json& plan_json) 
   checked.limits = applied_limits(plan, k);
   // On the main loop: the row first (the record), then the parsed job straight to the rig.
   return impl_->on_main<std::int64_t>([this, rig_id, kind, text, &rig, called, checked = std::move(checked)]() mutable {
+    auto isolator = impl_->isolator_for(rig, checked);  // before the row: a plan whose table is not there is refused
     const std::int64_t id = impl_->store.create_campaign(rig_id, kind, text, now_iso());
-    impl_->dispatch_new(rig, id, std::move(checked), called);
+    impl_->dispatch_new(rig, id, std::move(checked), called, std::move(isolator));
     return id;
   });
 }

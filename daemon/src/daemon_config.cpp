@@ -180,6 +180,8 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
       } else if (e.simulated && shaker) {
         e.isolator = std::make_shared<const IsolatorModel>(simulated_isolator());
       }
+    } catch (const IsolatorError& err) {
+      throw ConfigError(std::string("config: ") + err.what());
     } catch (const std::invalid_argument& err) {
       throw ConfigError(err.what());
     }

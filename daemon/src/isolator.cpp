@@ -17,7 +17,7 @@ namespace hystlab::daemon {
 namespace {
 constexpr double kG = 9.81;  // as the simulator's
 
-[[noreturn]] void isolator_fail(const std::string& field, const std::string& why) { throw std::invalid_argument("config: " + field + " " + why); }
+[[noreturn]] void isolator_fail(const std::string& field, const std::string& why) { throw IsolatorError(field, field + " " + why); }
 
 double isolator_positive(const nlohmann::json& j, const char* f, double def, const std::string& where) {
   if (!j.contains(f)) return def;
@@ -52,10 +52,17 @@ double steepest(const models::HysteresisModel& spring, double lo, double hi) {
   return most;
 }
 
-// A table identified on the load frame (a table document, docs/FORMATS.md): inline, or a file.
-IsolatorModel with_table(IsolatorModel m, const nlohmann::json& j, const std::string& where) {
+// A table identified on the load frame (a table document, docs/FORMATS.md): inline, a file, or
+// a table of this daemon's store by id.
+IsolatorModel with_table(IsolatorModel m, const nlohmann::json& j, const std::string& where, const TableLookup& stored) {
   std::string text, from = "inline";
-  if (j.is_string()) {
+  if (j.is_number_integer()) {
+    if (!stored) isolator_fail(where, "gives a stored table's id, which only a sine plan's isolator can (the store is not open when the config is read)");
+    const auto id = j.get<std::int64_t>();
+    const auto doc = stored(id);
+    if (!doc) isolator_fail(where, "names table " + std::to_string(id) + ", which this daemon's store does not hold");
+    text = *doc, from = "table " + std::to_string(id);
+  } else if (j.is_string()) {
     std::ifstream in(j.get<std::string>());
     if (!in) isolator_fail(where, "names a file that cannot be read: " + j.get<std::string>());
     std::ostringstream all;
@@ -64,14 +71,18 @@ IsolatorModel with_table(IsolatorModel m, const nlohmann::json& j, const std::st
   } else if (j.is_object()) {
     text = j.dump();
   } else {
-    isolator_fail(where, "must be a table document (as GET /api/tables/ID/export?format=json gives it) or the path of one");
+    isolator_fail(where, "must be a stored table's id, a table document (as GET /api/tables/ID/export?format=json gives it) or the path of one");
   }
   try {
     models::TableDocument doc = models::table_from_json(text);
     const models::Grid g = doc.table.grid();
     auto spring = std::make_shared<models::PreisachModel>(std::move(doc.table));
     const double k = steepest(*spring, g.lo, g.hi);
-    const std::string what = "Preisach table n = " + std::to_string(g.n) + " (" + doc.provenance.method + ", " + from + ")";
+    // The provenance said with the prediction (the page's "predicted with ..."): which table,
+    // how it was identified and from what.
+    std::string what = "Preisach table n = " + std::to_string(g.n) + " (" + doc.provenance.method + ", " + from;
+    if (!doc.provenance.source.empty()) what += ": " + doc.provenance.source;
+    what += ")";
     return with_spring(std::move(m), spring, std::max(k, 1e-6), what);
   } catch (const std::exception& e) {
     isolator_fail(where, std::string("is not a table document: ") + e.what());
@@ -93,7 +104,7 @@ double preload_of(const IsolatorModel& iso) {
 
 IsolatorModel simulated_isolator() { return with_spring(IsolatorModel{}, models::table1_parameters(), "simplified model, Table 1"); }
 
-IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where) {
+IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where, const TableLookup& stored) {
   if (!j.is_object()) isolator_fail(where, "must be an object: {\"mass_kg\": 13, \"springs\": 4, \"damping_N_s_per_m\": 58, \"params\": {...}}");
   for (const auto& [k, _] : j.items())
     if (k != "mass_kg" && k != "springs" && k != "damping_N_s_per_m" && k != "params" && k != "table" && k != "linear_N_per_mm")
@@ -107,7 +118,7 @@ IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where) 
   m.springs = j.value("springs", m.springs);
   m.damping_N_s_per_m =
       j.contains("damping_N_s_per_m") && j["damping_N_s_per_m"] == 0 ? 0.0 : isolator_positive(j, "damping_N_s_per_m", m.damping_N_s_per_m, where);
-  if (j.contains("table")) return with_table(m, j["table"], where + ".table");
+  if (j.contains("table")) return with_table(m, j["table"], where + ".table", stored);
   if (j.contains("linear_N_per_mm")) {
     const double k = isolator_positive(j, "linear_N_per_mm", 0, where);
     char what[64];

@@ -51,7 +51,7 @@ TEST_CASE("isolator: springs from a table identified on the load frame predict w
   const std::string file = (dir.path() / "S-07.json").string();
   std::ofstream(file) << table1_table(80).dump();
   const daemon::IsolatorModel from_table = daemon::parse_isolator({{"table", file}}, "isolator");
-  CHECK(from_table.describe.find("Preisach table n = 80 (virtual-fot, " + file + ")") != std::string::npos);
+  CHECK(from_table.describe.find("Preisach table n = 80 (virtual-fot, " + file + ": the simplified model, Table 1, on a virtual frame)") != std::string::npos);
   const daemon::IsolatorModel from_params = daemon::parse_isolator(json::object(), "isolator");  // Table 1 itself
   // Swept through the resonance at an amplitude that moves the springs' state (0.05 mm): the peak
   // where the springs themselves put it, and the ratio well below and above it. A table's small
@@ -109,4 +109,19 @@ TEST_CASE("isolator: a spring given two ways, a file that is not there, a docume
   CHECK(refusal({{"table", "/no/such/S-07.json"}}).find("rigs[1].isolator.table names a file that cannot be read") != std::string::npos);
   CHECK(refusal({{"table", {{"format", "nothing"}}}}).find("rigs[1].isolator.table is not a table document") != std::string::npos);
   CHECK(refusal({{"linear_N_per_mm", -1}}).find("rigs[1].isolator.linear_N_per_mm must be a number above 0") != std::string::npos);
+  CHECK(refusal({{"table", 7}}).find("rigs[1].isolator.table gives a stored table's id, which only a sine plan's isolator can") != std::string::npos);
+  // A plan's isolator: a stored table by id, looked up in the store.
+  const auto lookup = [](std::int64_t id) -> std::optional<std::string> {
+    if (id == 7) return table1_table(12).dump();
+    return std::nullopt;
+  };
+  const daemon::IsolatorModel stored = daemon::parse_isolator({{"table", 7}}, "isolator", lookup);
+  CHECK(stored.describe.find("Preisach table n = 12 (virtual-fot, table 7: the simplified model") != std::string::npos);
+  try {
+    (void)daemon::parse_isolator({{"table", 8}}, "isolator", lookup);
+    FAIL("a table the store does not hold was taken");
+  } catch (const daemon::IsolatorError& e) {
+    CHECK(e.field == "isolator.table");
+    CHECK(std::string(e.what()) == "isolator.table names table 8, which this daemon's store does not hold");
+  }
 }

@@ -18,8 +18,10 @@ using namespace hystlab;
 using namespace hystlab::test;
 
 namespace {
+// Read as hystlabd reads its simulated shaker: in blocks from the controller's sample window
+// (polled, a starved host left a 110 Hz window with 29 of its 32 samples, four times in a row).
 std::unique_ptr<drivers::Rig> shaker_rig(int port) {
-  return drivers::make_rig({{"transport", "modbus-tcp"}, {"port", port}, {"rig", "shaker"}, {"stale_after_ms", 5000}});
+  return drivers::make_rig({{"transport", "modbus-tcp"}, {"port", port}, {"rig", "shaker"}, {"block_reads", true}, {"stale_after_ms", 5000}});
 }
 
 std::vector<nlohmann::json> points_of(db::Store& store, std::int64_t campaign) {
@@ -249,7 +251,7 @@ TEST_CASE("resonance refinement on the simulated shaker: a Q of 25 measured, not
   // from the controller's sample window, a starved host loses no sample.
   SimProcess sim({"--rig", "shaker", "--port", "0", "--linear", "40"});
   Bench b;
-  auto rig = drivers::make_rig({{"transport", "modbus-tcp"}, {"port", sim.modbus_port}, {"rig", "shaker"}, {"block_reads", true}, {"stale_after_ms", 5000}});
+  auto rig = shaker_rig(sim.modbus_port);
   const auto plan = domain::parse_plan({{"kind", "sine"},
                                         {"frequencies_hz", {8, 12, 25, 40}},
                                         {"amplitude_mm", 0.005},

@@ -74,3 +74,62 @@ TEST_CASE("a sweep through the API: points, prediction, resonance report, CSVs w
   CHECK(base > 0.004);  // the base envelope: the demand, with the steps' starting transients
   CHECK(base < 0.008);
 }
+
+TEST_CASE("the mission's chain: springs identified on the simulated load frame predict the simulated isolator on the simulated shaker") {
+  // Both simulators carry the same spring (Table 1's simplified model): the frame's specimen and
+  // each of the shaker's four, preloaded to 0.80 mm by the 13 kg mass. The frame identifies it
+  // over 0-2 mm (n = 16: cells of 0.125 mm around the 0.80 mm preload), and the shaker's sweep
+  // names that stored table as its isolator's springs.
+  test::LiveDaemon live([](daemon::DaemonConfig& c) {
+    c.rigs = daemon::parse_daemon_config(json{{"rigs",
+                                               {{{"name", "sim frame"}, {"simulate", {{"time_scale", 20}, {"noise_N", 0.05}}}},
+                                                {{"name", "sim shaker"}, {"simulate", {{"rig", "shaker"}, {"time_scale", 1}}}}}}})
+                 .rigs;
+  });
+  auto c = live.client();
+  json fot = test::fot_plan(16, 2.0);
+  fot["range_mm"] = {0, 2};
+  fot["limits"]["displacement_mm"] = {-0.5, 2.5};
+  auto r = c.Post("/api/campaigns", json{{"plan", fot}, {"rig", "sim frame"}}.dump(), "application/json");
+  REQUIRE(r);
+  REQUIRE(r->status == 201);
+  const std::string frame_id = std::to_string(json::parse(r->body)["id"].get<std::int64_t>());
+  REQUIRE(live.wait_json(
+      "/api/campaigns/" + frame_id, [](const json& j) { return j["state"] == "completed" && j["recommendation"].is_object(); }, 240));
+  const std::int64_t table = json::parse(c.Get(("/api/campaigns/" + frame_id).c_str())->body)["recommendation"]["table"];
+
+  const json plan{{"kind", "sine"},        {"frequencies_hz", {10, 15, 17, 18.5, 24}},
+                  {"amplitude_mm", 0.005}, {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
+                  {"measured_cycles", 8},  {"isolator", {{"table", table}}}};
+  json missing = plan;  // a table the store does not hold: refused, named, before anything moves
+  missing["isolator"]["table"] = table + 1000;
+  r = c.Post("/api/campaigns", json{{"plan", missing}, {"rig", "sim shaker"}}.dump(), "application/json");
+  REQUIRE(r);
+  CHECK(r->status == 400);
+  CAPTURE(r->body);
+  CHECK(json::parse(r->body)["field"] == "plan.isolator.table");
+  CHECK(json::parse(r->body)["detail"].get<std::string>().find("which this daemon's store does not hold") != std::string::npos);
+  r = c.Post("/api/campaigns", json{{"plan", plan}, {"rig", "sim shaker"}}.dump(), "application/json");
+  REQUIRE(r);
+  REQUIRE(r->status == 201);
+  const std::string id = std::to_string(json::parse(r->body)["id"].get<std::int64_t>());
+  REQUIRE(live.wait_json(
+      "/api/campaigns/" + id, [](const json& j) { return j["state"] == "completed"; }, 180));
+  const json pts = json::parse(c.Get(("/api/campaigns/" + id + "/transmissibility").c_str())->body);
+  REQUIRE(pts.size() == 5);
+  for (const json& p : pts) {
+    CAPTURE(p.dump());
+    REQUIRE(p["predicted_ratio"].is_number());
+    // Measured against predicted from the frame's table, within 5 % (seen: 0.1 to 2.1 %, the
+    // largest at 17 and 18.5 Hz, where the ratio changes 30 % a hertz).
+    CHECK(std::fabs(p["predicted_ratio"].get<double>() / p["ratio"].get<double>() - 1) < 0.05);
+  }
+  // The provenance with the prediction: which table, how identified, from which campaign.
+  const json events = json::parse(c.Get(("/api/campaigns/" + id + "/events").c_str())->body);
+  std::string with;
+  for (const json& e : events)
+    if (e["kind"] == "sweep_done") with = e["detail"]["predicted_with"];
+  CAPTURE(with);
+  CHECK(with.find("Preisach table n = 16") != std::string::npos);
+  CHECK(with.find("table " + std::to_string(table) + ": campaign " + frame_id) != std::string::npos);
+}

@@ -164,6 +164,11 @@ SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   p.control = parse_control(j);
   p.jump_threshold_pct = fields::percent(j, "jump_threshold", p.jump_threshold_pct, "");
   p.resonance = parse_resonance(j, p.continuous);
+  if (j.contains("isolator")) {
+    if (!j["isolator"].is_object())
+      fields::fail("isolator", "must be an object: {\"table\": 7} (a stored table's id), with mass_kg, springs and damping_N_s_per_m if not the rig's");
+    p.isolator = j["isolator"];
+  }
   if (p.highest_hz() > sample_rate_hz / 8)
     fields::fail(
         p.continuous || j.contains("sweep") ? "sweep.to_hz" : "frequencies_hz",

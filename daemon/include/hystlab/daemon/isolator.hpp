@@ -9,12 +9,17 @@
 //   "params": {...simplified-model parameters...}   (Table 1 when no spring is given), or
 //   "table": "S-07.json" or {...a table document...} (a Preisach table identified on a load frame:
 //            the mission's chain, identify the springs on the frame, predict the isolator), or
+//            7 (a table in this daemon's store, by id: a sine plan's "isolator" only), or
 //   "linear_N_per_mm": 40}
-// A simulated shaker without one is predicted with the simulator's own isolator.
+// A simulated shaker without one is predicted with the simulator's own isolator. A sine plan's
+// own "isolator" (the same fields) replaces the rig's for that campaign.
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -32,8 +37,16 @@ struct IsolatorModel {
 
 // The simulator's default isolator (drivers/sim/shaker_sim.hpp: 13 kg, 4 springs of Table 1, 58 N·s/m).
 [[nodiscard]] IsolatorModel simulated_isolator();
-// A rig config's "isolator"; throws std::invalid_argument naming the field (where: "rigs[1].isolator").
-[[nodiscard]] IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where);
+// What is wrong with an isolator, naming the field ("rigs[1].isolator.table names a file ...").
+struct IsolatorError : std::invalid_argument {
+  IsolatorError(std::string field_name, const std::string& what) : std::invalid_argument(what), field(std::move(field_name)) {}
+  std::string field;
+};
+// A stored table's document by id (db::Reads::table_document), none when there is no such table.
+using TableLookup = std::function<std::optional<std::string>(std::int64_t)>;
+// A rig config's or a plan's "isolator" (where: "rigs[1].isolator", "isolator"); throws
+// IsolatorError. `stored` resolves "table": ID; without it an id is refused.
+[[nodiscard]] IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where, const TableLookup& stored = {});
 
 struct PredictStep {
   double frequency_hz = 0, base_amplitude_mm = 0;

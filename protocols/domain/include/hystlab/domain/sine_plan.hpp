@@ -11,7 +11,8 @@
 //                "converge": "1 %", "max_windows": 12, "max_drive_ratio": 4, "start_level": 0.5,
 //                "abort_windows": 3} or false (open loop: the drive is the demand)
 //    "jump_threshold": "10 %",            up and down differing by more than this is a jump
-//    "resonance": {"half_power_points": 5, "max_steps": 40} or true}   stepped: refine each pass's peak
+//    "resonance": {"half_power_points": 5, "max_steps": 40} or true,   stepped: refine each pass's peak
+//    "isolator": {"table": 7, ...}}       predicted with this isolator, not the rig's (daemon/isolator.hpp)
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -84,6 +85,9 @@ struct SinePlan {
   SineControl control;
   double jump_threshold_pct = 10;
   SineResonance resonance;
+  // The isolator to predict with, as written (the daemon builds it: a stored table by id needs
+  // its store); null: the rig's.
+  nlohmann::json isolator;
   [[nodiscard]] double max_amplitude_mm() const;
   [[nodiscard]] double lowest_hz() const { return continuous ? from_hz : frequencies_hz.front(); }
   [[nodiscard]] double highest_hz() const { return continuous ? to_hz : frequencies_hz.back(); }
