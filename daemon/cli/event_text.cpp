@@ -133,6 +133,15 @@ std::string say(const domain::ControlUnreachedEvent& d) {
 std::string say(const domain::UnsettledEvent& d) {
   return "at " + n(d.frequency_hz) + " Hz: not settled after " + n(d.cycles) + " cycles (still changing " + n(d.change_pct) + " %)";
 }
+std::string say(const domain::DwellEvent& d) {
+  std::string s = "pass " + n(d.pass) + ": dwell at " + n(d.amplitude_mm) + " mm";
+  if (d.track != "phase") return s + ", " + n(d.frequency_hz) + " Hz for " + count(static_cast<double>(d.cycles), "cycle");
+  if (!d.locked)
+    return s + ": the phase " + n(d.target_deg) + "° not found in " + count(static_cast<double>(d.windows), "window") + " (from " + n(d.start_hz) + " Hz)";
+  return s + " held at " + n(d.target_deg) + "° (mean " + n(d.phase_deg) + "°) for " + count(static_cast<double>(d.cycles), "cycle") + ", ending at " +
+         n(d.frequency_hz) + " Hz (from " + n(d.start_hz) + " Hz); " + n(d.out_of_tolerance) + " windows beyond the tolerance";
+}
+
 std::string say(const domain::ResonanceUnresolvedEvent& d) {
   return "pass " + n(d.pass) + ": the resonance near " + n(d.frequency_hz) + " Hz not resolved (" + n(d.band_points) + " of " + n(d.wanted) +
          " points in its half-power band, " + count(static_cast<double>(d.added), "step") + " added): " + d.why;

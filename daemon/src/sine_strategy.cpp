@@ -15,6 +15,7 @@
 #include "hystlab/daemon/base_control.hpp"
 #include "hystlab/models/sine_fit.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
+#include "phase_tracker.hpp"
 #include "sine_window.hpp"
 
 namespace hystlab::daemon {
@@ -59,7 +60,7 @@ class SineStrategy final : public Strategy {
 
   [[nodiscard]] bool done() const override { return pass_ >= passes_.size(); }
   [[nodiscard]] CampaignPhase phase() const override {
-    return mode_ == Mode::measure || mode_ == Mode::sweep ? CampaignPhase::shaker_measure : CampaignPhase::shaker_control;
+    return mode_ == Mode::measure || mode_ == Mode::sweep || mode_ == Mode::dwell ? CampaignPhase::shaker_measure : CampaignPhase::shaker_control;
   }
 
   void fill_finish(Loop& L, FinishJob& fj) override {
@@ -71,7 +72,7 @@ class SineStrategy final : public Strategy {
   }
 
  private:
-  enum class Mode { control, settle, measure, sweep };
+  enum class Mode { control, settle, measure, sweep, dwell };
 
   double demand() const { return passes_[pass_].amplitude_mm; }
   bool up() const { return passes_[pass_].up; }
@@ -103,6 +104,7 @@ class SineStrategy final : public Strategy {
   }
 
   bool to_measure() {
+    if (s_.dwell.on) return start_dwell();
     if (!s_.continuous) return open(Mode::measure, 0, s_.measured_cycles);
     next_cycle_ = w_.phase() + kTwoPi;
     return open(Mode::sweep, 0, s_.measured_cycles);
@@ -134,6 +136,8 @@ class SineStrategy final : public Strategy {
         return after_measure(L, t, b, m, v);
       case Mode::sweep:
         return after_sweep_window(L, t, b, m, v);
+      case Mode::dwell:
+        return after_dwell_window(L, t, b, m, v);
     }
     return true;
   }
@@ -144,7 +148,9 @@ class SineStrategy final : public Strategy {
   // A warning is said once per step; control.abort_windows windows in a row beyond the abort
   // band (one while measuring) stop the drive and end the campaign with the reason.
   bool check_band(Loop& L, double t, const ControlVerdict& v, double base) {
-    const bool measuring = mode_ == Mode::measure || mode_ == Mode::sweep;
+    // A dwell still looking for its phase moves the frequency every window: its base is
+    // controlled as a step's, not yet measured.
+    const bool measuring = mode_ == Mode::measure || mode_ == Mode::sweep || (mode_ == Mode::dwell && dwell_.locked);
     const bool counts = v.error_pct > 0 || established_ || v.limited || measuring || std::isnan(v.error_pct);
     if (v.band == ControlBand::within) established_ = true;
     if (counts && v.band == ControlBand::abort && (++abort_windows_ >= s_.control.abort_windows || measuring)) {
@@ -242,6 +248,52 @@ class SineStrategy final : public Strategy {
       if (!L.command_drive(t, f_, drive_)) return going(L);
     }
     return open(Mode::sweep, 0, s_.measured_cycles);
+  }
+
+  // A dwell (the plan's "dwell"), from its settled start: each window a point; tracking the
+  // phase, the frequency moves until the phase is the target within the tolerance, and the
+  // cycles count from then.
+  bool start_dwell() {
+    const domain::SineDwell& d = s_.dwell;
+    dwell_ = DwellCount{};
+    dwell_.locked = !d.track_phase;
+    tracker_.start(d.phase_deg * std::numbers::pi / 180, d.frequency_hz / domain::SineDwell::kRange, d.frequency_hz * domain::SineDwell::kRange);
+    return open(Mode::dwell, 0, s_.measured_cycles);
+  }
+
+  bool after_dwell_window(Loop& L, double t, const models::HarmonicFit& b, const models::HarmonicFit& m, const ControlVerdict& v) {
+    const domain::SineDwell& d = s_.dwell;
+    const double phase = std::remainder(m.fundamental.phase_rad - b.fundamental.phase_rad, kTwoPi);
+    const bool within = !d.track_phase || std::fabs(tracker_.error(phase)) * 180 / std::numbers::pi <= d.tolerance_deg;
+    ++dwell_.windows;
+    // Found once the phase is within the tolerance and the base at its demand (the window just
+    // after the last big move still rings: the base read +3.7 % and −4.8 % there).
+    dwell_.locked = dwell_.locked || (within && (v.converged || !s_.control.closed));
+    if (dwell_.locked) {
+      dwell_.cycles += s_.measured_cycles, dwell_.phase_sum_deg += phase * 180 / std::numbers::pi, ++dwell_.measured;
+      if (!within) ++dwell_.out_of_tolerance;
+    }
+    store_point(L, t, b, m, v);
+    if ((dwell_.locked && dwell_.cycles >= d.cycles) || (!dwell_.locked && dwell_.windows >= d.max_windows)) return end_dwell(L, t);
+    const double f = d.track_phase ? tracker_.next(f_, phase) : f_;
+    const bool moved = std::fabs(f - f_) > 1e-9 * f_, redrive = s_.control.closed && !v.converged;
+    if (redrive) drive_ = v.next_drive_mm;
+    f_ = f;
+    if ((moved || redrive) && !L.command_drive(t, f_, drive_)) return going(L);
+    return open(Mode::dwell, moved ? 1 : 0, s_.measured_cycles);
+  }
+
+  bool end_dwell(Loop& L, double t) {
+    const domain::SineDwell& d = s_.dwell;
+    domain::DwellEvent ev;
+    ev.pass = static_cast<std::int64_t>(pass_) + 1, ev.amplitude_mm = demand(), ev.track = d.track_phase ? "phase" : "none";
+    ev.start_hz = d.frequency_hz, ev.frequency_hz = f_, ev.target_deg = d.track_phase ? d.phase_deg : NAN;
+    ev.phase_deg = dwell_.measured > 0 ? dwell_.phase_sum_deg / static_cast<double>(dwell_.measured) : NAN;
+    ev.cycles = dwell_.cycles, ev.windows = dwell_.windows, ev.out_of_tolerance = dwell_.out_of_tolerance, ev.locked = dwell_.locked;
+    L.event(ev);
+    if (!dwell_.locked) ++warnings_;
+    ++step_;
+    return next_step(L, t);
   }
 
   // A cycle of a continuous pass has gone by: the next frequency at the plan's rate.
@@ -353,7 +405,13 @@ class SineStrategy final : public Strategy {
   std::vector<double> freqs_, refine_next_;      // this pass's frequencies (planned, then refined); a round's
   std::vector<models::SweepPoint> pass_points_;  // this pass's measured points (resonance refinement)
   int added_ = 0;                                // steps added to this pass
-  double added_nominal_ = 0;                     // their nominal seconds (the ETA)
+  struct DwellCount {
+    std::int64_t cycles = 0, windows = 0, out_of_tolerance = 0, measured = 0;
+    double phase_sum_deg = 0;
+    bool locked = false;
+  } dwell_;
+  PhaseTracker tracker_;
+  double added_nominal_ = 0;  // their nominal seconds (the ETA)
   std::size_t total_ = 0, pass_ = 0, step_ = 0;
   std::int64_t points_ = 0;
   static constexpr int kMaxRetakes = 3;

@@ -166,6 +166,62 @@ TEST_CASE("sine campaign: beyond the abort band the shaker is stopped, at zero d
   CHECK(base < 2e-4);
 }
 
+TEST_CASE("a resonance dwell tracks the phase: the mass held at -90 degrees against the base for its cycles, at the frequency where the physics puts it") {
+  // hystlab-sim --linear 40: the linear isolator (f_n 17.7 Hz, Q 25). Started at 16 Hz (the
+  // phase there about -8 degrees), the dwell moves the frequency until the mass lags its base by
+  // 90 degrees within 5, then holds it there for 300 cycles.
+  SimProcess sim({"--rig", "shaker", "--port", "0", "--linear", "40"});
+  Bench b;
+  auto rig = shaker_rig(sim.modbus_port);
+  const auto plan = domain::parse_plan({{"kind", "sine"},
+                                        {"dwell", {{"frequency_hz", 16}, {"cycles", 300}, {"track", "phase"}, {"phase_deg", -90}, {"tolerance_deg", 5}}},
+                                        {"amplitude_mm", 0.005},
+                                        {"settle_cycles", 20},
+                                        {"measured_cycles", 10},
+                                        {"sample_rate_hz", 1000}});
+  CHECK(plan.sine.lowest_hz() == doctest::Approx(16 / 1.25));  // the envelope is checked over where tracking may go
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 1.0, true);
+  const auto r = run(id, plan, ctx);
+  CAPTURE(r.reason);
+  REQUIRE(end_of(r) == "completed");
+  b.writer->flush();
+  const auto dwell = b.store->event_details(id, "dwell");
+  REQUIRE(dwell.size() == 1);
+  const auto d = nlohmann::json::parse(dwell[0]);
+  CAPTURE(d.dump());
+  CHECK(d["locked"] == true);
+  CHECK(d["cycles"].get<int>() >= 300);
+  CHECK(d["track"] == "phase");
+  // Where the physics puts -90 degrees: X/Y = (k + icω)/(k − mω² + icω) (mass minus base).
+  const double k = 4 * 40e3, c = 58, m = 13;
+  const auto phase_at = [&](double f) {
+    const double w = 2 * std::numbers::pi * f;
+    return std::atan2(c * w, k) - std::atan2(c * w, k - m * w * w);
+  };
+  double lo = 15, hi = 20;
+  for (int i = 0; i < 60; ++i) (phase_at(0.5 * (lo + hi)) > -std::numbers::pi / 2 ? lo : hi) = 0.5 * (lo + hi);
+  CHECK(d["frequency_hz"].get<double>() == doctest::Approx(0.5 * (lo + hi)).epsilon(0.005));
+  // Every window from where it was found (the phase within 5 degrees, the base within the 1 %
+  // of control.converge) on: within 90 ± 5 degrees, the base at its demand.
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() >= 30);
+  bool found = false;
+  int held = 0;
+  for (const auto& p : pts) {
+    const double deg = p["phase_rad"].get<double>() * 180 / std::numbers::pi;
+    CAPTURE(p.dump());
+    found = found || (std::fabs(deg + 90) <= 5 && std::fabs(p["control_error_pct"].get<double>()) <= 1);
+    if (!found) continue;
+    CHECK(std::fabs(deg + 90) <= 5);
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);  // the base still at its demand
+    ++held;
+  }
+  CHECK(held * 10 >= 300);
+  CHECK(d["out_of_tolerance"] == 0);
+  CHECK(d["phase_deg"].get<double>() == doctest::Approx(-90).epsilon(0.02));
+}
+
 TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rate, each window a point at its mean frequency") {
   SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5"});
   Bench b;
@@ -239,6 +295,12 @@ TEST_CASE("sine plans: sweeps, directions, amplitudes, settle and control, with 
   bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60}, "amplitude_mm": 0.1, "resonance": {"half_power_points": 2}})",
       "resonance.half_power_points must be");
   bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60}, "amplitude_mm": 0.1, "resonance": {"points": 5}})", "resonance.points");
+  bad(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60}, "dwell": {"frequency_hz": 17, "cycles": 10}, "amplitude_mm": 0.1})", "dwell or a sweep");
+  bad(R"({"kind": "sine", "dwell": {"frequency_hz": 17}, "amplitude_mm": 0.1})", "dwell needs frequency_hz (where it starts) and cycles");
+  bad(R"({"kind": "sine", "dwell": {"frequency_hz": 17, "cycles": 10, "track": "amplitude"}, "amplitude_mm": 0.1})", "dwell.track must be");
+  bad(R"({"kind": "sine", "dwell": {"frequency_hz": 17, "cycles": 10}, "direction": "down", "amplitude_mm": 0.1})", "direction is for a sweep");
+  bad(R"({"kind": "sine", "dwell": {"frequency_hz": 110, "cycles": 10, "track": "phase"}, "amplitude_mm": 0.1})",
+      "dwell.frequency_hz must stay below sample_rate_hz / 8");  // 110 × 1.25 at 1 kHz
   const auto r = domain::parse_plan(nlohmann::json::parse(R"({"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 60}, "amplitude_mm": 0.1, "resonance": true})"));
   CHECK(r.sine.resonance.refine);
   CHECK(r.sine.resonance.half_power_points == 5);

@@ -19,7 +19,8 @@ namespace {
 
 bool is_sine(const PlanField& f) {
   if (f.group == "sine") return true;
-  for (const char* p : {"sweep.", "frequencies_hz", "amplitude", "settle", "measured_cycles", "control.", "jump_threshold", "direction", "resonance."})
+  for (const char* p :
+       {"sweep.", "frequencies_hz", "amplitude", "settle", "measured_cycles", "control.", "jump_threshold", "direction", "resonance.", "dwell."})
     if (f.path.starts_with(p)) return true;
   return false;
 }
@@ -34,6 +35,7 @@ json base_plan(const PlanField& f) {
                       : json{{"kind", "fot"}, {"range_mm", {0, 4}}, {"subdivisions", 4}};
   if (!is_sine(f) && f.path != "training_cycles") p["training"] = {{"max_cycles", 5}, {"until", json::object()}};
   if (f.path == "frequencies_hz") p.erase("sweep");
+  if (f.path.starts_with("dwell.")) p.erase("sweep"), p["dwell"] = {{"frequency_hz", 17}, {"cycles", 100}};
   if (f.path == "amplitude_mm") p.erase("amplitudes_mm");
   if (f.path == "settle_cycles") p.erase("settle");
   if (f.path.starts_with("validation.")) p["validation"] = json::object();

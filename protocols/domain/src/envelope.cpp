@@ -113,7 +113,7 @@ void check_shaker(const Plan& p, const RigEnvelope& e) {
   const SinePlan& s = p.sine;
   const double a = s.max_amplitude_mm(), lo = s.lowest_hz(), hi = s.highest_hz(), w = 2 * std::numbers::pi * hi;
   const std::string amp = p.source.contains("amplitudes_mm") ? "amplitudes_mm" : "amplitude_mm";
-  const std::string freq = p.source.contains("frequencies_hz") ? "frequencies_hz" : "sweep";
+  const std::string freq = p.source.contains("frequencies_hz") ? "frequencies_hz" : s.dwell.on ? "dwell.frequency_hz" : "sweep";
   if (a > e.shaker_displacement_max_mm) refuse(amp, num(a) + " mm exceeds the shaker's maximum displacement " + num(e.shaker_displacement_max_mm) + " mm");
   for (const double f : {lo, hi})
     if (f < e.shaker_freq_min_hz * (1 - 1e-9) || f > e.shaker_freq_max_hz * (1 + 1e-9))

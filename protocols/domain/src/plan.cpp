@@ -198,7 +198,7 @@ Plan parse_plan(const json& j) {
         fail("points_mm[" + std::to_string(k) + "]", "lies outside limits.displacement_mm");
   } else {
     known({"frequencies_hz", "sweep", "amplitude_mm", "amplitudes_mm", "direction", "settle_cycles", "settle", "measured_cycles", "control", "jump_threshold",
-           "resonance", "isolator"});
+           "resonance", "isolator", "dwell"});
     parse_sine(j, p);
   }
   // Only against a rate the plan wrote: without one, the rig's envelope decides at submission and

@@ -80,6 +80,11 @@ constexpr std::array kFields{
   field("control.abort_windows", "abort windows in a row", "", 1, 100, T::integer),
   field("jump_threshold", "jump threshold", "%", 0, 100, T::percent),
   field("resonance.max_steps", "resonance steps added at most", "", 1, 1000, T::integer),
+  field("dwell.frequency_hz", "dwell frequency", "Hz", 1e-3, 1000, T::number),
+  field("dwell.cycles", "dwell cycles", "", 1, 100000000, T::integer),
+  field("dwell.phase_deg", "dwell phase", "°", -180, 180, T::number),
+  field("dwell.tolerance_deg", "dwell phase tolerance", "°", 0.1, 90, T::number),
+  field("dwell.max_windows", "windows to find the phase at most", "", 1, 10000, T::integer),
 };
 // clang-format on
 }  // namespace

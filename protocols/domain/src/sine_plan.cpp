@@ -92,6 +92,23 @@ SineSettle parse_settle(const json& j) {
   return s;
 }
 
+SineDwell parse_dwell(const json& b) {
+  if (!b.is_object()) fields::fail("dwell", "must be an object: {\"frequency_hz\": 17, \"cycles\": 2000, \"track\": \"phase\"}");
+  fields::only(b, "dwell.", {"frequency_hz", "cycles", "track", "phase_deg", "tolerance_deg", "max_windows"});
+  if (!b.contains("frequency_hz") || !b.contains("cycles")) fields::fail("dwell", "needs frequency_hz (where it starts) and cycles (how long it holds)");
+  SineDwell d;
+  d.on = true;
+  d.frequency_hz = fields::number(b, "frequency_hz", 0, "dwell.");
+  d.cycles = fields::integer(b, "cycles", 0, "dwell.");
+  const std::string track = b.contains("track") && b["track"].is_string() ? b["track"].get<std::string>() : b.contains("track") ? "?" : "none";
+  if (track != "phase" && track != "none") fields::fail("dwell.track", "must be \"phase\" (the frequency follows the phase) or \"none\" (held)");
+  d.track_phase = track == "phase";
+  d.phase_deg = fields::number(b, "phase_deg", d.phase_deg, "dwell.");
+  d.tolerance_deg = fields::number(b, "tolerance_deg", d.tolerance_deg, "dwell.");
+  d.max_windows = fields::integer(b, "max_windows", d.max_windows, "dwell.");
+  return d;
+}
+
 SineResonance parse_resonance(const json& j, bool continuous) {
   SineResonance r;
   if (!j.contains("resonance")) return r;
@@ -139,13 +156,19 @@ SineControl parse_control(const json& j) {
 
 SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   SinePlan p;
-  if (j.contains("frequencies_hz") && j.contains("sweep")) fields::fail("frequencies_hz", "or sweep: give one of them");
-  if (!j.contains("frequencies_hz") && !j.contains("sweep"))
-    fields::fail("sweep", "is required (or frequencies_hz): {\"from_hz\": 5, \"to_hz\": 80, \"steps\": 24}");
-  if (j.contains("frequencies_hz"))
+  const int given = static_cast<int>(j.contains("frequencies_hz")) + static_cast<int>(j.contains("sweep")) + static_cast<int>(j.contains("dwell"));
+  if (given > 1)
+    fields::fail(j.contains("dwell") ? "dwell" : "frequencies_hz", j.contains("dwell") ? "or a sweep: give one of them" : "or sweep: give one of them");
+  if (given == 0) fields::fail("sweep", "is required (or frequencies_hz, or dwell): {\"from_hz\": 5, \"to_hz\": 80, \"steps\": 24}");
+  if (j.contains("frequencies_hz")) {
     p.frequencies_hz = frequency_list(j["frequencies_hz"]);
-  else
+  } else if (j.contains("dwell")) {
+    p.dwell = parse_dwell(j["dwell"]);
+    p.frequencies_hz = {p.dwell.frequency_hz};
+    if (j.contains("direction")) fields::fail("direction", "is for a sweep; a dwell has none");
+  } else {
     parse_sweep(j["sweep"], p);
+  }
   if (j.contains("direction")) {
     const json& d = j["direction"];
     const std::string v = d.is_string() ? d.get<std::string>() : "";
@@ -164,6 +187,7 @@ SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   p.control = parse_control(j);
   p.jump_threshold_pct = fields::percent(j, "jump_threshold", p.jump_threshold_pct, "");
   p.resonance = parse_resonance(j, p.continuous);
+  if (p.resonance.refine && p.dwell.on) fields::fail("resonance", "refines a sweep's steps; a dwell has none (it tracks the phase)");
   if (j.contains("isolator")) {
     if (!j["isolator"].is_object())
       fields::fail("isolator", "must be an object: {\"table\": 7} (a stored table's id), with mass_kg, springs and damping_N_s_per_m if not the rig's");
@@ -171,7 +195,9 @@ SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   }
   if (p.highest_hz() > sample_rate_hz / 8)
     fields::fail(
-        p.continuous || j.contains("sweep") ? "sweep.to_hz" : "frequencies_hz",
+        p.dwell.on                            ? "dwell.frequency_hz"
+        : p.continuous || j.contains("sweep") ? "sweep.to_hz"
+                                              : "frequencies_hz",
         "must stay below sample_rate_hz / 8 (at least 8 samples a cycle): " + plan_number(p.highest_hz()) + " Hz at " + plan_number(sample_rate_hz) + " Hz");
   return p;
 }
@@ -214,6 +240,7 @@ double step_nominal_s(const SinePlan& p, double f) {
 
 double nominal_duration_s(const SinePlan& p) {
   const auto passes = sweep_passes(p);
+  if (p.dwell.on) return static_cast<double>(passes.size()) * (step_nominal_s(p, p.dwell.frequency_hz) + p.dwell.cycles / p.dwell.frequency_hz);
   if (p.continuous) return static_cast<double>(passes.size()) * (continuous_seconds(p) + step_nominal_s(p, p.from_hz) - p.measured_cycles / p.from_hz);
   double per_pass = 0;
   for (const double f : p.frequencies_hz) per_pass += step_nominal_s(p, f);
@@ -222,6 +249,7 @@ double nominal_duration_s(const SinePlan& p) {
 
 std::size_t step_count(const SinePlan& p) {
   const std::size_t passes = sweep_passes(p).size();
+  if (p.dwell.on) return passes * static_cast<std::size_t>(std::max(1, (p.dwell.cycles + p.measured_cycles - 1) / p.measured_cycles));
   if (!p.continuous) return passes * p.frequencies_hz.size();
   // cycles in a pass: ∫ f dt over the pass
   const double cycles =

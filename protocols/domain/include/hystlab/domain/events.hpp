@@ -117,6 +117,15 @@ struct ResonanceUnresolvedEvent {
   double frequency_hz = NAN, amplitude_mm = NAN;
   std::string why;
 };
+// A dwell's end (the plan's "dwell"): where it held, for how long, and how well. Tracking the
+// phase: the frequency it ended at, the mean phase of the windows since it was found, and the
+// windows beyond the tolerance since; not found within max_windows: locked false.
+struct DwellEvent {
+  std::int64_t pass = 0, cycles = 0, windows = 0, out_of_tolerance = 0;
+  double amplitude_mm = NAN, start_hz = NAN, frequency_hz = NAN, phase_deg = NAN, target_deg = NAN;
+  bool locked = false;
+  std::string track;
+};
 // The partial table scored on the run so far (after a descent); accuracy as models::accuracy_json.
 struct FitEvent {
   std::int64_t nodes = 0, required = 0;
@@ -141,9 +150,10 @@ struct CommandEvent {
   std::string text;
 };
 
-using CampaignEvent = std::variant<GapEvent, GapsEvent, SafeEvent, LimitsEvent, QualityEvent, ShakedownEvent, TrainingEvent, ValidationEvent, RetakeEvent,
-                                   SineStepEvent, TransmissibilityEvent, SweepDoneEvent, ControlAbortEvent, ControlWarningEvent, ControlUnreachedEvent,
-                                   UnsettledEvent, ResonanceUnresolvedEvent, FitEvent, EnvelopeEvent, RecordEvent, RecommendationEvent, CommandEvent>;
+using CampaignEvent =
+    std::variant<GapEvent, GapsEvent, SafeEvent, LimitsEvent, QualityEvent, ShakedownEvent, TrainingEvent, ValidationEvent, RetakeEvent, SineStepEvent,
+                 TransmissibilityEvent, SweepDoneEvent, ControlAbortEvent, ControlWarningEvent, ControlUnreachedEvent, UnsettledEvent, ResonanceUnresolvedEvent,
+                 DwellEvent, FitEvent, EnvelopeEvent, RecordEvent, RecommendationEvent, CommandEvent>;
 
 // Its stored kind ("gap", "control_unreached").
 [[nodiscard]] std::string_view kind_of(const CampaignEvent& e) noexcept;

@@ -3,6 +3,8 @@
 //   {"kind": "sine",
 //    "sweep": {"from_hz": 5, "to_hz": 80, "steps": 24, "spacing": "log"}     stepped (or "frequencies_hz": [...])
 //          or {"from_hz": 5, "to_hz": 80, "rate_oct_min": 2}                continuous (or "rate_hz_s")
+//    or "dwell": {"frequency_hz": 17, "cycles": 2000, "track": "phase", "phase_deg": -90,
+//                 "tolerance_deg": 5, "max_windows": 60}                    a (resonance) dwell
 //    "direction": "up" | "down" | "up-down",
 //    "amplitudes_mm": [0.01, 0.1]        base amplitudes (peak), each swept in turn ("amplitude_mm": one)
 //    "settle_cycles": 10                  or "settle": {"change": "2 %", "consecutive": 2, "min_cycles": 30, "max_cycles": 400}
@@ -74,6 +76,20 @@ struct SineResonance {
   int half_power_points = 5, max_steps = 40;
 };
 
+// A dwell: one frequency held for `cycles` cycles at each amplitude, each window of
+// measured_cycles a point. Tracking the phase ("track": "phase"), the frequency is moved window
+// by window until the mass's phase against the base is phase_deg (−90°: a linear isolator's
+// natural frequency, as resonance dwells for fatigue and damping tests hold it) within
+// tolerance_deg, and kept there; the cycles count from then. Not there within max_windows
+// windows: said, and the dwell ends. Tracking moves the frequency at most kRange either way of
+// frequency_hz: the envelope and the sample-rate rule are checked over that range.
+struct SineDwell {
+  static constexpr double kRange = 1.25;
+  bool on = false, track_phase = false;
+  double frequency_hz = 0, phase_deg = -90, tolerance_deg = 5;
+  int cycles = 0, max_windows = 60;
+};
+
 struct SinePlan {
   std::vector<double> frequencies_hz;  // stepped: the frequencies, ascending
   bool continuous = false;
@@ -85,12 +101,13 @@ struct SinePlan {
   SineControl control;
   double jump_threshold_pct = 10;
   SineResonance resonance;
+  SineDwell dwell;  // on: frequencies_hz holds its one (starting) frequency
   // The isolator to predict with, as written (the daemon builds it: a stored table by id needs
   // its store); null: the rig's.
   nlohmann::json isolator;
   [[nodiscard]] double max_amplitude_mm() const;
-  [[nodiscard]] double lowest_hz() const { return continuous ? from_hz : frequencies_hz.front(); }
-  [[nodiscard]] double highest_hz() const { return continuous ? to_hz : frequencies_hz.back(); }
+  [[nodiscard]] double lowest_hz() const { return continuous ? from_hz : dwell.track_phase ? dwell.frequency_hz / SineDwell::kRange : frequencies_hz.front(); }
+  [[nodiscard]] double highest_hz() const { return continuous ? to_hz : dwell.track_phase ? dwell.frequency_hz * SineDwell::kRange : frequencies_hz.back(); }
 };
 
 // One pass of a sweep: one amplitude, one direction.
