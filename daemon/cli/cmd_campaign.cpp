@@ -206,6 +206,7 @@ void print_sweep(db::Reads& store, const db::CampaignRow& row) {
       std::cout << "    " << what << " " << round_g(c.amplitude_mm) << " mm " << (c.up ? "up" : "down") << ": resonance " << round_g(z.frequency_hz)
                 << " Hz, peak " << round_g(z.peak_ratio);
       if (z.q > 0) std::cout << ", Q " << (z.resolved ? "" : ">= ") << round_g(z.q);
+      if (std::isfinite(c.damping_at_resonance)) std::cout << ", equivalent damping " << round_g(c.damping_at_resonance);  // the backbone's
       std::cout << (z.at_edge ? " (at the sweep's edge)" : "") << "\n";
     }
     for (const auto& a : r.jumps)

@@ -3,6 +3,7 @@
 // event details): the file carries it as the store has it.
 #include <nlohmann/json.hpp>
 
+#include <tuple>
 #include <vector>
 
 #include "h5_file.hpp"
@@ -10,6 +11,7 @@
 #include "hystlab/db/campaign_record.hpp"
 #include "hystlab/db/run_h5.hpp"
 #include "hystlab/db/store.hpp"
+#include "hystlab/models/sweep_analysis.hpp"
 
 namespace hystlab::db::h5_layout {
 namespace {
@@ -82,6 +84,40 @@ void write_nodes(Reads& store, hid_t file, std::int64_t campaign, int deflate_le
     h5::attr_text(d.get(), "units", n.substr(n.rfind('_') + 1));
   }
 }
+// A sine campaign's points, one row per step measured, as GET /api/campaigns/ID/sweep.csv has
+// them: with each step's equivalent damping from its hysteresis loop (models/sweep_analysis.hpp),
+// measured and predicted (NaN without a prediction). None for a campaign without points.
+void write_sweep(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
+  const auto rows = store.transmissibility(campaign);
+  if (rows.empty()) return;
+  const Handle g = h5::create_group(file, "sweep");
+  std::vector<std::int64_t> step, run;
+  std::vector<std::string> direction;
+  std::vector<double> f, demand, base, mass, ratio, phase, pratio, pphase, zeta, pzeta;
+  for (const TransmissibilityInfo& t : rows) {
+    step.push_back(t.step), run.push_back(t.run), direction.push_back(t.direction.empty() ? "up" : t.direction);
+    f.push_back(t.frequency_hz), demand.push_back(t.demand_mm), base.push_back(t.base_amplitude_mm), mass.push_back(t.mass_amplitude_mm);
+    ratio.push_back(t.ratio), phase.push_back(t.phase_rad), pratio.push_back(t.predicted_ratio), pphase.push_back(t.predicted_phase_rad);
+    zeta.push_back(models::equivalent_damping(t.ratio, t.phase_rad)), pzeta.push_back(models::equivalent_damping(t.predicted_ratio, t.predicted_phase_rad));
+  }
+  (void)h5::write_column(g.get(), "step", std::span<const std::int64_t>(step), deflate_level);
+  (void)h5::write_column(g.get(), "run", std::span<const std::int64_t>(run), deflate_level);
+  h5::dataset_texts(g.get(), "direction", direction, deflate_level);
+  const std::tuple<const char*, const std::vector<double>*, const char*> cols[] = {{"frequency_hz", &f, "Hz"},
+                                                                                   {"amplitude_mm", &demand, "mm"},
+                                                                                   {"base_amplitude_mm", &base, "mm"},
+                                                                                   {"mass_amplitude_mm", &mass, "mm"},
+                                                                                   {"ratio", &ratio, "1"},
+                                                                                   {"phase_rad", &phase, "rad"},
+                                                                                   {"predicted_ratio", &pratio, "1"},
+                                                                                   {"predicted_phase_rad", &pphase, "rad"},
+                                                                                   {"equivalent_damping", &zeta, "1"},
+                                                                                   {"predicted_equivalent_damping", &pzeta, "1"}};
+  for (const auto& [name, v, units] : cols) {
+    const Handle d = h5::write_column(g.get(), name, std::span<const double>(*v), deflate_level);
+    h5::attr_text(d.get(), "units", units);
+  }
+}
 }  // namespace
 
 std::int64_t write_campaign(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
@@ -90,6 +126,7 @@ std::int64_t write_campaign(Reads& store, hid_t file, std::int64_t campaign, int
   write_campaign_group(store, file, *c);
   write_events(store, file, campaign, deflate_level);
   write_nodes(store, file, campaign, deflate_level);
+  write_sweep(store, file, campaign, deflate_level);
   return write_tables(store, file, campaign, deflate_level);
 }
 

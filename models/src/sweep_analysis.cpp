@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <utility>
 
 namespace hystlab::models {
@@ -209,6 +210,28 @@ std::vector<Jump> find_jumps(std::span<const SweepPoint> up_points, std::span<co
   return out;
 }
 
+double equivalent_damping(double ratio, double phase_rad) noexcept {
+  if (!std::isfinite(ratio) || !std::isfinite(phase_rad) || !(ratio > 0)) return NAN;
+  const std::complex<double> t = std::polar(ratio, phase_rad);
+  const double delta = std::arg(t / (t - 1.0));
+  return std::tan(delta) / 2;
+}
+
+namespace {
+double damping_at(const std::vector<SweepPoint>& pts, double f) {
+  const std::vector<SweepPoint> s = sorted(pts);
+  if (s.size() < 2 || f < s.front().frequency_hz || f > s.back().frequency_hz) return NAN;
+  const auto it = std::lower_bound(s.begin(), s.end(), f, [](const SweepPoint& p, double v) { return p.frequency_hz < v; });
+  if (it == s.begin()) return equivalent_damping(it->ratio, it->phase_rad);
+  const SweepPoint& a = *(it - 1);
+  const SweepPoint& b = it == s.end() ? *(it - 1) : *it;
+  const double za = equivalent_damping(a.ratio, a.phase_rad), zb = equivalent_damping(b.ratio, b.phase_rad);
+  if (b.frequency_hz == a.frequency_hz) return za;
+  const double u = std::log(f / a.frequency_hz) / std::log(b.frequency_hz / a.frequency_hz);
+  return za + u * (zb - za);
+}
+}  // namespace
+
 SweepReport analyse_sweep(std::span<const SweepCurvePoint> points, double threshold) {
   SweepReport r;
   for (const SweepCurvePoint& p : points) {
@@ -216,7 +239,10 @@ SweepReport analyse_sweep(std::span<const SweepCurvePoint> points, double thresh
     if (it == r.curves.end()) it = r.curves.insert(r.curves.end(), SweepCurve{p.amplitude_mm, p.up, {}, std::nullopt});
     it->points.push_back(p.point);
   }
-  for (SweepCurve& c : r.curves) c.resonance = find_resonance(c.points);
+  for (SweepCurve& c : r.curves) {
+    c.resonance = find_resonance(c.points);
+    if (c.resonance && !c.resonance->at_edge) c.damping_at_resonance = damping_at(c.points, c.resonance->frequency_hz);
+  }
   for (const SweepCurve& up : r.curves) {
     if (!up.up) continue;
     for (const SweepCurve& down : r.curves)

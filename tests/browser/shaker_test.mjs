@@ -179,6 +179,10 @@ try {
   await page.fill('input[name=freqs]', FREQS.join(', '));
   await page.fill('input[name=settle]', '5');
   await page.fill('input[name=measured]', '5');
+  // The form proposes refining the resonance (5 points in its half-power band); this sweep keeps
+  // its 20 steps to be counted (the refinement: tests/daemon/test_shaker_campaign.cpp).
+  check(await page.inputValue('input[name=respts]') === '5', 'the form proposes refining the resonance to 5 half-power points');
+  await page.fill('input[name=respts]', '');
   await page.click('#submit');
   await checkRunning(page);
   check(await wait(page, () => window.hystlab.state() === 'completed', null, 'the sweep completing', 180000), 'the sweep completes');

@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <random>
 
@@ -164,6 +165,41 @@ TEST_CASE("resonance refinement: steps added around the peak until its half-powe
     CHECK(f < band->upper_hz);
   }
   CHECK(next.size() + static_cast<std::size_t>(points_in_band(*band, fine)) >= 40);
+}
+
+TEST_CASE("equivalent damping from the loop: a linear spring-damper's is zeta f/f_n; the SMA isolator's backbone softens and damps more with amplitude") {
+  for (const double zeta : {0.01, 0.02, 0.05, 0.2}) {
+    for (const double r : {0.3, 0.9, 1.0, 1.1, 2.5}) {
+      CAPTURE(zeta);
+      CAPTURE(r);
+      const std::complex<double> t = std::complex<double>(1, 2 * zeta * r) / std::complex<double>(1 - r * r, 2 * zeta * r);
+      CHECK(equivalent_damping(std::abs(t), std::arg(t)) == doctest::Approx(zeta * r).epsilon(1e-9));
+    }
+  }
+  CHECK(std::isnan(equivalent_damping(NAN, 0.1)));
+  CHECK(std::isnan(equivalent_damping(0, 0.1)));
+  // The simulator's isolator (Table 1 springs) swept up at 0.005 and 0.05 mm: the resonance falls
+  // (the springs transform and soften) and the damping at it rises (their hysteresis loop opens).
+  std::vector<SweepCurvePoint> all;
+  const std::vector<double> f = log_steps(12, 22, 26);
+  for (const double a : {0.005, 0.05}) {
+    SdofSystem sys = default_isolator();
+    for (const SweepPoint& p : sweep(sys, a, f)) all.push_back({a, true, p});
+  }
+  const SweepReport rep = analyse_sweep(all, 0.1);
+  REQUIRE(rep.curves.size() == 2);
+  REQUIRE(rep.curves[0].resonance);
+  REQUIRE(rep.curves[1].resonance);
+  const double f_small = rep.curves[0].resonance->frequency_hz, f_large = rep.curves[1].resonance->frequency_hz;
+  const double z_small = rep.curves[0].damping_at_resonance, z_large = rep.curves[1].damping_at_resonance;
+  CAPTURE(f_small);
+  CAPTURE(f_large);
+  CAPTURE(z_small);
+  CAPTURE(z_large);
+  CHECK(f_small == doctest::Approx(17.7).epsilon(0.03));   // on the austenite line: the linearised 17.7 Hz
+  CHECK(z_small == doctest::Approx(0.020).epsilon(0.15));  // the damper's 0.020 alone: the springs elastic
+  CHECK(f_large < 0.97 * f_small);
+  CHECK(z_large > 1.5 * z_small);
 }
 
 TEST_CASE("jumps: the band where up and down differ, and where each direction changes most") {

@@ -35,6 +35,9 @@ json point_json(const db::TransmissibilityInfo& t) {
   if (!j.contains("direction")) j["direction"] = t.direction.empty() ? "up" : t.direction;
   j["predicted_ratio"] = or_null(t.predicted_ratio);
   j["predicted_phase_rad"] = or_null(t.predicted_phase_rad);
+  // The step's hysteresis loop read as engineers do: its area against the elastic energy.
+  j["equivalent_damping"] = or_null(models::equivalent_damping(t.ratio, t.phase_rad));
+  j["predicted_equivalent_damping"] = or_null(models::equivalent_damping(t.predicted_ratio, t.predicted_phase_rad));
   return j;
 }
 
@@ -71,8 +74,11 @@ json report_json(const std::vector<db::TransmissibilityInfo>& rows, const json& 
   const models::SweepReport r = models::analyse_sweep(pts, threshold);
   json curves = json::array(), jumps = json::array();
   for (const models::SweepCurve& c : r.curves)
-    curves.push_back(
-        {{"amplitude_mm", c.amplitude_mm}, {"direction", c.up ? "up" : "down"}, {"points", c.points.size()}, {"resonance", resonance_json(c.resonance)}});
+    curves.push_back({{"amplitude_mm", c.amplitude_mm},
+                      {"direction", c.up ? "up" : "down"},
+                      {"points", c.points.size()},
+                      {"resonance", resonance_json(c.resonance)},
+                      {"equivalent_damping", or_null(c.damping_at_resonance)}});
   for (const models::AmplitudeJumps& a : r.jumps)
     for (const models::Jump& j : a.jumps)
       jumps.push_back({{"amplitude_mm", a.amplitude_mm},
@@ -81,7 +87,20 @@ json report_json(const std::vector<db::TransmissibilityInfo>& rows, const json& 
                        {"max_difference", j.max_difference},
                        {"up_jump_hz", j.up_jump_hz},
                        {"down_jump_hz", j.down_jump_hz}});
-  return {{"curves", curves}, {"jumps", jumps}, {"compared", r.jumps.size()}};
+  // The backbone: each amplitude's resonance and the damping there, amplitude by amplitude (a
+  // direction's own line), as an amplitude-dependent isolator is read.
+  json backbone = json::array();
+  for (const models::SweepCurve& c : r.curves)
+    if (c.resonance && !c.resonance->at_edge)
+      backbone.push_back({{"amplitude_mm", c.amplitude_mm},
+                          {"direction", c.up ? "up" : "down"},
+                          {"frequency_hz", c.resonance->frequency_hz},
+                          {"peak_ratio", c.resonance->peak_ratio},
+                          {"equivalent_damping", or_null(c.damping_at_resonance)}});
+  std::stable_sort(backbone.begin(), backbone.end(), [](const json& a, const json& b) {
+    return a["direction"] != b["direction"] ? a["direction"] == "up" : a["amplitude_mm"].get<double>() < b["amplitude_mm"].get<double>();
+  });
+  return {{"curves", curves}, {"jumps", jumps}, {"compared", r.jumps.size()}, {"backbone", backbone}};
 }
 
 constexpr const char* kCsvColumns[] = {"k",
@@ -101,7 +120,9 @@ constexpr const char* kCsvColumns[] = {"k",
                                        "band",
                                        "settle_cycles",
                                        "predicted_ratio",
-                                       "predicted_phase_rad"};
+                                       "predicted_phase_rad",
+                                       "equivalent_damping",
+                                       "predicted_equivalent_damping"};
 
 std::string points_csv(const std::vector<db::TransmissibilityInfo>& rows) {
   std::string out;

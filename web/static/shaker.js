@@ -177,16 +177,19 @@ export class SweepView {
   }
   renderTable() {
     const rows = this.rows(), r = this.report;
-    const head = el('tr', {}, ...['curve', 'resonance (Hz)', 'peak T', 'half-power points (Hz)', 'bandwidth (Hz)', 'Q'].map(h => el('th', { text: h })));
+    // ζ eq: the equivalent damping at the resonance, from the steps' hysteresis loops (the loop's
+    // area against the elastic energy): read down the amplitudes with the resonance, the backbone.
+    const head = el('tr', {}, ...['curve', 'resonance (Hz)', 'peak T', 'half-power points (Hz)', 'bandwidth (Hz)', 'Q', 'ζ eq'].map(h => el('th', { text: h })));
     const body = rows.map(({ which, curve: c }) => {
       const res = c.resonance;
       const label = `${num(c.amplitude_mm)} mm ${c.direction}${which === 'predicted' ? ' (predicted)' : ''}`;
-      const cells = !res ? ['–', '–', '–', '–', '–'] : [
+      const cells = !res ? ['–', '–', '–', '–', '–', '–'] : [
         res.at_edge ? 'beyond the sweep' : num(res.frequency_hz),
         (res.at_edge ? '≥ ' : '') + num(res.peak_ratio),
         // Steps coarser than the peak (resolved false): the bandwidth is at most, and Q at least, what is shown.
         halfPower(res), res.bandwidth_hz != null ? (res.resolved === false ? '≤ ' : '') + num(res.bandwidth_hz) : '–',
-        res.q != null ? (res.resolved === false ? '≥ ' : '') + num(res.q) : '–'];
+        res.q != null ? (res.resolved === false ? '≥ ' : '') + num(res.q) : '–',
+        Number.isFinite(c.equivalent_damping) ? num(c.equivalent_damping, 3) : '–'];
       const why = res && res.at_edge ? `the highest point (${hz(res.frequency_hz)}) is at the sweep's end: the peak may lie beyond`
         : res && res.resolved === false ? 'the steps are coarser than the peak: its bandwidth is at most, and its Q at least, what is shown' : '';
       return el('tr', { class: which, title: why },

@@ -3,6 +3,7 @@
 // half-power bandwidth and Q where the sweep reaches the half-power points) and, for a sweep
 // taken up and down at one amplitude, the band where the two directions differ: the jump of a
 // softening or hardening (here: hysteretic) isolator, which a linear plant never shows.
+#include <cmath>
 #include <optional>
 #include <span>
 #include <vector>
@@ -48,6 +49,15 @@ void next_resonance_steps(std::span<const SweepPoint> points, int want, std::vec
 // its neighbouring points (nor the top's) more than 2/want of the bandwidth apart.
 [[nodiscard]] bool band_holds(std::span<const SweepPoint> points, int want);
 
+// A step's equivalent viscous damping ratio from its hysteresis loop: ζ_eq = W_d / (4π W_s),
+// W_d the loop's area ∮F dz over a cycle and W_s = ½·k'·Z² the elastic energy at its amplitude,
+// with F = m·ω²·X_mass the force the springs and damper put on the mass and z = mass − base. On
+// the measured fundamentals (ratio T and phase φ of mass against base), F/Z = m·ω²·T·e^{iφ}/(T·e^{iφ} − 1),
+// and with δ its argument (the force's lead over the stroke, the loss angle) ζ_eq = tan(δ)/2:
+// the loop's harmonics do not change its area against a sine stroke. A linear spring-damper's
+// is ζ·f/f_n (ζ at its natural frequency); NaN when the ratio or phase is not finite.
+[[nodiscard]] double equivalent_damping(double ratio, double phase_rad) noexcept;
+
 struct Jump {
   double lo_hz = 0, hi_hz = 0;  // the frequencies between which up and down differ by more than the threshold
   double max_difference = 0;    // the largest |up − down| / max(up, down) there
@@ -72,6 +82,9 @@ struct SweepCurve {
   bool up = true;
   std::vector<SweepPoint> points;
   std::optional<Resonance> resonance;
+  // The backbone's damping: equivalent_damping at the resonance, interpolated in log f between
+  // the points either side of it (NaN without a resonance inside the sweep).
+  double damping_at_resonance = NAN;
 };
 struct AmplitudeJumps {
   double amplitude_mm = 0;
