@@ -72,23 +72,48 @@ class SineStrategy final : public Strategy {
   }
 
  private:
-  enum class Mode { control, settle, measure, sweep, dwell };
+  enum class Mode { ramp, control, settle, measure, sweep, dwell };
+  // Amplitude changes between the plan's levels go at most ×2 (6 dB) a control window.
+  static constexpr double kRampStep = 2.0;
 
-  double demand() const { return passes_[pass_].amplitude_mm; }
+  // The base amplitude aimed at: the pass's, or while ramping to it, the ramp's level.
+  double demand() const { return ramping_ ? ramp_level_ : passes_[pass_].amplitude_mm; }
   bool up() const { return passes_[pass_].up; }
   int harmonics(double f) const { return std::clamp(static_cast<int>(0.45 * plan_.sample_rate_hz / f), 1, 5); }
 
   // A step (stepped pass) or the start of a continuous pass: drive at the learnt response.
   bool begin_step(Loop& L, double t) {
     f_ = s_.continuous ? (up() ? s_.from_hz : s_.to_hz) : freqs_[step_];
+    start_ramp();
     drive_ = control_.start(f_, demand());
     control_windows_ = 0, settled_cycles_ = 0, stable_ = 0, abort_windows_ = 0, retakes_ = 0, warned_ = false, established_ = !s_.control.closed;
     prev_mass_ = NAN;
     if (!L.command_drive(t, f_, drive_)) return going(L);
     L.event(domain::SineStepEvent{points_ + 1, static_cast<std::int64_t>(total_), static_cast<std::int64_t>(pass_) + 1,
-                                  static_cast<std::int64_t>(passes_.size()), f_, demand(), drive_, eta(t), up() ? "up" : "down"});
+                                  static_cast<std::int64_t>(passes_.size()), f_, passes_[pass_].amplitude_mm, drive_, eta(t), up() ? "up" : "down"});
+    if (ramping_) return open(Mode::ramp, 1, s_.control.window_cycles);
     if (s_.control.closed) return open(Mode::control, 1, s_.control.window_cycles);
     return to_settle();
+  }
+
+  // A new level more than a factor kRampStep from the one before (the next pass's amplitude) is
+  // reached in steps of kRampStep a control window, from the last level: a hysteretic isolator's
+  // state is its amplitude history, and a jump of ×10 is a shock, not a sweep's level.
+  void start_ramp() {
+    const double target = passes_[pass_].amplitude_mm;
+    ramping_ = last_level_ > 0 && (target > kRampStep * last_level_ || target * kRampStep < last_level_);
+    if (ramping_) ramp_level_ = target > last_level_ ? last_level_ * kRampStep : last_level_ / kRampStep;
+    last_level_ = target;
+  }
+
+  // A ramp window: the next level (the last: on to control at the pass's own).
+  bool after_ramp(Loop& L, double t) {
+    const double target = passes_[pass_].amplitude_mm;
+    ramp_level_ = target > ramp_level_ ? std::min(target, ramp_level_ * kRampStep) : std::max(target, ramp_level_ / kRampStep);
+    ramping_ = ramp_level_ != target;
+    drive_ = control_.start(f_, demand());
+    if (!L.command_drive(t, f_, drive_)) return going(L);
+    return open(ramping_ ? Mode::ramp : Mode::control, 1, s_.control.window_cycles);
   }
 
   bool open(Mode m, int skip_cycles, int cycles) {
@@ -128,6 +153,8 @@ class SineStrategy final : public Strategy {
     const ControlVerdict v = control_.update(s_.continuous ? w_.mean_frequency() : f_, demand(), drive_, b.fundamental.amplitude);
     if (!check_band(L, t, v, b.fundamental.amplitude)) return false;
     switch (mode_) {
+      case Mode::ramp:
+        return after_ramp(L, t);
       case Mode::control:
         return after_control(L, t, v);
       case Mode::settle:
@@ -411,7 +438,9 @@ class SineStrategy final : public Strategy {
     bool locked = false;
   } dwell_;
   PhaseTracker tracker_;
-  double added_nominal_ = 0;  // their nominal seconds (the ETA)
+  bool ramping_ = false;
+  double ramp_level_ = 0, last_level_ = 0;  // the ramp's level now; the level of the step before
+  double added_nominal_ = 0;                // their nominal seconds (the ETA)
   std::size_t total_ = 0, pass_ = 0, step_ = 0;
   std::int64_t points_ = 0;
   static constexpr int kMaxRetakes = 3;

@@ -222,6 +222,43 @@ TEST_CASE("a resonance dwell tracks the phase: the mass held at -90 degrees agai
   CHECK(d["phase_deg"].get<double>() == doctest::Approx(-90).epsilon(0.02));
 }
 
+TEST_CASE("amplitude levels ramped: from 0.005 to 0.05 mm and back the drive goes at most x2 a control window, never a jump of x10") {
+  SimProcess sim({"--rig", "shaker", "--port", "0", "--linear", "40"});
+  Bench b;
+  auto rig = shaker_rig(sim.modbus_port);
+  const auto plan = domain::parse_plan({{"kind", "sine"},
+                                        {"frequencies_hz", {10}},
+                                        {"amplitudes_mm", {0.005, 0.05, 0.005}},
+                                        {"settle_cycles", 10},
+                                        {"measured_cycles", 8},
+                                        {"sample_rate_hz", 1000}});
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 1.0, true);
+  const auto r = run(id, plan, ctx);
+  CAPTURE(r.reason);
+  REQUIRE(end_of(r) == "completed");
+  b.writer->flush();
+  // The drive as commanded, sample by sample: each change at most ×2.2 (a ramp's ×2 and the
+  // loop's correction on it), after the first step's start.
+  double prev = 0, largest = 1;
+  int changes = 0;
+  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30, [&](const db::ShakerRow& row) {
+    const double d = row.v.drive_amplitude_mm;
+    if (prev > 0 && d > 0 && d != prev) largest = std::max(largest, std::max(d / prev, prev / d)), ++changes;
+    prev = d;
+  });
+  CAPTURE(changes);
+  CHECK(largest <= 2.2);
+  CHECK(largest >= 1.5);  // the ramp's steps are there
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 3);
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);  // each level reached and measured at its demand
+  }
+  CHECK(pts[1]["amplitude_mm"] == 0.05);
+}
+
 TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rate, each window a point at its mean frequency") {
   SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5"});
   Bench b;
