@@ -73,10 +73,9 @@ int report_points(db::Store& store, std::int64_t id, const domain::SinePlan& sin
   if (completed && pts.size() != domain::step_count(sine)) return 1;
   return completed && beyond > static_cast<int>(unreached) ? 1 : 0;
 }
-}  // namespace
 
 struct Swept {
-  daemon::CampaignResult r;
+  daemon::RunnerResult r;
   std::int64_t id = 0;
   double wall = 0;
 };
@@ -145,7 +144,7 @@ int main(int argc, char** argv) {
                                         {"sample_rate_hz", 1000}});
   const double nominal = domain::nominal_duration_s(plan.sine);
   const Swept s = sweep(bench, plan, !polled);
-  const daemon::CampaignResult& r = s.r;
+  const daemon::RunnerResult& r = s.r;
   const double wall = s.wall;
   // The baseline: a bare 1 kHz loop for a quarter of the sweep's time (its rate of missed periods is what compares).
   const double base_s = std::max(10.0, wall / 4);
