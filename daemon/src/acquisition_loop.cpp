@@ -406,6 +406,7 @@ bool tick(Loop& L, Strategy& strategy, Reader& rd, double t, bool blocks, double
       rd.last_kept = s.time_s;
       if (!link_back(L, strategy, s.time_s, blocks ? s.time_s : t, view_of(s), "step")) return false;
       if (!shaker_sample(L, strategy, s)) return false;
+      if (strategy.done()) break;  // a block's later samples belong to no step: the campaign is over
     }
   } else {
     if (auto ec = c.rig.read_samples(t, rd.block)) return on_missed(L, t, ec);

@@ -184,7 +184,8 @@ struct Daemon::Impl {
   std::shared_ptr<const IsolatorModel> isolator_for(const RigWorker& w, const domain::Plan& plan) {
     if (plan.kind != domain::CampaignKind::sine || plan.sine.isolator.is_null()) return w.entry.isolator;
     try {
-      return std::make_shared<const IsolatorModel>(parse_isolator(plan.sine.isolator, "isolator", [this](std::int64_t t) { return store.table_document(t); }));
+      return std::make_shared<const IsolatorModel>(parse_isolator(
+          plan.sine.isolator, "isolator", [this](std::int64_t t) { return store.table_document(t); }, w.entry.isolator.get()));
     } catch (const IsolatorError& e) {
       throw control::PlanError(e.field, e.what());
     }

@@ -56,7 +56,9 @@ double steepest(const models::HysteresisModel& spring, double lo, double hi) {
 // a table of this daemon's store by id.
 IsolatorModel with_table(IsolatorModel m, const nlohmann::json& j, const std::string& where, const TableLookup& stored) {
   std::string text, from = "inline";
-  if (j.is_number_integer()) {
+  if (j.is_string() && stored) {  // a plan comes over the network: no file of the daemon's host is opened for it
+    isolator_fail(where, "must be a stored table's id or a table document in a plan (a file path is for the rig's config)");
+  } else if (j.is_number_integer()) {
     if (!stored) isolator_fail(where, "gives a stored table's id, which only a sine plan's isolator can (the store is not open when the config is read)");
     const auto id = j.get<std::int64_t>();
     const auto doc = stored(id);
@@ -104,7 +106,7 @@ double preload_of(const IsolatorModel& iso) {
 
 IsolatorModel simulated_isolator() { return with_spring(IsolatorModel{}, models::table1_parameters(), "simplified model, Table 1"); }
 
-IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where, const TableLookup& stored) {
+IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where, const TableLookup& stored, const IsolatorModel* base) {
   if (!j.is_object()) isolator_fail(where, "must be an object: {\"mass_kg\": 13, \"springs\": 4, \"damping_N_s_per_m\": 58, \"params\": {...}}");
   for (const auto& [k, _] : j.items())
     if (k != "mass_kg" && k != "springs" && k != "damping_N_s_per_m" && k != "params" && k != "table" && k != "linear_N_per_mm")
@@ -112,6 +114,7 @@ IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where, 
   if (int(j.contains("params")) + int(j.contains("table")) + int(j.contains("linear_N_per_mm")) > 1)
     isolator_fail(where, "gives its springs one way: params, table or linear_N_per_mm");
   IsolatorModel m;
+  if (base) m.mass_kg = base->mass_kg, m.springs = base->springs, m.damping_N_s_per_m = base->damping_N_s_per_m;
   m.mass_kg = isolator_positive(j, "mass_kg", m.mass_kg, where);
   if (j.contains("springs") && (!j["springs"].is_number_integer() || j["springs"] < 1 || j["springs"] > 1000))
     isolator_fail(where + ".springs", "must be an integer from 1 to 1000");

@@ -33,6 +33,7 @@ class SineStrategy final : public Strategy {
   }
 
   bool on_shaker(Loop& L, const drivers::ShakerSample& s) override {
+    if (done()) return true;  // the last pass is over (a block read brings samples past it)
     if (!started_) {
       started_ = true;
       t0_ = s.time_s;
@@ -55,6 +56,7 @@ class SineStrategy final : public Strategy {
   // The step is taken again from its start (a pause, a held link): the response has changed.
   void on_resume(Loop& L, double t, bool) override {
     w_.restart(t);
+    resumed_ = true;  // from zero drive: the level is ramped to again
     if (pass_ < passes_.size()) (void)begin_step(L, t);
   }
 
@@ -99,11 +101,16 @@ class SineStrategy final : public Strategy {
   // A new level more than a factor kRampStep from the one before (the next pass's amplitude) is
   // reached in steps of kRampStep a control window, from the last level: a hysteretic isolator's
   // state is its amplitude history, and a jump of ×10 is a shock, not a sweep's level.
+  // After a pause or a held link (zero drive) the level is ramped to from a quarter of it
+  // (12 dB, two windows). last_level_ moves to a level once it is reached, so a ramp cut short
+  // starts again from where it was.
   void start_ramp() {
     const double target = passes_[pass_].amplitude_mm;
-    ramping_ = last_level_ > 0 && (target > kRampStep * last_level_ || target * kRampStep < last_level_);
-    if (ramping_) ramp_level_ = target > last_level_ ? last_level_ * kRampStep : last_level_ / kRampStep;
-    last_level_ = target;
+    const double from = resumed_ ? target / (kRampStep * kRampStep) : last_level_;
+    resumed_ = false;
+    ramping_ = from > 0 && (target > kRampStep * from * (1 + 1e-9) || target * kRampStep < from * (1 - 1e-9));
+    if (ramping_) ramp_level_ = target > from ? from * kRampStep : from / kRampStep;
+    if (!ramping_) last_level_ = target;
   }
 
   // A ramp window: the next level (the last: on to control at the pass's own).
@@ -111,6 +118,7 @@ class SineStrategy final : public Strategy {
     const double target = passes_[pass_].amplitude_mm;
     ramp_level_ = target > ramp_level_ ? std::min(target, ramp_level_ * kRampStep) : std::max(target, ramp_level_ / kRampStep);
     ramping_ = ramp_level_ != target;
+    if (!ramping_) last_level_ = target;
     drive_ = control_.start(f_, demand());
     if (!L.command_drive(t, f_, drive_)) return going(L);
     return open(ramping_ ? Mode::ramp : Mode::control, 1, s_.control.window_cycles);
@@ -301,6 +309,9 @@ class SineStrategy final : public Strategy {
       dwell_.cycles += s_.measured_cycles, dwell_.phase_sum_deg += phase * 180 / std::numbers::pi, ++dwell_.measured;
       if (!within) ++dwell_.out_of_tolerance;
     }
+    // The windows still to come, for the progress ("k of N"): the search's were not planned.
+    const auto left = dwell_.locked ? static_cast<std::size_t>(std::max<std::int64_t>(0, d.cycles - dwell_.cycles) / s_.measured_cycles) : 1;
+    total_ = std::max(total_, static_cast<std::size_t>(points_) + 1 + left);
     store_point(L, t, b, m, v);
     if ((dwell_.locked && dwell_.cycles >= d.cycles) || (!dwell_.locked && dwell_.windows >= d.max_windows)) return end_dwell(L, t);
     const double f = d.track_phase ? tracker_.next(f_, phase) : f_;
@@ -405,7 +416,10 @@ class SineStrategy final : public Strategy {
     const double phase = std::remainder(m.fundamental.phase_rad - b.fundamental.phase_rad, kTwoPi);
     const double f = s_.continuous ? w_.mean_frequency() : f_;
     ++points_;
-    if (!s_.continuous) nominal_done_ += domain::step_nominal_s(s_, f_);
+    if (s_.dwell.on)
+      nominal_done_ += s_.measured_cycles / f_;  // a dwell's window, not a step
+    else if (!s_.continuous)
+      nominal_done_ += domain::step_nominal_s(s_, f_);
     domain::TransmissibilityEvent rec;
     rec.k = points_, rec.of = static_cast<std::int64_t>(total_), rec.pass = static_cast<std::int64_t>(pass_) + 1;
     rec.frequency_hz = f, rec.amplitude_mm = demand(), rec.direction = up() ? "up" : "down", rec.drive_mm = drive_;
@@ -414,7 +428,11 @@ class SineStrategy final : public Strategy {
     rec.ratio = ratio, rec.phase_rad = phase, rec.thd = m.thd, rec.harmonics = m.harmonics;
     rec.control_error_pct = v.error_pct, rec.band = to_string(v.band), rec.control_windows = control_windows_;
     rec.settle_cycles = s_.settle.until ? settled_cycles_ : s_.settle.cycles, rec.t_s = t, rec.eta_s = eta(t);
-    steps_.push_back({points_, PredictStep{f, b.fundamental.amplitude, settled_cycles_ + s_.settle.cycles, s_.measured_cycles}});
+    // A dwell's windows are predicted once per frequency (within 0.5 %): a 2000-cycle dwell is
+    // not 200 simulations on the finisher.
+    const bool predict = !s_.dwell.on || steps_.empty() || std::fabs(steps_.back().second.frequency_hz / f - 1) > 0.005 ||
+                         std::fabs(steps_.back().second.base_amplitude_mm / b.fundamental.amplitude - 1) > 0.05;
+    if (predict) steps_.push_back({points_, PredictStep{f, b.fundamental.amplitude, settled_cycles_ + s_.settle.cycles, s_.measured_cycles}});
     if (!s_.continuous && pass_points_.size() < pass_points_.capacity()) pass_points_.push_back({f, ratio, phase});
     db::SinePointRow row{points_, f, demand(), b.fundamental.amplitude, m.fundamental.amplitude, ratio, phase, rec.direction, domain::encode(rec)};
     const auto run = L.result.run_id, id = L.job.id;
@@ -439,8 +457,8 @@ class SineStrategy final : public Strategy {
     bool locked = false;
   } dwell_;
   PhaseTracker tracker_;
-  bool ramping_ = false;
-  double ramp_level_ = 0, last_level_ = 0;  // the ramp's level now; the level of the step before
+  bool ramping_ = false, resumed_ = false;
+  double ramp_level_ = 0, last_level_ = 0;  // the ramp's level now; the last level reached
   double added_nominal_ = 0;                // their nominal seconds (the ETA)
   std::size_t total_ = 0, pass_ = 0, step_ = 0;
   std::int64_t points_ = 0;

@@ -479,7 +479,9 @@ std::error_code ModbusRig::write_host_heartbeat(std::uint32_t value) noexcept {
 // once needs no rewrite of it 1,000 times a sweep); anything that may have changed it on the
 // controller side (a reconnect, a failed transaction, an e-stop, a reset) writes it again.
 std::error_code ModbusRig::command_shaker(double f, double a, bool enable) noexcept {
-  if (enable_known_ && enable_written_ == enable) return write_signals({{Signal::drive_frequency_hz, f}, {Signal::drive_amplitude_mm, a}});
+  // A disable is always written (the supervisor's retry of one the controller did not take
+  // must reach the coil); only a standing enable is left as it is.
+  if (enable && enable_known_ && enable_written_) return write_signals({{Signal::drive_frequency_hz, f}, {Signal::drive_amplitude_mm, a}});
   if (auto ec = write_signals({{Signal::drive_frequency_hz, f}, {Signal::drive_amplitude_mm, a}, {Signal::shaker_enable, enable ? 1.0 : 0.0}})) return ec;
   enable_known_ = true, enable_written_ = enable;
   return {};

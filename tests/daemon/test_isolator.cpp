@@ -117,6 +117,19 @@ TEST_CASE("isolator: a spring given two ways, a file that is not there, a docume
   };
   const daemon::IsolatorModel stored = daemon::parse_isolator({{"table", 7}}, "isolator", lookup);
   CHECK(stored.describe.find("Preisach table n = 12 (virtual-fot, table 7: the simplified model") != std::string::npos);
+  // The rig's mass, springs and damper unless the plan gives them; no file opened for a plan.
+  daemon::IsolatorModel rig;
+  rig.mass_kg = 20, rig.springs = 6, rig.damping_N_s_per_m = 80;
+  const daemon::IsolatorModel on_rig = daemon::parse_isolator({{"table", 7}, {"springs", 3}}, "isolator", lookup, &rig);
+  CHECK(on_rig.mass_kg == 20);
+  CHECK(on_rig.springs == 3);
+  CHECK(on_rig.damping_N_s_per_m == 80);
+  try {
+    (void)daemon::parse_isolator({{"table", "/etc/passwd"}}, "isolator", lookup);
+    FAIL("a plan opened a file of the daemon's host");
+  } catch (const daemon::IsolatorError& e) {
+    CHECK(std::string(e.what()).find("isolator.table must be a stored table's id or a table document in a plan") == 0);
+  }
   try {
     (void)daemon::parse_isolator({{"table", 8}}, "isolator", lookup);
     FAIL("a table the store does not hold was taken");

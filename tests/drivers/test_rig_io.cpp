@@ -441,6 +441,13 @@ TEST_CASE("shaker over modbus, block reads: every sample once on the controller'
   const std::uint64_t before_reenable = rig.health().writes;
   REQUIRE_FALSE(rig.command_shaker(20.0, 0.4, true));
   CHECK(rig.health().writes - before_reenable == 2);  // the drive's registers, then the enable coil
+  // A disable is written every time: the supervisor's retry of one the controller did not take
+  // must reach the coil.
+  for (int k = 0; k < 2; ++k) {
+    const std::uint64_t before = rig.health().writes;
+    REQUIRE_FALSE(rig.command_shaker(0.0, 0.0, false));
+    CHECK(rig.health().writes - before == 2);
+  }
 }
 
 TEST_CASE("rigs from configuration: a simulated rig is only a different address") {

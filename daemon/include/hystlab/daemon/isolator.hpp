@@ -45,8 +45,11 @@ struct IsolatorError : std::invalid_argument {
 // A stored table's document by id (db::Reads::table_document), none when there is no such table.
 using TableLookup = std::function<std::optional<std::string>(std::int64_t)>;
 // A rig config's or a plan's "isolator" (where: "rigs[1].isolator", "isolator"); throws
-// IsolatorError. `stored` resolves "table": ID; without it an id is refused.
-[[nodiscard]] IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where, const TableLookup& stored = {});
+// IsolatorError. `stored` (a plan's) resolves "table": ID, and refuses a file path (a plan comes
+// over the network); without it an id is refused. Mass, springs and damping not given are
+// base's (the rig's isolator, for a plan's), else the simulator's.
+[[nodiscard]] IsolatorModel parse_isolator(const nlohmann::json& j, const std::string& where, const TableLookup& stored = {},
+                                           const IsolatorModel* base = nullptr);
 
 struct PredictStep {
   double frequency_hz = 0, base_amplitude_mm = 0;
