@@ -381,9 +381,9 @@ class SineStrategy final : public Strategy {
 
   // The refinement is over: said when the band does not hold the points asked, with why.
   void unresolved(Loop& L, int want) {
+    if (models::band_holds(pass_points_, want)) return;  // the refinement's own goal, not a second copy of it
     const auto r = models::find_resonance(pass_points_);
     const int in_band = r ? models::points_in_band(*r, pass_points_) : 0;
-    if (r && r->resolved && in_band >= want) return;
     const char* why = !r                                     ? "fewer than 3 points"
                       : r->at_edge                           ? "the peak is at the sweep's edge (it may lie beyond)"
                       : added_ >= s_.resonance.max_steps     ? "resonance.max_steps reached"

@@ -42,11 +42,7 @@ class Rig {
   // gives what its controller buffered on its own clock, time_s from the controller's counter:
   // a late caller loses nothing until the controller's buffer overruns (counted in health()).
   virtual std::error_code read_samples(double now_s, std::vector<RigSample>& out) noexcept {
-    out.clear();
-    RigSample s;
-    const std::error_code ec = read_sample(now_s, s);
-    if (!ec && out.capacity() > 0) out.push_back(s);
-    return ec;
+    return latest_as_block(out, [&](RigSample& s) { return read_sample(now_s, s); });
   }
   [[nodiscard]] virtual bool block_reads() const noexcept { return false; }
   // What a real controller needs beyond motion. Each answers RigError::unsupported when the rig
@@ -66,11 +62,7 @@ class Rig {
   // A shaker's read_samples: every sample since the last call, oldest first, as above (a rig
   // without block reads gives its latest, read_shaker).
   virtual std::error_code read_shaker_samples(double now_s, std::vector<ShakerSample>& out) noexcept {
-    out.clear();
-    ShakerSample s;
-    const std::error_code ec = read_shaker(now_s, s);
-    if (!ec && out.capacity() > 0) out.push_back(s);
-    return ec;
+    return latest_as_block(out, [&](ShakerSample& s) { return read_shaker(now_s, s); });
   }
   [[nodiscard]] virtual IoHealthSnapshot health() const noexcept = 0;
   [[nodiscard]] virtual std::string describe() const = 0;
@@ -85,6 +77,16 @@ class Rig {
   void command_or_throw(double setpoint_mm, double ramp_rate_mm_s) { check(command(setpoint_mm, ramp_rate_mm_s), "command"); }
 
  private:
+  // The latest sample as a block of one (out cleared; nothing added when its capacity is 0: the
+  // caller's buffer never grows here).
+  template <class Sample, class Read>
+  static std::error_code latest_as_block(std::vector<Sample>& out, Read read) noexcept {
+    out.clear();
+    Sample s;
+    const std::error_code ec = read(s);
+    if (!ec && out.capacity() > 0) out.push_back(s);
+    return ec;
+  }
   void check(std::error_code ec, const char* what) const {
     if (ec) throw std::system_error(ec, describe() + ": " + what);
   }
