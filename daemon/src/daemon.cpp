@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <exception>
 #include <filesystem>
 #include <future>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -50,20 +52,48 @@ struct Daemon::Impl {
 
   explicit Impl(const DaemonConfig& c) : config(c), store(c.db_path) {}
 
-  // Runs f on the main loop with its store and waits for it (at most 10 s).
+  // Runs f on the main loop with its store and waits for it (at most 10 s). An exception crosses
+  // as an exception_ptr that the caller moves out of the answer, so the caller's thread holds its
+  // only reference and frees it. (A std::packaged_task left a reference in the job, freed by the
+  // main loop while the HTTP thread still read the message: ThreadSanitizer saw that race in CI,
+  // since libstdc++'s exception refcount is not instrumented.)
   template <class R>
   R on_main(std::function<R()> f) {
-    auto task = std::make_shared<std::packaged_task<R()>>(std::move(f));
-    auto fut = task->get_future();
+    struct Answer {
+      std::mutex m;
+      std::condition_variable cv;
+      bool done = false;
+      std::optional<R> value;
+      std::exception_ptr error;
+    };
+    auto answer = std::make_shared<Answer>();
     {
       std::lock_guard lk(mu);
       if (!accepting) throw std::runtime_error("the daemon is stopping");
-      jobs.emplace_back([task] { (*task)(); });
+      jobs.emplace_back([answer, f = std::move(f)] {
+        std::optional<R> value;
+        std::exception_ptr error;
+        try {
+          value.emplace(f());
+        } catch (...) {
+          error = std::current_exception();
+        }
+        std::lock_guard alk(answer->m);
+        answer->value = std::move(value);
+        answer->error = std::move(error);
+        answer->done = true;
+        answer->cv.notify_all();
+      });
     }
     cv.notify_one();
-    if (fut.wait_for(std::chrono::seconds(10)) != std::future_status::ready)
+    std::unique_lock lk(answer->m);
+    if (!answer->cv.wait_for(lk, std::chrono::seconds(10), [&] { return answer->done; }))
       throw std::runtime_error("the daemon did not answer within 10 s (is the database busy?)");
-    return fut.get();
+    if (std::exception_ptr error = std::move(answer->error)) {
+      lk.unlock();
+      std::rethrow_exception(std::move(error));
+    }
+    return std::move(*answer->value);
   }
 
   RigWorker* worker_of(std::int64_t rig_id) {

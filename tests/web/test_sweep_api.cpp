@@ -143,3 +143,24 @@ TEST_CASE("the mission's chain: springs identified on the simulated load frame p
   CHECK(with.find("Preisach table n = 16 (fot,") != std::string::npos);
   CHECK(with.find("table " + std::to_string(table) + ": campaign " + frame_id) != std::string::npos);
 }
+
+TEST_CASE("a refusal from the daemon's main loop crosses to the HTTP thread whole, request after request") {
+  // The isolator's table is looked up on the main loop; its refusal is an exception carried back
+  // to the HTTP thread that reads its message. That exception was once freed by the main loop
+  // while the HTTP thread still read it (ThreadSanitizer, CI): 40 refusals in a row, each whole.
+  test::LiveDaemon live([](daemon::DaemonConfig& c) {
+    c.rigs = daemon::parse_daemon_config(json{{"rigs", {{{"name", "sim shaker"}, {"simulate", {{"rig", "shaker"}}}}}}}).rigs;
+  });
+  auto c = live.client();
+  const json plan{{"kind", "sine"}, {"frequencies_hz", {10}}, {"amplitude_mm", 0.005}, {"isolator", {{"table", 4242}}}};
+  for (int k = 0; k < 40; ++k) {
+    CAPTURE(k);
+    auto r = c.Post("/api/campaigns", json{{"plan", plan}, {"rig", "sim shaker"}}.dump(), "application/json");
+    REQUIRE(r);
+    REQUIRE(r->status == 400);
+    const json e = json::parse(r->body);
+    CHECK(e["field"] == "plan.isolator.table");
+    CHECK(e["detail"].get<std::string>().find("4242") != std::string::npos);
+  }
+  CHECK(json::parse(c.Get("/api/campaigns")->body).empty());  // nothing stored for a refused plan
+}
