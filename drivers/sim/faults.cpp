@@ -22,6 +22,8 @@ std::string Faults::apply(const std::string& spec) {
     drop = true;
   else if (name == "delay")
     delay_ms = value > 0 ? value : 200;
+  else if (name == "late-step")
+    late_step_ms = value > 0 ? value : 150;
   else if (name == "stall")
     stall_ms = value > 0 ? value : 30;
   else if (name == "exception")
@@ -38,14 +40,15 @@ std::string Faults::apply(const std::string& spec) {
     *this = Faults{};
   else
     return "unknown fault '" + name +
-           "' (drop, delay=MS, stall=MS, exception=CODE, crc, freeze, overload, can-silent, estop, latch=CODE, deadband=MM, overtravel=MM, clear)";
+           "' (drop, delay=MS, late-step=MS, stall=MS, exception=CODE, crc, freeze, overload, can-silent, estop, latch=CODE, deadband=MM, overtravel=MM, "
+           "clear)";
   return "";
 }
 
 std::string Faults::describe() const {
   std::ostringstream s;
-  s << "drop=" << drop << " delay=" << delay_ms << " stall=" << stall_ms << " exception=" << exception << " crc=" << crc << " freeze=" << freeze
-    << " overload=" << overload << " can-silent=" << can_silent;
+  s << "drop=" << drop << " delay=" << delay_ms << " late-step=" << late_step_ms << " stall=" << stall_ms << " exception=" << exception << " crc=" << crc
+    << " freeze=" << freeze << " overload=" << overload << " can-silent=" << can_silent;
   return s.str();
 }
 

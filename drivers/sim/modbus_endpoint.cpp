@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -117,6 +118,7 @@ void ModbusEndpoint::serve(int fd, const Faults& faults, SimRig& rig) {
   }
   if (rc == 0) return;  // not for us (RTU: another slave)
   if (faults.delay_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(faults.delay_ms));
+  if (faults.late_step_ms > 0 && starts_new_step(query, rc)) std::this_thread::sleep_for(std::chrono::milliseconds(faults.late_step_ms));
   if (faults.exception > 0) {
     modbus_reply_exception(ctx_, query, static_cast<unsigned>(faults.exception));
     return;
@@ -131,6 +133,31 @@ void ModbusEndpoint::serve(int fd, const Faults& faults, SimRig& rig) {
     rig.apply(written_commands());
     show_enable(rig);
   }
+}
+
+// The first write of each new drive frequency (a shaker's step: 0x06 or 0x10 over the entry's
+// registers, to a frequency other than 0 and than the last one answered late), which the
+// late-step fault answers late, as a controller busy retuning. Its retake is on time: once a step.
+bool ModbusEndpoint::starts_new_step(const std::uint8_t* q, int length) {
+  const protocols::MapEntry* e = map_.find(protocols::Signal::drive_frequency_hz);
+  if (!e || e->table != ModbusTable::holding_register) return false;
+  const int h = modbus_get_header_length(ctx_), fn = q[h];
+  const int first = (q[h + 1] << 8) | q[h + 2];
+  const int count = fn == 0x06 ? 1 : fn == 0x10 ? ((q[h + 3] << 8) | q[h + 4]) : 0;
+  const int at = fn == 0x06 ? h + 3 : h + 6;  // the first word's first byte
+  std::array<std::uint16_t, 2> words{mapping_->tab_registers[e->address], mapping_->tab_registers[e->address + e->width() - 1]};
+  bool touched = false;
+  for (int k = 0; k < count && at + 2 * k + 1 < length; ++k) {
+    const int i = first + k - e->address;
+    if (i < 0 || i >= e->width()) continue;
+    words[static_cast<std::size_t>(i)] = static_cast<std::uint16_t>((q[at + 2 * k] << 8) | q[at + 2 * k + 1]);
+    touched = true;
+  }
+  double f = 0;
+  if (!touched || protocols::decode(*e, std::span<const std::uint16_t>(words.data(), static_cast<std::size_t>(e->width())), f) || f == 0 || f == last_late_hz_)
+    return false;
+  last_late_hz_ = f;
+  return true;
 }
 
 // A reset drops the drive's enable; the coil says so, and the host must write it again (an

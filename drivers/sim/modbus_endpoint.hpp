@@ -35,6 +35,7 @@ class ModbusEndpoint {
  private:
   void serve(int fd, const Faults& faults, SimRig& rig);
   void show_enable(const SimRig& rig);
+  [[nodiscard]] bool starts_new_step(const std::uint8_t* query, int length);
   void reply_with_bad_crc(const std::uint8_t* query, int length);
   SignalValues written_commands() const;
 
@@ -49,6 +50,7 @@ class ModbusEndpoint {
   std::vector<std::uint16_t> window_ring_;  // encoded records, oldest overwritten first
   std::size_t window_head_ = 0, window_filled_ = 0;
   bool window_dirty_ = false;
+  double last_late_hz_ = 0;  // the late-step fault's last step
 };
 
 }  // namespace hystlab::sim

@@ -567,11 +567,22 @@ try {
     await page.fill('input[name=settle]', '3');
     await page.fill('input[name=measured]', '3');
     await page.fill('input[name=hz]', '500');
+    // The isolator's springs: the FOT table identified on the frame in 1., named by its id.
+    const fot = (await getJSON('/api/tables')).filter(t => t.method === 'fot').map(t => t.id);
+    const table = fot.length ? fot[0] : null;
+    check(table != null, `the frame's FOT table is in the store for the shaker's prediction (#${table})`);
+    await page.fill('input[name=isotable]', String(table));
     await page.click('#submit');
     check(await wait(page, () => window.hystlab.transmissibilityPoints() >= 1 && window.hystlab.loopPoints() > 20, null, 'transmissibility'),
           'the transmissibility plot and the base/mass signals build while the sweep runs');
     check(await wait(page, () => window.hystlab.state() === 'completed' && window.hystlab.transmissibilityPoints() === 3, null, 'sweep done'),
           'the sweep completes with a point per frequency');
+    // Measured against predicted from the named table, with its provenance.
+    check(await wait(page, () => window.hystlab.transmissibilityCurves().length === 4 && window.hystlab.transmissibilityCurves().every(c => c.predicted === 3), null, 'the prediction', 20000),
+          `each curve predicted from table #${table} is drawn beside the measured one: ${JSON.stringify(await page.evaluate(() => window.hystlab.transmissibilityCurves()))}`);
+    const said = await page.textContent('#sweep-status');
+    check(said.includes('predicted with ') && said.includes(`Preisach table n = 4 (fot, table ${table}: campaign `), `the page names the table and how it was identified: "${said}"`);
+    await page.fill('input[name=isotable]', '');
     await page.screenshot({ path: path.join(outDir, 'shaker.png'), fullPage: true });
 
     check(scriptErrors().length === 0, 'no script errors on the page' + (scriptErrors().length ? ': ' + scriptErrors().join(' | ') : ''));

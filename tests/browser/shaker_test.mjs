@@ -19,10 +19,11 @@ freshDir(outDir);
 const started = Date.now();
 const checks = new Checks(), check = checks.check;
 
-// The sweep: 5 frequencies around the simulated isolator's resonance (17.7 Hz) and one at 60 Hz,
+// The sweep: 1 Hz steps around the simulated isolator's resonance (17.7 Hz at 0.005 mm, lower at
+// 0.05 mm, where the springs transform: fine enough for the backbone to show it) and one at 60 Hz,
 // where a cycle has under 20 samples at 1000 Hz (the time plot draws envelopes there); both
-// amplitudes, up then down: 20 steps, about 30 s of rig time.
-const FREQS = [10, 16, 18, 30, 60], AMPS = [0.005, 0.05], STEPS = FREQS.length * AMPS.length * 2;
+// amplitudes, up then down: 32 steps, about 50 s of rig time.
+const FREQS = [10, 15, 16, 17, 18, 19, 30, 60], AMPS = [0.005, 0.05], STEPS = FREQS.length * AMPS.length * 2;
 
 fs.writeFileSync(path.join(outDir, 'hystlab.json'), JSON.stringify({
   db: 'shaker.db', rigs: [{ name: 'sim shaker', simulate: { rig: 'shaker', time_scale: 1 } }],
@@ -136,6 +137,17 @@ async function checkEnded(page, when) {
   // their loop opens, so the isolator damps more there than at 0.005 mm (seen 0.085 and 0.021).
   const zeta = a => Number((h.rows.find(r => r[0] === `${a} mm up`) || [])[6]);
   check(zeta('0.005') > 0.005 && zeta('0.05') > 2 * zeta('0.005'), `${when}: ζ eq at the resonance grows with amplitude: ${zeta('0.005')} at 0.005 mm, ${zeta('0.05')} at 0.05 mm`);
+  // The backbone: three small plots against the base amplitude (resonance, peak, ζ eq), measured
+  // and predicted; the SMA springs soften as they transform, so the resonance falls with the
+  // amplitude, in the measurement as in the model.
+  const bb = await page.evaluate(() => window.hystlab.backbone());
+  const line = (key, label) => { const k = bb ? bb.series.indexOf(label) : -1; return k < 0 ? [] : bb.values[key][k]; };
+  check(bb && bb.plots === 3 && bb.amplitudes === 2 && ['measured up', 'measured down', 'predicted up'].every(l => bb.series.includes(l)),
+        `${when}: the backbone's three plots over two amplitudes, measured and predicted: ${JSON.stringify(bb && bb.series)}`);
+  const fm = line('frequency_hz', 'measured up'), fp = line('frequency_hz', 'predicted up'), zm = line('equivalent_damping', 'measured up');
+  check(fm.length === 2 && fm[1] < fm[0] && fp.length === 2 && fp[1] < fp[0],
+        `${when}: the backbone falls with amplitude, measured (${fm.map(v => v && v.toFixed(2)).join(' → ')} Hz) as predicted (${fp.map(v => v && v.toFixed(2)).join(' → ')} Hz)`);
+  check(zm.length === 2 && zm[1] > zm[0], `${when}: and its damping grows (ζ eq ${zm.map(v => v && v.toFixed(3)).join(' → ')})`);
   check(h.time.yAxes === 1 && h.time.envelope > 1000, `${when}: the whole stored run against time, as an envelope (${h.time.envelope} values)`);
   check(new RegExp(`^${STEPS} of ${STEPS} steps measured`).test(h.progress) && h.eta === '', `${when}: the header says "${h.progress}"`);
   // Acceleration is a live view (the stored overview keeps displacements): not offered empty.
@@ -200,6 +212,11 @@ try {
     if (width === 800) check(await page.evaluate(() => document.documentElement.scrollWidth) <= 800, 'no horizontal scrolling at 800 px');
     await page.screenshot({ path: path.join(outDir, `sweep-${width}.png`), fullPage: true });
     await shoot(page, '#sweep-fig', `transmissibility-${width}.png`);
+    await shoot(page, '#backbone', `backbone-${width}.png`);
+    if (width === 800) {
+      const w = await page.evaluate(() => window.hystlab.backbone().widths);
+      check(w.every(x => x <= 800), `at 800 px the backbone's plots fit (${w.join(', ')} px)`);
+    }
   }
   await page.setViewportSize({ width: 1280, height: 1000 });
   await page.reload();

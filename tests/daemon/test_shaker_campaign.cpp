@@ -389,3 +389,79 @@ TEST_CASE("resonance refinement on the simulated shaker: a Q of 25 measured, not
   CHECK(r.samples > 10000);
   CHECK(r.missed_deadlines * 2000 < r.samples);
 }
+
+namespace {
+// The base's amplitude, half its peak-to-peak, in consecutive windows of `window_s` from t0 to t1:
+// the smallest one over ratio to the demand (a window at least one period of the lowest frequency).
+double weakest_base_window(db::Store& store, std::int64_t run, double t0, double t1, double window_s, double demand_mm) {
+  double lo = 1e9, hi = -1e9, start = t0, weakest = 1e9;
+  store.for_each_shaker_sample(run, 0, 1 << 30, [&](const db::ShakerRow& row) {
+    if (row.t < t0 || row.t > t1) return;
+    if (row.t - start > window_s) {
+      weakest = std::min(weakest, (hi - lo) / 2 / demand_mm);
+      lo = 1e9, hi = -1e9, start = row.t;
+    }
+    lo = std::min(lo, row.v.base_displacement_mm), hi = std::max(hi, row.v.base_displacement_mm);
+  });
+  return weakest;
+}
+}  // namespace
+
+TEST_CASE("every frequency step of an isolation sweep keeps the base at its demand: never below 90 % across a change, the drive carried") {
+  // Above the isolator's resonance (17.7 Hz), where it isolates: each step starts at the drive
+  // learnt nearest it (stop 31 started each at half of it). Across the resonance itself the
+  // table's response changes 2.5 times between 17 and 18.5 Hz (the mass's reaction on the
+  // table), and a step from one side to the other starts at the other side's drive: seen down to
+  // 22 % for one window, corrected within 0.3 s. Only a pre-test of the table's response would
+  // know it before the step (left for a later issue: see the closing note of stop 34).
+  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5", "--linear", "40"});
+  Bench b;
+  auto rig = shaker_rig(sim.modbus_port);
+  const auto plan = domain::parse_plan({{"kind", "sine"},
+                                        {"frequencies_hz", {22, 26, 30, 36, 44}},
+                                        {"amplitude_mm", 0.005},
+                                        {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
+                                        {"measured_cycles", 8},
+                                        {"sample_rate_hz", 1000}});
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 0.5, true);
+  const auto r = run(id, plan, ctx);
+  CAPTURE(r.reason);
+  REQUIRE(end_of(r) == "completed");
+  b.writer->flush();
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 5);
+  for (const auto& p : pts) CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
+  // From the first step's measurement to the last's: every window of one 22 Hz period.
+  const double weakest = weakest_base_window(*b.store, r.run_id, pts.front()["t_s"].get<double>(), pts.back()["t_s"].get<double>(), 1 / 22.0, 0.005);
+  CAPTURE(weakest);
+  MESSAGE("the weakest window of the base: " << weakest << " of its demand");
+  CHECK(weakest >= 0.90);
+  CHECK(weakest < 1.0);  // the windows were read: a real minimum, not the initial value
+}
+
+TEST_CASE("a drive write answered 150 ms late at every frequency step (hystlab-sim late-step): taken again, the sweep completes at its demand") {
+  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5", "--linear", "40", "--fault", "late-step=150"});
+  Bench b;
+  auto rig = shaker_rig(sim.modbus_port);  // answers due within 50 ms: each step's first write is lost
+  const auto plan = domain::parse_plan({{"kind", "sine"},
+                                        {"frequencies_hz", {12, 25, 40}},
+                                        {"amplitude_mm", 0.005},
+                                        {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
+                                        {"measured_cycles", 8},
+                                        {"sample_rate_hz", 1000}});
+  const auto id = b.submit(plan.source);
+  auto ctx = context(*rig, b, nullptr, 0.5, true);
+  const auto r = run(id, plan, ctx);
+  CAPTURE(r.reason);
+  CHECK(end_of(r) == "completed");
+  CHECK(b.sup->link_losses() >= 3);  // one lost write a step at least: the fault acted
+  b.writer->flush();
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 3);
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
+    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()) - 1) < 0.05);
+  }
+}

@@ -29,7 +29,7 @@ const loop = new XYPlot($('loop-plot'), 'displacement (mm)', 'force (N)',
   [{ label: 'measured', color: '#1565c0', width: 1.2 }, { label: 'identified model', color: '#ef6c00', width: 2 }], { share: LOOP_SHARE, minHeight: 200 });
 const heat = new TriangleHeatmap($('heatmap-plot'));
 const timeplot = new TimePlot($('time-plot'), ['displacement (mm)', 'force (N)']);
-const sweep = new SweepView({ trans: $('trans-plot'), time: $('shaker-time-plot'), table: $('resonance'), status: $('sweep-status') });
+const sweep = new SweepView({ trans: $('trans-plot'), time: $('shaker-time-plot'), table: $('resonance'), status: $('sweep-status'), backbone: $('backbone') });
 $('time-mode').addEventListener('change', e => { sweep.time.setMode(e.target.value); sweep.time.redraw(); });
 const isSine = () => !!S.detail && S.detail.kind === 'sine';
 const shakedown = new ShakedownPlot($('shakedown-plot'));
@@ -51,6 +51,7 @@ window.hystlab = {
   sineStatus: () => (isSine() ? sweep.status(S.detail) : null), streamRate: () => S.streamRate,
   resonanceRows: () => [...document.querySelectorAll('#resonance tbody tr')].map(tr => [...tr.cells].map(c => c.textContent)),
   jumps: () => [...document.querySelectorAll('#resonance .jumps li')].map(li => li.textContent),
+  backbone: () => sweep.backbone.shown(),
   timeAxes: () => (isSine() ? sweep.time.axes() : timeplot.axes()),
   rigs: () => rigPanel.rigs(), warnings: () => S.warnings.slice(),
   shakedownPoints: () => shakedown.points(), shakedownTicks: () => shakedown.ticks(), loopRows: () => $('loops').querySelectorAll('tbody tr').length,

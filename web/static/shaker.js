@@ -7,6 +7,7 @@ import { api } from './api.js';
 import { el, num, duration, roughly, plural } from './fmt.js';
 import { TransmissibilityPlot } from './sweep_plots.js';
 import { ShakerTimePlot } from './shaker_time.js';
+import { BackbonePlot } from './backbone.js';
 
 const MAX_LISTED = 8;  // of a kind of warning, the steps named before "…"
 const pct = v => (Number.isFinite(v) ? `${v > 0 ? '+' : v < 0 ? '−' : ''}${num(Math.abs(v), 2)} %` : '–');
@@ -42,8 +43,9 @@ const KIND_WORDS = {
 };
 
 export class SweepView {
-  constructor({ trans, time, table, status }) {
+  constructor({ trans, time, table, status, backbone }) {
     this.plot = new TransmissibilityPlot(trans);
+    this.backbone = new BackbonePlot(backbone);
     this.time = new ShakerTimePlot(time);
     this.tableEl = table; this.statusEl = status;
     this.reset(null);
@@ -52,6 +54,7 @@ export class SweepView {
     this.id = id; this.points = []; this.report = null; this.loadedKey = null;
     this.step = null; this.point = null; this.warning = null; this.done = null; this.events = [];
     this.plot.set([]);
+    this.backbone.set(null);
     this.time.clear(); this.time.redraw();
     this.renderTable();
   }
@@ -100,6 +103,7 @@ export class SweepView {
     this.report = sweep;
     this.points = Array.isArray(sweep.points) ? sweep.points : [];
     this.plot.set(this.points);
+    this.backbone.set(sweep);
     this.renderTable();
   }
 

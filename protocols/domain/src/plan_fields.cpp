@@ -48,6 +48,7 @@ constexpr std::array kFields{
   input("settle_cycles", "settle cycles", "", 0, 100000, T::integer, "sine", "settle", "or settle cycles (instead)", "", "until settled", true),
   input("measured_cycles", "measured cycles", "", 1, 100000, T::integer, "sine", "measured", "", "10"),
   input("resonance.half_power_points", "points in the half-power band", "", 3, 100, T::integer, "sine", "respts", "refine the resonance until its half-power band holds", "5", "no refinement", true),
+  input("isolator.table", "the isolator's springs: table", "", 1, 1e9, T::integer, "sine", "isotable", "predict with the springs of table #", "", "the rig's springs", true),
   input("control.tolerance", "control tolerance", "%", 0, 100, T::percent, "sine", "tol", "", "5"),
   input("control.warning", "control warning", "%", 0, 1000, T::percent, "sine", "warn", "control warning beyond", "", "daemon's: 10", true),
   input("control.abort", "control abort", "%", 0, 1000, T::percent, "sine", "abortpct", "control abort beyond", "", "daemon's: 30", true),

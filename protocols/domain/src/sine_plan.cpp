@@ -191,6 +191,8 @@ SinePlan parse_sine_plan(const json& j, double sample_rate_hz) {
   if (j.contains("isolator")) {
     if (!j["isolator"].is_object())
       fields::fail("isolator", "must be an object: {\"table\": 7} (a stored table's id), with mass_kg, springs and damping_N_s_per_m if not the rig's");
+    // A stored table's id, read here with the form's bounds (a table document is the daemon's to read).
+    if (j["isolator"].contains("table") && j["isolator"]["table"].is_number()) (void)fields::integer(j["isolator"], "table", 0, "isolator.");
     p.isolator = j["isolator"];
   }
   if (p.highest_hz() > sample_rate_hz / 8)
