@@ -57,6 +57,12 @@ const char* to_string(CampaignPhase p) noexcept {
       return "shaker_control";
     case P::shaker_measure:
       return "shaker_measure";
+    case P::shaker_ramp:
+      return "shaker_ramp";
+    case P::shaker_sweep:
+      return "shaker_sweep";
+    case P::shaker_dwell:
+      return "shaker_dwell";
   }
   return "?";
 }

@@ -62,7 +62,18 @@ class SineStrategy final : public Strategy {
 
   [[nodiscard]] bool done() const override { return pass_ >= passes_.size(); }
   [[nodiscard]] CampaignPhase phase() const override {
-    return mode_ == Mode::measure || mode_ == Mode::sweep || mode_ == Mode::dwell ? CampaignPhase::shaker_measure : CampaignPhase::shaker_control;
+    switch (mode_) {
+      case Mode::measure:
+        return CampaignPhase::shaker_measure;
+      case Mode::ramp:
+        return CampaignPhase::shaker_ramp;
+      case Mode::sweep:
+        return CampaignPhase::shaker_sweep;
+      case Mode::dwell:
+        return CampaignPhase::shaker_dwell;
+      default:
+        return CampaignPhase::shaker_control;
+    }
   }
 
   void fill_finish(Loop& L, FinishJob& fj) override {

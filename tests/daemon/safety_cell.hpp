@@ -51,7 +51,19 @@ json next_plan(bool shaker) {  // after a reset: the next campaign must run
   return {{"kind", "waveform"}, {"points_mm", {0, 0.2, 0}}, {"ramp_rate_mm_s", 2}, {"sample_rate_hz", 500}, {"limits", {{"displacement_mm", {-0.5, 1.5}}}}};
 }
 
-bool shaker_state(State s) { return s == State::shaker_control || s == State::shaker_measure; }
+bool shaker_state(State s) {
+  return s == State::shaker_control || s == State::shaker_measure || s == State::shaker_ramp || s == State::shaker_sweep || s == State::shaker_dwell;
+}
+// The shaker's campaign that passes through the state: a second level ramped to from the first,
+// a continuous sweep, a dwell tracking the phase (the fake mass is 0.3 rad behind at every
+// frequency: the tracker moves the frequency all the way, writing it every window).
+json shaker_plan(State s) {
+  json p = sine_plan();
+  if (s == State::shaker_ramp) p.erase("amplitude_mm"), p["frequencies_hz"] = {25}, p["amplitudes_mm"] = {0.005, 0.05};
+  if (s == State::shaker_sweep) p.erase("frequencies_hz"), p["sweep"] = {{"from_hz", 20}, {"to_hz", 30}, {"rate_hz_s", 2}};
+  if (s == State::shaker_dwell) p.erase("frequencies_hz"), p["dwell"] = {{"frequency_hz", 25}, {"cycles", 400}};
+  return p;
+}
 bool campaign_event(Event e) {
   return e == Event::campaign_estop || e == Event::abort || e == Event::pause || e == Event::resume || e == Event::dead_band ||
          e == Event::strategy_exception || e == Event::db_busy || e == Event::db_failing || e == Event::ring_full || e == Event::finisher_failing;
@@ -266,6 +278,12 @@ struct Cell {
         return p == CampaignPhase::shaker_control && ticks > 30;
       case State::shaker_measure:
         return p == CampaignPhase::shaker_measure;
+      case State::shaker_ramp:
+        return p == CampaignPhase::shaker_ramp && rig().amplitude() > 0.008;
+      case State::shaker_sweep:
+        return p == CampaignPhase::shaker_sweep && ticks > 30;
+      case State::shaker_dwell:
+        return p == CampaignPhase::shaker_dwell && ticks > 30;
       default:
         return false;
     }

@@ -26,6 +26,9 @@ const char* to_string(State s) noexcept {
                                    "safing",
                                    "shaker control window",
                                    "shaker measuring window",
+                                   "shaker ramp between levels",
+                                   "shaker continuous sweep",
+                                   "shaker resonance dwell",
                                    "finishing",
                                    "held after restart",
                                    "limit recovery (latched, on the way back)"};
@@ -179,7 +182,7 @@ void Cell::run() {
   world.idle(4);  // connected: the first answer re-asserts held and disabled
   if (state == State::limit_recovery) return run_recovery_state();
   if (!loop_state(state)) return run_idle_state();
-  const auto job = world.job(shaker_state(state) ? sine_plan() : fot_plan());
+  const auto job = world.job(shaker_state(state) ? shaker_plan(state) : fot_plan());
   const auto r = world.run(job, [this] { tick(); });
   acted_after_loop();
   if (!injected) fail("the state was never reached (the scenario is broken)");

@@ -45,8 +45,11 @@ enum class CampaignPhase : std::uint8_t {
   paused,
   held,
   safing,
-  shaker_control,
-  shaker_measure
+  shaker_control,  // a control window: the base brought to its demand
+  shaker_measure,  // a step's measured window
+  shaker_ramp,     // between two levels, the amplitude stepped x2 a window
+  shaker_sweep,    // a continuous sweep: the frequency written every cycle
+  shaker_dwell     // a resonance dwell: the frequency moved after the phase
 };
 [[nodiscard]] const char* to_string(CampaignPhase p) noexcept;
 
