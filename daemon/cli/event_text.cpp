@@ -133,6 +133,12 @@ std::string say(const domain::ControlUnreachedEvent& d) {
 std::string say(const domain::UnsettledEvent& d) {
   return "at " + n(d.frequency_hz) + " Hz: not settled after " + n(d.cycles) + " cycles (still changing " + n(d.change_pct) + " %)";
 }
+std::string say(const domain::PretestEvent& d) {
+  std::string s = "loop check: " + count(static_cast<double>(d.frequencies), "frequency", "frequencies") + " at " + n(d.level_mm) + " mm in " + n(d.seconds) +
+                  " s, " + count(static_cast<double>(d.windows), "window") + "; the table's response " + n(d.response_min) + " to " + n(d.response_max) +
+                  " of the drive";
+  return d.unsettled > 0 ? s + " (" + n(d.unsettled) + " not settled)" : s;
+}
 std::string say(const domain::DwellEvent& d) {
   std::string s = "pass " + n(d.pass) + ": dwell at " + n(d.amplitude_mm) + " mm";
   if (d.track != "phase") return s + ", " + n(d.frequency_hz) + " Hz for " + count(static_cast<double>(d.cycles), "cycle");

@@ -16,6 +16,7 @@
 #include "hystlab/models/sine_fit.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
 #include "phase_tracker.hpp"
+#include "sine_pretest.hpp"
 #include "sine_window.hpp"
 
 namespace hystlab::daemon {
@@ -25,7 +26,7 @@ constexpr double kTwoPi = 2 * std::numbers::pi;
 class SineStrategy final : public Strategy {
  public:
   explicit SineStrategy(const domain::Plan& p)
-      : plan_(p), s_(p.sine), control_(p.sine.control), passes_(domain::sweep_passes(p.sine)), total_(domain::step_count(p.sine)) {
+      : plan_(p), s_(p.sine), control_(p.sine.control), pre_(p.sine), passes_(domain::sweep_passes(p.sine)), total_(domain::step_count(p.sine)) {
     // Every buffer a pass fills at its largest, here: none grows on the acquisition thread.
     const std::size_t most = s_.frequencies_hz.size() + static_cast<std::size_t>(s_.resonance.refine ? s_.resonance.max_steps : 0);
     freqs_.reserve(most), pass_points_.reserve(most), refine_next_.reserve(static_cast<std::size_t>(s_.resonance.half_power_points) + 2);
@@ -38,7 +39,7 @@ class SineStrategy final : public Strategy {
       started_ = true;
       t0_ = s.time_s;
       w_.restart(s.time_s);
-      return begin_step(L, s.time_s);
+      return pre_.active() ? pretest_step(L, s.time_s) : begin_step(L, s.time_s);
     }
     w_.advance(s.time_s, L.drive_hz);
     w_.collect(s.time_s, s.base_displacement_mm, s.mass_displacement_mm);
@@ -57,7 +58,12 @@ class SineStrategy final : public Strategy {
   void on_resume(Loop& L, double t, bool) override {
     w_.restart(t);
     resumed_ = true;  // from zero drive: the level is ramped to again
-    if (pass_ < passes_.size()) (void)begin_step(L, t);
+    if (pre_.active()) {
+      pre_.restart_frequency();
+      (void)pretest_step(L, t);
+    } else if (pass_ < passes_.size()) {
+      (void)begin_step(L, t);
+    }
   }
 
   [[nodiscard]] bool done() const override { return pass_ >= passes_.size(); }
@@ -85,7 +91,7 @@ class SineStrategy final : public Strategy {
   }
 
  private:
-  enum class Mode { ramp, control, settle, measure, sweep, dwell };
+  enum class Mode { pretest, ramp, control, settle, measure, sweep, dwell };
   // Amplitude changes between the plan's levels go at most ×2 (6 dB) a control window.
   static constexpr double kRampStep = 2.0;
 
@@ -135,6 +141,34 @@ class SineStrategy final : public Strategy {
     return open(ramping_ ? Mode::ramp : Mode::control, 1, s_.control.window_cycles);
   }
 
+  // The loop check (sine_pretest.hpp): each frequency at its level, corrected as a step is, until
+  // its response holds; then the first pass, ramped to from the check's level.
+  bool pretest_step(Loop& L, double t) {
+    f_ = pre_.frequency();
+    drive_ = control_.start(f_, pre_.level());
+    abort_windows_ = 0, retakes_ = 0;
+    if (!L.command_drive(t, f_, drive_)) return going(L);
+    return open(Mode::pretest, 1, s_.control.window_cycles);
+  }
+  bool after_pretest(Loop& L, double t, const ControlVerdict& v, double base) {
+    if (!pre_.window(base / drive_)) {
+      drive_ = v.next_drive_mm;
+      if (!L.command_drive(t, f_, drive_)) return going(L);
+      return open(Mode::pretest, 1, s_.control.window_cycles);
+    }
+    if (pre_.active()) return pretest_step(L, t);
+    L.event(pre_.summary(t - t0_));
+    nominal_done_ += domain::pretest_nominal_s(s_);
+    last_level_ = pre_.level();  // the first pass is ramped to from here
+    return begin_step(L, t);
+  }
+  // A check's window against the level about to be driven (the first pass's): only a base beyond
+  // its bands counts (the check's own level is far below them on purpose).
+  ControlVerdict against_demand(ControlVerdict v, double base) const {
+    v.error_pct = (base / demand() - 1) * 100, v.band = control_.band_of(v.error_pct), v.limited = false;
+    return v;
+  }
+
   bool open(Mode m, int skip_cycles, int cycles) {
     mode_ = m;
     w_.open(skip_cycles, cycles);
@@ -169,9 +203,12 @@ class SineStrategy final : public Strategy {
     if (const std::string hole = w_.hole(); !hole.empty()) return retake(L, t, hole);
     const models::HarmonicFit b = w_.fit_base(), m = w_.fit_mass(harmonics(f_));
     if (!b.fundamental.ok || !m.fundamental.ok) return retake(L, t, "no sine fit");
-    const ControlVerdict v = control_.update(s_.continuous ? w_.mean_frequency() : f_, demand(), drive_, b.fundamental.amplitude);
-    if (!check_band(L, t, v, b.fundamental.amplitude)) return false;
+    const bool check = mode_ == Mode::pretest;
+    const ControlVerdict v = control_.update(s_.continuous ? w_.mean_frequency() : f_, check ? pre_.level() : demand(), drive_, b.fundamental.amplitude);
+    if (!check_band(L, t, check ? against_demand(v, b.fundamental.amplitude) : v, b.fundamental.amplitude)) return false;
     switch (mode_) {
+      case Mode::pretest:
+        return after_pretest(L, t, v, b.fundamental.amplitude);
       case Mode::ramp:
         return after_ramp(L, t);
       case Mode::control:
@@ -457,6 +494,7 @@ class SineStrategy final : public Strategy {
   const domain::Plan& plan_;
   const domain::SinePlan& s_;
   BaseControl control_;
+  SinePretest pre_;
   std::vector<domain::SweepPass> passes_;
   std::vector<std::pair<std::int64_t, PredictStep>> steps_;
   std::vector<double> freqs_, refine_next_;      // this pass's frequencies (planned, then refined); a round's

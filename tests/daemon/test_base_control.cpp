@@ -6,6 +6,7 @@
 #include <random>
 
 #include "hystlab/daemon/base_control.hpp"
+#include "sine_pretest.hpp"
 
 using namespace hystlab::daemon;
 using namespace hystlab::domain;
@@ -93,4 +94,43 @@ TEST_CASE("base control: bands, the drive's cap, open loop") {
   CHECK(o.next_drive_mm == 0.2);
   CHECK(o.band == ControlBand::abort);
   CHECK(o.error_pct == doctest::Approx(50));
+}
+
+TEST_CASE("the loop check: every frequency ascending at a quarter of the smallest level, each done when two windows agree or after 8") {
+  SinePlan s;
+  s.frequencies_hz = {30, 12, 18.5, 12};
+  s.amplitudes_mm = {0.05, 0.02};
+  REQUIRE(has_pretest(s));
+  SinePretest p(s);
+  CHECK(p.frequencies() == 3);  // once each, ascending
+  CHECK(p.level() == doctest::Approx(0.005));
+  REQUIRE(p.active());
+  CHECK(p.frequency() == 12);
+  CHECK_FALSE(p.window(0.80));  // the first window is never enough
+  CHECK(p.window(0.81));        // within 2 % of the one before: done
+  CHECK(p.frequency() == 18.5);
+  // A ringing isolator: its windows never agree; after 8 the check goes on, and says so.
+  for (int k = 0; k < 7; ++k) CHECK_FALSE(p.window(k % 2 ? 0.3 : 0.6));
+  CHECK(p.window(0.45));
+  CHECK(p.frequency() == 30);
+  p.restart_frequency();  // a pause: the frequency's windows count afresh
+  CHECK_FALSE(p.window(1.2));
+  CHECK(p.window(1.2));
+  CHECK_FALSE(p.active());
+  const PretestEvent e = p.summary(3.5);
+  CHECK(e.frequencies == 3);
+  CHECK(e.windows == 12);
+  CHECK(e.unsettled == 1);
+  CHECK(e.response_min == doctest::Approx(0.45));
+  CHECK(e.response_max == doctest::Approx(1.2));
+  // Left out: a continuous sweep, a dwell, a single frequency, open loop, level 0.
+  SinePlan one = s;
+  one.frequencies_hz = {20};
+  CHECK_FALSE(has_pretest(one));
+  SinePlan off = s;
+  off.control.pretest_level = 0;
+  CHECK_FALSE(has_pretest(off));
+  SinePlan open = s;
+  open.control.closed = false;
+  CHECK_FALSE(has_pretest(open));
 }

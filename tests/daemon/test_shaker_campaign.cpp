@@ -41,6 +41,28 @@ double linear_ratio(double f) {
   return models::linear_transmissibility(f / fn, zeta);
 }
 
+// A campaign on its own hystlab-sim shaker (the simulator's arguments), read in blocks, stored in
+// its own database, run in time_scale: the set-up every test here shares. Its parts are named
+// by a structured binding: auto& [sim, b, rig, plan, id, r] = run_.
+struct ShakerSweep {
+  ShakerSweep(std::vector<std::string> sim_args, const nlohmann::json& plan_json, double scale, std::shared_ptr<const daemon::IsolatorModel> isolator = nullptr)
+      : sim(std::move(sim_args)), rig(shaker_rig(sim.modbus_port)), plan(domain::parse_plan(plan_json)), id(b.submit(plan.source)) {
+    auto ctx = context(*rig, b, nullptr, scale, true);
+    daemon::CampaignJob job;
+    job.id = id;
+    job.plan = plan;
+    job.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, true);
+    job.isolator = std::move(isolator);
+    r = daemon::run_campaign(job, ctx);
+  }
+  SimProcess sim;
+  Bench b;
+  std::unique_ptr<drivers::Rig> rig;
+  domain::Plan plan;
+  std::int64_t id = 0;
+  daemon::RunnerResult r;
+};
+
 std::int64_t rows_in(db::Store& store, const char* table, std::int64_t run) {
   db::Statement st(store.database(), std::string("SELECT count(*) FROM ") + table + " WHERE run_id = ?");
   st.bind(1, run);
@@ -52,30 +74,21 @@ std::int64_t rows_in(db::Store& store, const char* table, std::int64_t run) {
 TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in closed loop, transmissibility and prediction per step") {
   // In slow motion (time scale 0.25): polled at 1 kHz, a starved 2-core VM leaves gaps of
   // 50-600 ms, and at 10 Hz in real time every window had over half of it in gaps.
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);
   // The isolator rings at 17.7 Hz for 1/(ζω_n) = 0.45 s after each change: the settle criterion
   // waits until the mass amplitude stops changing (a fixed 10 cycles at 60 Hz measured a 16 %
   // high ratio with 9 % "distortion": the free vibration beating with the response).
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"frequencies_hz", {12, 30, 60}},
-                                        {"amplitude_mm", 0.005},
-                                        {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
-                                        {"measured_cycles", 8},
-                                        {"sample_rate_hz", 1000},
-                                        {"control", {{"tolerance", "3 %"}, {"window_cycles", 3}}}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 0.25, true);
-  daemon::CampaignJob job;
-  job.id = id;
-  job.plan = plan;
-  job.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, true);
-  job.isolator = std::make_shared<const daemon::IsolatorModel>(daemon::simulated_isolator());
-  const auto r = daemon::run_campaign(job, ctx);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"},
+                   {{"kind", "sine"},
+                    {"frequencies_hz", {12, 30, 60}},
+                    {"amplitude_mm", 0.005},
+                    {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
+                    {"measured_cycles", 8},
+                    {"sample_rate_hz", 1000},
+                    {"control", {{"tolerance", "3 %"}, {"window_cycles", 3}}}},
+                   0.25, std::make_shared<const daemon::IsolatorModel>(daemon::simulated_isolator()));
+  auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(r.reason);
   REQUIRE(end_of(r) == "completed");
-  b.writer->flush();
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 3);
   bool loop_had_work = false;
@@ -106,21 +119,17 @@ TEST_CASE("sine campaign with linear springs: the transmissibility of the analyt
   // hystlab-sim --linear 40: the same isolator (13 kg, 4 springs, 58 N·s/m) on linear springs of
   // the SMA springs' elastic stiffness. At 0.05 mm and 16 Hz the relative motion (0.22 mm) would
   // pass the SMA springs' Ms; linear springs keep the curve analytic there.
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25", "--linear", "40"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"frequencies_hz", {12, 16, 30}},
-                                        {"amplitude_mm", 0.05},
-                                        {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
-                                        {"measured_cycles", 8},
-                                        {"sample_rate_hz", 1000}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 0.25, true);
-  const auto r = run(id, plan, ctx);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.25", "--linear", "40"},
+                   {{"kind", "sine"},
+                    {"frequencies_hz", {12, 16, 30}},
+                    {"amplitude_mm", 0.05},
+                    {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
+                    {"measured_cycles", 8},
+                    {"sample_rate_hz", 1000}},
+                   0.25);
+  auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(r.reason);
   REQUIRE(end_of(r) == "completed");
-  b.writer->flush();
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 3);
   for (const auto& p : pts) {
@@ -136,24 +145,20 @@ TEST_CASE("sine campaign with linear springs: the transmissibility of the analyt
 }
 
 TEST_CASE("sine campaign: beyond the abort band the shaker is stopped, at zero drive, and the reason stored") {
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);
   // 110 Hz is beyond the table's servo (60 Hz): the base follows a third of the drive, and the
   // plan allows the drive only 1.5 times the demand, so the base stays about 45 % short.
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"frequencies_hz", {110}},
-                                        {"amplitude_mm", 0.005},
-                                        {"sample_rate_hz", 1000},
-                                        {"control", {{"abort", "30 %"}, {"max_drive_ratio", 1.5}}}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 0.25, true);
-  const auto r = run(id, plan, ctx);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"},
+                   {{"kind", "sine"},
+                    {"frequencies_hz", {110}},
+                    {"amplitude_mm", 0.005},
+                    {"sample_rate_hz", 1000},
+                    {"control", {{"abort", "30 %"}, {"max_drive_ratio", 1.5}}}},
+                   0.25);
+  auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(r.reason);
   CHECK(end_of(r) == "aborted");
   CHECK(r.reason.find("control abort") != std::string::npos);
   CHECK(r.reason.find("abort band ±30 %") != std::string::npos);
-  b.writer->flush();
   CHECK(b.store->event_details(id, "control_abort").size() == 1);
   // The shaker is left without drive: its base comes to rest.
   std::this_thread::sleep_for(std::chrono::milliseconds(400));
@@ -170,22 +175,18 @@ TEST_CASE("a resonance dwell tracks the phase: the mass held at -90 degrees agai
   // hystlab-sim --linear 40: the linear isolator (f_n 17.7 Hz, Q 25). Started at 16 Hz (the
   // phase there about -8 degrees), the dwell moves the frequency until the mass lags its base by
   // 90 degrees within 5, then holds it there for 300 cycles.
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--linear", "40"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"dwell", {{"frequency_hz", 16}, {"cycles", 300}, {"track", "phase"}, {"phase_deg", -90}, {"tolerance_deg", 5}}},
-                                        {"amplitude_mm", 0.005},
-                                        {"settle_cycles", 20},
-                                        {"measured_cycles", 10},
-                                        {"sample_rate_hz", 1000}});
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"},
+                   {{"kind", "sine"},
+                    {"dwell", {{"frequency_hz", 16}, {"cycles", 300}, {"track", "phase"}, {"phase_deg", -90}, {"tolerance_deg", 5}}},
+                    {"amplitude_mm", 0.005},
+                    {"settle_cycles", 20},
+                    {"measured_cycles", 10},
+                    {"sample_rate_hz", 1000}},
+                   1.0);
+  auto& [sim, b, rig, plan, id, r] = run_;
   CHECK(plan.sine.lowest_hz() == doctest::Approx(16 / 1.25));  // the envelope is checked over where tracking may go
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 1.0, true);
-  const auto r = run(id, plan, ctx);
   CAPTURE(r.reason);
   REQUIRE(end_of(r) == "completed");
-  b.writer->flush();
   const auto dwell = b.store->event_details(id, "dwell");
   REQUIRE(dwell.size() == 1);
   const auto d = nlohmann::json::parse(dwell[0]);
@@ -223,21 +224,17 @@ TEST_CASE("a resonance dwell tracks the phase: the mass held at -90 degrees agai
 }
 
 TEST_CASE("amplitude levels ramped: from 0.005 to 0.05 mm and back the drive goes at most x2 a control window, never a jump of x10") {
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--linear", "40"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"frequencies_hz", {10}},
-                                        {"amplitudes_mm", {0.005, 0.05, 0.005}},
-                                        {"settle_cycles", 10},
-                                        {"measured_cycles", 8},
-                                        {"sample_rate_hz", 1000}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 1.0, true);
-  const auto r = run(id, plan, ctx);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"},
+                   {{"kind", "sine"},
+                    {"frequencies_hz", {10}},
+                    {"amplitudes_mm", {0.005, 0.05, 0.005}},
+                    {"settle_cycles", 10},
+                    {"measured_cycles", 8},
+                    {"sample_rate_hz", 1000}},
+                   1.0);
+  auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(r.reason);
   REQUIRE(end_of(r) == "completed");
-  b.writer->flush();
   // The drive as commanded, sample by sample: each change at most ×2.2 (a ramp's ×2 and the
   // loop's correction on it), after the first step's start.
   double prev = 0, largest = 1;
@@ -260,21 +257,17 @@ TEST_CASE("amplitude levels ramped: from 0.005 to 0.05 mm and back the drive goe
 }
 
 TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rate, each window a point at its mean frequency") {
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"sweep", {{"from_hz", 8}, {"to_hz", 11}, {"rate_hz_s", 1.5}}},
-                                        {"amplitude_mm", 0.005},
-                                        {"settle_cycles", 20},
-                                        {"measured_cycles", 4},
-                                        {"sample_rate_hz", 1000}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 0.5, true);
-  const auto r = run(id, plan, ctx);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.5"},
+                   {{"kind", "sine"},
+                    {"sweep", {{"from_hz", 8}, {"to_hz", 11}, {"rate_hz_s", 1.5}}},
+                    {"amplitude_mm", 0.005},
+                    {"settle_cycles", 20},
+                    {"measured_cycles", 4},
+                    {"sample_rate_hz", 1000}},
+                   0.5);
+  auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(r.reason);
   REQUIRE(end_of(r) == "completed");
-  b.writer->flush();
   const auto pts = points_of(*b.store, id);
   // 2 s from 8 to 11 Hz: about 19 cycles, 4 a point (the last window may cross the end).
   CHECK(pts.size() >= 4);
@@ -348,22 +341,18 @@ TEST_CASE("resonance refinement on the simulated shaker: a Q of 25 measured, not
   // ζ = 0.020, Q = 1/(2ζ) = 25. The plan's steps put 12 and 25 Hz either side of the peak, far
   // outside its 0.7 Hz half-power band; the refinement finds it. In real time: read in blocks
   // from the controller's sample window, a starved host loses no sample.
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--linear", "40"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"frequencies_hz", {8, 12, 25, 40}},
-                                        {"amplitude_mm", 0.005},
-                                        {"settle", {{"change", "1 %"}, {"consecutive", 2}, {"min_cycles", 15}}},
-                                        {"measured_cycles", 8},
-                                        {"sample_rate_hz", 1000},
-                                        {"resonance", {{"half_power_points", 5}, {"max_steps", 30}}}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 1.0, true);
-  const auto r = run(id, plan, ctx);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"},
+                   {{"kind", "sine"},
+                    {"frequencies_hz", {8, 12, 25, 40}},
+                    {"amplitude_mm", 0.005},
+                    {"settle", {{"change", "1 %"}, {"consecutive", 2}, {"min_cycles", 15}}},
+                    {"measured_cycles", 8},
+                    {"sample_rate_hz", 1000},
+                    {"resonance", {{"half_power_points", 5}, {"max_steps", 30}}}},
+                   1.0);
+  auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(r.reason);
   REQUIRE(end_of(r) == "completed");
-  b.writer->flush();
   const auto pts = points_of(*b.store, id);
   CHECK(pts.size() > 4);
   CHECK(pts.size() <= 4 + 30);
@@ -409,54 +398,89 @@ double weakest_base_window(db::Store& store, std::int64_t run, double t0, double
 
 TEST_CASE("every frequency step of an isolation sweep keeps the base at its demand: never below 90 % across a change, the drive carried") {
   // Above the isolator's resonance (17.7 Hz), where it isolates: each step starts at the drive
-  // learnt nearest it (stop 31 started each at half of it). Across the resonance itself the
-  // table's response changes 2.5 times between 17 and 18.5 Hz (the mass's reaction on the
-  // table), and a step from one side to the other starts at the other side's drive: seen down to
-  // 22 % for one window, corrected within 0.3 s. Only a pre-test of the table's response would
-  // know it before the step (left for a later issue: see the closing note of stop 34).
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5", "--linear", "40"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"frequencies_hz", {22, 26, 30, 36, 44}},
-                                        {"amplitude_mm", 0.005},
-                                        {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
-                                        {"measured_cycles", 8},
-                                        {"sample_rate_hz", 1000}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 0.5, true);
-  const auto r = run(id, plan, ctx);
+  // learnt at its own frequency by the loop check (stop 31 started each at half of it).
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.5", "--linear", "40"},
+                   {{"kind", "sine"},
+                    {"frequencies_hz", {22, 26, 30, 36, 44}},
+                    {"amplitude_mm", 0.005},
+                    {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
+                    {"measured_cycles", 8},
+                    {"sample_rate_hz", 1000}},
+                   0.5);
+  auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(r.reason);
   REQUIRE(end_of(r) == "completed");
-  b.writer->flush();
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 5);
   for (const auto& p : pts) CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
   // From the first step's measurement to the last's: every window of one 22 Hz period.
   const double weakest = weakest_base_window(*b.store, r.run_id, pts.front()["t_s"].get<double>(), pts.back()["t_s"].get<double>(), 1 / 22.0, 0.005);
-  CAPTURE(weakest);
   MESSAGE("the weakest window of the base: " << weakest << " of its demand");
   CHECK(weakest >= 0.90);
   CHECK(weakest < 1.0);  // the windows were read: a real minimum, not the initial value
 }
 
+TEST_CASE(
+    "a loop check learns every frequency before the sweep: through the resonance the base stays above 60 % of its demand across a change (22 % without)") {
+  // Through the isolator's resonance (17.7 Hz), where the mass's reaction on the table changes its
+  // response 2.5 times between 17 and 18.5 Hz. Without the loop check each step started at the
+  // drive learnt at the step before: the base read 22 % of its demand for a window after 17 ->
+  // 18.5 Hz. The check learns every frequency at a quarter of the level first, never driving the
+  // base beyond it; the step then starts at the right drive (0.0076 mm at 18.5 Hz, as the loop
+  // ends there), and what is left is the isolator's free vibration, excited by the jump, beating
+  // with the table: 64 % to 175 % for half a second (a glide of 8 cycles between the steps, at the
+  // drive interpolated between the two, did not help: 68 %). The issue's 90 % is not met here.
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.5", "--linear", "40"},
+                   {{"kind", "sine"},
+                    {"frequencies_hz", {12, 15, 17, 18.5, 22}},
+                    {"amplitude_mm", 0.005},
+                    {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
+                    {"measured_cycles", 8},
+                    {"sample_rate_hz", 1000}},
+                   0.5);
+  auto& [sim, b, rig, plan, id, r] = run_;
+  CAPTURE(r.reason);
+  REQUIRE(end_of(r) == "completed");
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 5);
+  for (const auto& p : pts) CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
+  const auto checks = b.store->event_details(id, "pretest");
+  REQUIRE(checks.size() == 1);
+  const auto check = nlohmann::json::parse(checks[0]);
+  CAPTURE(check.dump());
+  CHECK(check["frequencies"] == 5);
+  CHECK(check["level_mm"].get<double>() == doctest::Approx(0.00125));
+  CHECK(check["response_max"].get<double>() > 1.5 * check["response_min"].get<double>());  // the table's response does change
+  // From the first step's measurement to the last's: every window of one 12 Hz period.
+  const double weakest = weakest_base_window(*b.store, r.run_id, pts.front()["t_s"].get<double>(), pts.back()["t_s"].get<double>(), 1 / 12.0, 0.005);
+  MESSAGE("the weakest window of the base: " << weakest << " of its demand");
+  CHECK(weakest >= 0.60);
+  CHECK(weakest < 1.0);  // the windows were read: a real minimum, not the initial value
+  // The check itself stays low: while it runs its base is never beyond half the demand.
+  double t_first = NAN, check_peak = 0;
+  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30, [&](const db::ShakerRow& row) {
+    if (std::isnan(t_first)) t_first = row.t;
+    if (row.t - t_first < check["seconds"].get<double>()) check_peak = std::max(check_peak, std::fabs(row.v.base_displacement_mm));
+  });
+  CAPTURE(check_peak);
+  CHECK(check_peak > 0.0005);
+  CHECK(check_peak < 0.0025);
+}
+
 TEST_CASE("a drive write answered 150 ms late at every frequency step (hystlab-sim late-step): taken again, the sweep completes at its demand") {
-  SimProcess sim({"--rig", "shaker", "--port", "0", "--time-scale", "0.5", "--linear", "40", "--fault", "late-step=150"});
-  Bench b;
-  auto rig = shaker_rig(sim.modbus_port);  // answers due within 50 ms: each step's first write is lost
-  const auto plan = domain::parse_plan({{"kind", "sine"},
-                                        {"frequencies_hz", {12, 25, 40}},
-                                        {"amplitude_mm", 0.005},
-                                        {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
-                                        {"measured_cycles", 8},
-                                        {"sample_rate_hz", 1000}});
-  const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 0.5, true);
-  const auto r = run(id, plan, ctx);
+  // Answers are due within 50 ms: each step's first write is lost, and taken again.
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.5", "--linear", "40", "--fault", "late-step=150"},
+                   {{"kind", "sine"},
+                    {"frequencies_hz", {12, 25, 40}},
+                    {"amplitude_mm", 0.005},
+                    {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
+                    {"measured_cycles", 8},
+                    {"sample_rate_hz", 1000}},
+                   0.5);
+  auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(r.reason);
   CHECK(end_of(r) == "completed");
   CHECK(b.sup->link_losses() >= 3);  // one lost write a step at least: the fault acted
-  b.writer->flush();
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 3);
   for (const auto& p : pts) {

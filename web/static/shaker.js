@@ -216,6 +216,8 @@ export function describeSweepEvent(e) {
   if (e.kind === 'sine_step') return `step ${d.k} of ${d.of}: ${hz(d.frequency_hz)}, ${num(d.amplitude_mm)} mm ${d.direction} (pass ${d.pass} of ${d.passes}), drive ${num(d.drive_mm)} mm`;
   if (e.kind === 'transmissibility') return `${hz(d.frequency_hz)}` + (d.amplitude_mm != null ? ` at ${num(d.amplitude_mm)} mm ${d.direction}` : '') +
     `: T = ${num(d.ratio)}, phase ${num(d.phase_rad * 180 / Math.PI)}°` + (d.control_error_pct != null ? `, control error ${pct(d.control_error_pct)}` : '');
+  if (e.kind === 'pretest') return `loop check: ${plural(d.frequencies, 'frequency', 'frequencies')} at ${num(d.level_mm)} mm in ${duration(d.seconds)} of rig time, ${plural(d.windows, 'window')}` +
+    ` (the table's response ${num(d.response_min, 3)}–${num(d.response_max, 3)} of the drive${d.unsettled ? `; ${d.unsettled} not settled` : ''})`;
   if (e.kind === 'sweep_done') return `${d.points} of ${plural(d.of, 'step')} in ${duration(d.seconds)} of rig time (planned ${duration(d.nominal_seconds)}), ${plural(d.warnings, 'warning')}`;
   // A load frame's retake has rows, not a frequency: not ours.
   return SAY[e.kind] && (e.kind === 'gap' || d.frequency_hz != null) ? SAY[e.kind](d) : null;

@@ -115,6 +115,7 @@ HYSTLAB_EVENT(SweepDoneEvent, "sweep_done", points, of, seconds, nominal_seconds
 HYSTLAB_EVENT(ControlAbortEvent, "control_abort", frequency_hz, demand_mm, base_mm, error_pct, drive_mm)
 HYSTLAB_EVENT(ControlWarningEvent, "control_warning", frequency_hz, demand_mm, base_mm, error_pct, band)
 HYSTLAB_EVENT(UnsettledEvent, "unsettled", frequency_hz, cycles, change_pct)
+HYSTLAB_EVENT(PretestEvent, "pretest", frequencies, level_mm, windows, seconds, unsettled, response_min, response_max)
 HYSTLAB_EVENT(DwellEvent, "dwell", pass, amplitude_mm, track, start_hz, frequency_hz, target_deg, phase_deg, cycles, windows, out_of_tolerance, locked)
 HYSTLAB_EVENT(ResonanceUnresolvedEvent, "resonance_unresolved", pass, frequency_hz, amplitude_mm, band_points, wanted, added, why)
 HYSTLAB_EVENT(FitEvent, "fit", nodes, required, accuracy)

@@ -79,6 +79,7 @@ constexpr std::array kFields{
   field("control.max_drive_ratio", "drive at most", "× the demand", 1, 100, T::number),
   field("control.start_level", "start level", "", 0.05, 1, T::number),
   field("control.abort_windows", "abort windows in a row", "", 1, 100, T::integer),
+  field("control.pretest_level", "loop check level", "× the smallest amplitude", 0, 1, T::number),
   field("jump_threshold", "jump threshold", "%", 0, 100, T::percent),
   field("resonance.max_steps", "resonance steps added at most", "", 1, 1000, T::integer),
   field("dwell.frequency_hz", "dwell frequency", "Hz", 1e-3, 1000, T::number),

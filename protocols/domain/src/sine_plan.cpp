@@ -136,7 +136,8 @@ SineControl parse_control(const json& j) {
   }
   if (!b.is_object()) fields::fail("control", "must be an object ({\"tolerance\": \"5 %\", ...}) or false (open loop)");
   fields::only(b, "control.",
-               {"tolerance", "warning", "abort", "converge", "gain", "window_cycles", "max_windows", "max_drive_ratio", "start_level", "abort_windows"});
+               {"tolerance", "warning", "abort", "converge", "gain", "window_cycles", "max_windows", "max_drive_ratio", "start_level", "abort_windows",
+                "pretest_level"});
   c.tolerance_pct = fields::percent(b, "tolerance", c.tolerance_pct, "control.");
   c.converge_pct = fields::percent(b, "converge", std::min(c.converge_pct, c.tolerance_pct), "control.");
   if (c.converge_pct > c.tolerance_pct) fields::fail("control.converge", "must be at most control.tolerance");
@@ -150,6 +151,7 @@ SineControl parse_control(const json& j) {
   c.max_drive_ratio = fields::number(b, "max_drive_ratio", c.max_drive_ratio, "control.");
   c.start_level = fields::number(b, "start_level", c.start_level, "control.");
   c.abort_windows = fields::integer(b, "abort_windows", c.abort_windows, "control.");
+  c.pretest_level = fields::number(b, "pretest_level", c.pretest_level, "control.");
   return c;
 }
 }  // namespace
@@ -240,13 +242,29 @@ double step_nominal_s(const SinePlan& p, double f) {
   return (control + settle + p.measured_cycles) / f;
 }
 
+bool has_pretest(const SinePlan& p) { return p.control.closed && p.control.pretest_level > 0 && !p.continuous && !p.dwell.on && p.frequencies_hz.size() >= 2; }
+
+std::vector<double> pretest_frequencies(const SinePlan& p) {
+  if (!has_pretest(p)) return {};
+  std::vector<double> f = p.frequencies_hz;
+  std::sort(f.begin(), f.end());
+  f.erase(std::unique(f.begin(), f.end()), f.end());
+  return f;
+}
+
+double pretest_nominal_s(const SinePlan& p) {
+  double s = 0;
+  for (const double f : pretest_frequencies(p)) s += 2.0 * (p.control.window_cycles + 1) / f;
+  return s;
+}
+
 double nominal_duration_s(const SinePlan& p) {
   const auto passes = sweep_passes(p);
   if (p.dwell.on) return static_cast<double>(passes.size()) * (step_nominal_s(p, p.dwell.frequency_hz) + p.dwell.cycles / p.dwell.frequency_hz);
   if (p.continuous) return static_cast<double>(passes.size()) * (continuous_seconds(p) + step_nominal_s(p, p.from_hz) - p.measured_cycles / p.from_hz);
   double per_pass = 0;
   for (const double f : p.frequencies_hz) per_pass += step_nominal_s(p, f);
-  return static_cast<double>(passes.size()) * per_pass;
+  return pretest_nominal_s(p) + static_cast<double>(passes.size()) * per_pass;
 }
 
 std::size_t step_count(const SinePlan& p) {

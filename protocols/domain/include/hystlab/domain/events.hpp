@@ -126,6 +126,13 @@ struct DwellEvent {
   bool locked = false;
   std::string track;
 };
+// The loop check's end (control.pretest_level): its frequencies driven at level_mm, the windows
+// it took, the rig seconds, the frequencies whose response had not settled in its windows, and
+// the table's response (base per unit of drive) it learnt, lowest and highest.
+struct PretestEvent {
+  std::int64_t frequencies = 0, windows = 0, unsettled = 0;
+  double level_mm = NAN, seconds = NAN, response_min = NAN, response_max = NAN;
+};
 // The partial table scored on the run so far (after a descent); accuracy as models::accuracy_json.
 struct FitEvent {
   std::int64_t nodes = 0, required = 0;
@@ -153,7 +160,7 @@ struct CommandEvent {
 using CampaignEvent =
     std::variant<GapEvent, GapsEvent, SafeEvent, LimitsEvent, QualityEvent, ShakedownEvent, TrainingEvent, ValidationEvent, RetakeEvent, SineStepEvent,
                  TransmissibilityEvent, SweepDoneEvent, ControlAbortEvent, ControlWarningEvent, ControlUnreachedEvent, UnsettledEvent, ResonanceUnresolvedEvent,
-                 DwellEvent, FitEvent, EnvelopeEvent, RecordEvent, RecommendationEvent, CommandEvent>;
+                 DwellEvent, PretestEvent, FitEvent, EnvelopeEvent, RecordEvent, RecommendationEvent, CommandEvent>;
 
 // Its stored kind ("gap", "control_unreached").
 [[nodiscard]] std::string_view kind_of(const CampaignEvent& e) noexcept;

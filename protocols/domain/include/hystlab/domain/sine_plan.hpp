@@ -51,6 +51,13 @@ struct SineControl {
   // 16 Hz after 18 Hz the simulated one's base read +40 % and +34 % in its first two 4-cycle
   // windows (the ringing at 17.7 Hz inside the fit's resolution), then settled.
   int abort_windows = 3;
+  // The loop check before a stepped sweep's first pass (0: none): every planned frequency driven
+  // at this fraction of the plan's smallest amplitude (-12 dB), up, until the table's response
+  // there stops changing, so that every step starts at the drive its own frequency needs. Without
+  // it a step across the isolator's resonance starts at the drive learnt on the other side: the
+  // simulated table's response changes 2.5 times between 17 and 18.5 Hz, and the base read 22 %
+  // of its demand for a window there.
+  double pretest_level = 0.25;
 };
 
 // When a step's response has settled: after `cycles` cycles at the step's final drive, or (until)
@@ -125,6 +132,12 @@ struct SweepPass {
 // tolerance (each with its cycle of transient), the settle (its minimum and the criterion's
 // windows, or the fixed cycles) and the measurement.
 [[nodiscard]] double step_nominal_s(const SinePlan& p, double f);
+// Whether the plan starts with the loop check (control.pretest_level): a closed-loop stepped
+// sweep of two frequencies or more; its frequencies, ascending; its nominal seconds (each
+// frequency: two windows that agree, each with its cycle of transient).
+[[nodiscard]] bool has_pretest(const SinePlan& p);
+[[nodiscard]] std::vector<double> pretest_frequencies(const SinePlan& p);
+[[nodiscard]] double pretest_nominal_s(const SinePlan& p);
 // The number of steps (points) of the plan: stepped: every frequency of every pass; continuous:
 // about one point per measured window.
 [[nodiscard]] std::size_t step_count(const SinePlan& p);
