@@ -53,6 +53,8 @@ const char* to_string(CampaignPhase p) noexcept {
       return "held";
     case P::safing:
       return "safing";
+    case P::shaker_check:
+      return "shaker_check";
     case P::shaker_control:
       return "shaker_control";
     case P::shaker_measure:

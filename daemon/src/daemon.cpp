@@ -79,7 +79,7 @@ struct Daemon::Impl {
           error = std::current_exception();
         }
         std::lock_guard alk(answer->m);
-        answer->value = std::move(value);
+        if (value) answer->value.emplace(std::move(*value));  // R need not be assignable
         answer->error = std::move(error);
         answer->done = true;
         answer->cv.notify_all();

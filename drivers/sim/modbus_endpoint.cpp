@@ -142,8 +142,9 @@ bool ModbusEndpoint::starts_new_step(const std::uint8_t* q, int length) {
   const protocols::MapEntry* e = map_.find(protocols::Signal::drive_frequency_hz);
   if (!e || e->table != ModbusTable::holding_register) return false;
   const int h = modbus_get_header_length(ctx_), fn = q[h];
+  if ((fn != 0x06 && fn != 0x10) || h + 5 > length) return false;  // a write, whole enough to read its address
   const int first = (q[h + 1] << 8) | q[h + 2];
-  const int count = fn == 0x06 ? 1 : fn == 0x10 ? ((q[h + 3] << 8) | q[h + 4]) : 0;
+  const int count = fn == 0x06 ? 1 : ((q[h + 3] << 8) | q[h + 4]);
   const int at = fn == 0x06 ? h + 3 : h + 6;  // the first word's first byte
   std::array<std::uint16_t, 2> words{mapping_->tab_registers[e->address], mapping_->tab_registers[e->address + e->width() - 1]};
   bool touched = false;

@@ -145,9 +145,10 @@ async function checkEnded(page, when) {
   check(bb && bb.plots === 3 && bb.amplitudes === 2 && ['measured up', 'measured down', 'predicted up'].every(l => bb.series.includes(l)),
         `${when}: the backbone's three plots over two amplitudes, measured and predicted: ${JSON.stringify(bb && bb.series)}`);
   const fm = line('frequency_hz', 'measured up'), fp = line('frequency_hz', 'predicted up'), zm = line('equivalent_damping', 'measured up');
-  check(fm.length === 2 && fm[1] < fm[0] && fp.length === 2 && fp[1] < fp[0],
+  const finite = v => v.length === 2 && v.every(Number.isFinite);
+  check(finite(fm) && fm[1] < fm[0] && finite(fp) && fp[1] < fp[0],
         `${when}: the backbone falls with amplitude, measured (${fm.map(v => v && v.toFixed(2)).join(' → ')} Hz) as predicted (${fp.map(v => v && v.toFixed(2)).join(' → ')} Hz)`);
-  check(zm.length === 2 && zm[1] > zm[0], `${when}: and its damping grows (ζ eq ${zm.map(v => v && v.toFixed(3)).join(' → ')})`);
+  check(finite(zm) && zm[1] > zm[0], `${when}: and its damping grows (ζ eq ${zm.map(v => v && v.toFixed(3)).join(' → ')})`);
   check(h.time.yAxes === 1 && h.time.envelope > 1000, `${when}: the whole stored run against time, as an envelope (${h.time.envelope} values)`);
   check(new RegExp(`^${STEPS} of ${STEPS} steps measured`).test(h.progress) && h.eta === '', `${when}: the header says "${h.progress}"`);
   // Acceleration is a live view (the stored overview keeps displacements): not offered empty.

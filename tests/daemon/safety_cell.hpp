@@ -52,7 +52,8 @@ json next_plan(bool shaker) {  // after a reset: the next campaign must run
 }
 
 bool shaker_state(State s) {
-  return s == State::shaker_control || s == State::shaker_measure || s == State::shaker_ramp || s == State::shaker_sweep || s == State::shaker_dwell;
+  return s == State::shaker_check || s == State::shaker_control || s == State::shaker_measure || s == State::shaker_ramp || s == State::shaker_sweep ||
+         s == State::shaker_dwell;
 }
 // The shaker's campaign that passes through the state: a second level ramped to from the first,
 // a continuous sweep, a dwell tracking the phase (the fake mass is 0.3 rad behind at every
@@ -61,7 +62,7 @@ json shaker_plan(State s) {
   json p = sine_plan();
   if (s == State::shaker_ramp) p.erase("amplitude_mm"), p["frequencies_hz"] = {25}, p["amplitudes_mm"] = {0.005, 0.05};
   if (s == State::shaker_sweep) p.erase("frequencies_hz"), p["sweep"] = {{"from_hz", 20}, {"to_hz", 30}, {"rate_hz_s", 2}};
-  if (s == State::shaker_dwell) p.erase("frequencies_hz"), p["dwell"] = {{"frequency_hz", 25}, {"cycles", 400}};
+  if (s == State::shaker_dwell) p.erase("frequencies_hz"), p["dwell"] = {{"frequency_hz", 25}, {"cycles", 400}, {"track", "phase"}};
   return p;
 }
 bool campaign_event(Event e) {
@@ -274,6 +275,8 @@ struct Cell {
       case State::safing:
         if (p == CampaignPhase::ramping && x > 0.6 && !abort_sent) abort_sent = true, world.controls.push_back(Control::abort);
         return p == CampaignPhase::safing && x < 0.5;
+      case State::shaker_check:
+        return p == CampaignPhase::shaker_check && ticks > 30;
       case State::shaker_control:
         return p == CampaignPhase::shaker_control && ticks > 30;
       case State::shaker_measure:

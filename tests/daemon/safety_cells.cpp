@@ -24,6 +24,7 @@ const char* to_string(State s) noexcept {
                                    "validation",
                                    "paused",
                                    "safing",
+                                   "shaker loop check",
                                    "shaker control window",
                                    "shaker measuring window",
                                    "shaker ramp between levels",

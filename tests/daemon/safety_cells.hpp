@@ -21,6 +21,7 @@ enum class State {
   validation,
   paused,
   safing,
+  shaker_check,
   shaker_control,
   shaker_measure,
   shaker_ramp,
@@ -52,26 +53,10 @@ enum class Event {
   ring_full,
   finisher_failing
 };
-inline constexpr std::array kStates{State::idle,
-                                    State::queued,
-                                    State::arming_ready,
-                                    State::arming_enable,
-                                    State::preamble,
-                                    State::training,
-                                    State::ramping,
-                                    State::dwelling,
-                                    State::retake,
-                                    State::validation,
-                                    State::paused,
-                                    State::safing,
-                                    State::shaker_control,
-                                    State::shaker_measure,
-                                    State::shaker_ramp,
-                                    State::shaker_sweep,
-                                    State::shaker_dwell,
-                                    State::finishing,
-                                    State::held_after_restart,
-                                    State::limit_recovery};
+inline constexpr std::array kStates{
+    State::idle,           State::queued,      State::arming_ready, State::arming_enable, State::preamble,  State::training,           State::ramping,
+    State::dwelling,       State::retake,      State::validation,   State::paused,        State::safing,    State::shaker_check,       State::shaker_control,
+    State::shaker_measure, State::shaker_ramp, State::shaker_sweep, State::shaker_dwell,  State::finishing, State::held_after_restart, State::limit_recovery};
 inline constexpr std::array kEvents{
     Event::rig_estop, Event::campaign_estop,     Event::abort,     Event::pause,          Event::resume,    Event::reset,           Event::ctl_estop,
     Event::ctl_fault, Event::limit_trip,         Event::not_ready, Event::enable_dropped, Event::link_lost, Event::stale_counter,   Event::heartbeat_lost,

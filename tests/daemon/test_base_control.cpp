@@ -133,4 +133,11 @@ TEST_CASE("the loop check: every frequency ascending at a quarter of the smalles
   SinePlan open = s;
   open.control.closed = false;
   CHECK_FALSE(has_pretest(open));
+  SinePlan continuous = s;
+  continuous.continuous = true;
+  CHECK_FALSE(has_pretest(continuous));
+  SinePlan dwell = s;
+  dwell.dwell.on = true;
+  CHECK_FALSE(has_pretest(dwell));
+  CHECK(has_pretest(s));  // and the plan they were made from has one
 }

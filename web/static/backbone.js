@@ -62,14 +62,15 @@ export class BackbonePlot {
   build() {
     for (const u of this.plots) u.destroy();
     this.row.replaceChildren();
-    const xRange = logRange(this.xs[0], this.xs[this.xs.length - 1], 1.3, [0.001, 1]);
+    // The amplitudes read at each redraw: a sweep's next level arrives after the plots are built.
+    const xRange = () => logRange(this.xs[0], this.xs[this.xs.length - 1], 1.3, [0.001, 1]);
     const cursor = { sync: { key: 'hystlab-backbone' }, drag: { x: false, y: false, setScale: false }, points: { show: false } };
     this.plots = FIGURES.map(f => {
       const box = el('div', { class: 'backbone-plot' });
       this.row.append(box);
       return new uPlot({
         ...this.size(), legend: { show: false }, cursor,
-        scales: { x: { time: false, distr: 3, log: 10, range: () => xRange }, y: { range: (u, lo, hi) => padded(lo, hi) } },
+        scales: { x: { time: false, distr: 3, log: 10, range: xRange }, y: { range: (u, lo, hi) => padded(lo, hi) } },
         axes: [{ label: 'base amplitude (mm)', space: 30, filter: oneTwoFive }, { label: f.label, size: 60, space: 24 }],
         series: [{}, ...this.series.map(s => this.opts(s))],
         hooks: { setCursor: [u => this.hover(u)] },

@@ -45,6 +45,7 @@ enum class CampaignPhase : std::uint8_t {
   paused,
   held,
   safing,
+  shaker_check,    // the loop check before a stepped sweep: each frequency at a low level
   shaker_control,  // a control window: the base brought to its demand
   shaker_measure,  // a step's measured window
   shaker_ramp,     // between two levels, the amplitude stepped x2 a window
