@@ -6,10 +6,15 @@
 
 namespace hystlab::models {
 
-EverettTable::EverettTable(Grid grid) : grid_(grid), inv_step_(1.0 / grid.step()), values_(grid.node_count(), 0.0) {}
+EverettTable::EverettTable(Grid grid)
+    : grid_(grid), inv_step_(1.0 / grid.step()), nodes_(grid.positions ? grid.positions->data() : nullptr), values_(grid.node_count(), 0.0) {}
 
 EverettTable::EverettTable(Grid grid, std::vector<double> values, double force_offset)
-    : grid_(grid), inv_step_(1.0 / grid.step()), values_(std::move(values)), force_offset_(force_offset) {
+    : grid_(grid),
+      inv_step_(1.0 / grid.step()),
+      nodes_(grid.positions ? grid.positions->data() : nullptr),
+      values_(std::move(values)),
+      force_offset_(force_offset) {
   if (values_.size() != grid_.node_count())
     throw std::invalid_argument("table: expected " + std::to_string(grid_.node_count()) + " values for n = " + std::to_string(grid_.n) + ", got " +
                                 std::to_string(values_.size()));

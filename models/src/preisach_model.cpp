@@ -18,19 +18,10 @@ PreisachModel::PreisachModel(std::shared_ptr<const EverettTable> table, Preisach
 }
 
 void PreisachModel::reset() noexcept {
-  len_ = 1;
+  now_ = Now{1, table_->grid().lo, 0.0, 0.0};
   turning_[0] = table_->grid().lo;
   closed_[0] = 0.0;
-  x_ = table_->grid().lo;
-  base_ = 0.0;
-  f_ = 0.0;
   saturations_ = merges_ = invalid_ = 0;
-}
-
-double PreisachModel::base_for(std::size_t len) const noexcept {
-  const std::size_t pairs = len / 2;
-  if (len & 1U) return closed_[pairs];  // rising from m_N, N = pairs
-  return closed_[pairs - 1] + table_->value_in_range(turning_[len - 1], turning_[len - 2]);
 }
 
 }  // namespace hystlab::models
@@ -50,10 +41,10 @@ std::size_t state_count(double v, double lo, double hi, const char* what) {
 }  // namespace
 
 std::vector<double> PreisachModel::save_state() const {
-  std::vector<double> s{kPreisachStateKind,           static_cast<double>(len_),    x_, f_, base_, static_cast<double>(saturations_),
+  std::vector<double> s{kPreisachStateKind,           static_cast<double>(now_.len), now_.x, now_.f, now_.base, static_cast<double>(saturations_),
                         static_cast<double>(merges_), static_cast<double>(invalid_)};
-  s.insert(s.end(), turning_.begin(), turning_.begin() + static_cast<std::ptrdiff_t>(len_));
-  s.insert(s.end(), closed_.begin(), closed_.begin() + static_cast<std::ptrdiff_t>(len_ / 2 + 1));
+  s.insert(s.end(), turning_.begin(), turning_.begin() + static_cast<std::ptrdiff_t>(now_.len));
+  s.insert(s.end(), closed_.begin(), closed_.begin() + static_cast<std::ptrdiff_t>(now_.len / 2 + 1));
   return s;
 }
 
@@ -74,10 +65,7 @@ void PreisachModel::restore_state(std::span<const double> s) {
   for (const double t : turning)
     if (t < g.lo || t > g.hi) throw std::invalid_argument("model state: a turning point lies outside the table's range (another table's state?)");
   if (s[2] < g.lo || s[2] > g.hi) throw std::invalid_argument("model state: the input lies outside the table's range (another table's state?)");
-  len_ = len;
-  x_ = s[2];
-  f_ = s[3];
-  base_ = s[4];
+  now_ = Now{len, s[2], s[3], s[4]};
   saturations_ = static_cast<std::uint64_t>(s[5]);
   merges_ = static_cast<std::uint64_t>(s[6]);
   invalid_ = static_cast<std::uint64_t>(s[7]);

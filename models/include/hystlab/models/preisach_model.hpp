@@ -35,8 +35,8 @@ class PreisachModel final : public HysteresisModel {
   double step(double x) noexcept override { return advance(*this, x); }
   [[nodiscard]] double peek(double x) const noexcept override { return advance(*this, x); }
   [[nodiscard]] std::unique_ptr<HysteresisModel> clone() const override { return std::make_unique<PreisachModel>(*this); }
-  [[nodiscard]] double input() const noexcept override { return x_; }
-  [[nodiscard]] double output() const noexcept override { return f_ + table_->force_offset(); }
+  [[nodiscard]] double input() const noexcept override { return now_.x; }
+  [[nodiscard]] double output() const noexcept override { return now_.f + table_->force_offset(); }
   [[nodiscard]] std::uint64_t saturation_count() const noexcept override { return saturations_; }
   // [kind 1, len, x, f, base, saturations, merges, invalid, turning[0..len), closed[0..len/2]].
   [[nodiscard]] std::vector<double> save_state() const override;
@@ -44,29 +44,35 @@ class PreisachModel final : public HysteresisModel {
 
   [[nodiscard]] std::uint64_t merge_count() const noexcept { return merges_; }
   [[nodiscard]] std::uint64_t invalid_input_count() const noexcept { return invalid_; }
-  [[nodiscard]] std::size_t depth() const noexcept { return len_; }
+  [[nodiscard]] std::size_t depth() const noexcept { return now_.len; }
   [[nodiscard]] const EverettTable& table() const noexcept { return *table_; }
   [[nodiscard]] const PreisachOptions& options() const noexcept { return options_; }
 
  private:
   // One implementation for step (Self non-const: the new state is stored) and peek (const).
+  // Always inlined, as what it calls: a caller that knows the model (a loop over a
+  // PreisachModel, the C API, the FMU, SdofSystem) gets the step without a call in it.
   template <class Self>
-  static double advance(Self& self, double x) noexcept;
-  [[nodiscard]] double base_for(std::size_t len) const noexcept;
+  [[gnu::always_inline]] static double advance(Self& self, double x) noexcept;
 
   std::shared_ptr<const EverettTable> table_;
   PreisachOptions options_;
   std::vector<double> turning_;  // capacity max_turning_points, first len_ valid
   std::vector<double> closed_;   // closed_[k]: sum over the first k closed pairs
-  std::size_t len_ = 1;
-  double x_ = 0.0;
-  double f_ = 0.0;     // without offset
-  double base_ = 0.0;  // rising: closed_[N]; falling: closed_[N-1] + F(M_N, m_{N-1})
+  // The state a step moves: stepped in place, peeked in a copy (advance).
+  struct Now {
+    std::size_t len = 1;  // turning points stored
+    double x = 0.0;
+    double f = 0.0;     // without offset
+    double base = 0.0;  // rising: closed_[N]; falling: closed_[N-1] + F(M_N, m_{N-1})
+  } now_;
   std::uint64_t saturations_ = 0, merges_ = 0, invalid_ = 0;
 };
 
+// Written as the bare loop is (bench_preisach's bare_everett.hpp), on the state in place: the same
+// rule kept in locals and merged at the end ran at 0.65-0.72 of it (issue 27), at par written so.
 template <class Self>
-double PreisachModel::advance(Self& self, double x) noexcept {
+inline double PreisachModel::advance(Self& self, double x) noexcept {
   constexpr bool kCommit = !std::is_const_v<Self>;
   const EverettTable& t = *self.table_;
   const double offset = t.force_offset();
@@ -79,57 +85,38 @@ double PreisachModel::advance(Self& self, double x) noexcept {
     if constexpr (kCommit) ++self.saturations_;
     x = x < g.lo ? g.lo : g.hi;
   }
-  if (x == self.x_) return self.f_ + offset;
-  const bool up = x > self.x_;
-  std::size_t len = self.len_;
+  std::conditional_t<kCommit, Now&, Now> c = self.now_;  // a step moves the state, a peek a copy of it
+  if (x == c.x) return c.f + offset;
+  const bool up = x > c.x;
   const double* tp = self.turning_.data();
-  double base = self.base_;
-  double last = tp[len - 1];
-  bool changed = false;
-  // A reversal makes x_ a turning point. The usual case (append) is done without branches,
-  // because for a random input it is a coin toss; merging is rare and branches.
-  const bool rev = up != static_cast<bool>(len & 1U);
-  // The rare condition first, so the common path has no branch on rev.
-  const bool merge = rev && (len >= self.options_.max_turning_points || (len > 1 && std::fabs(self.x_ - last) <= self.options_.merge_tolerance));
-  if (merge) {
-    --len;  // forget the excursion since the last turning point (counted)
-    changed = true;
-    if constexpr (kCommit) ++self.merges_;
-  } else {
-    if constexpr (kCommit) {
-      // Slot len is spare when there is no reversal; a new minimum (even index) closes pair
-      // N = len/2, anything else writes the scratch slot at the end of closed_ (mask select).
-      self.turning_[len] = self.x_;
-      const std::size_t scratch = self.closed_.size() - 1, closes = (rev ? 1U : 0U) & ~len & 1U;
-      self.closed_[scratch ^ ((scratch ^ (len / 2)) & (0U - closes))] = self.f_;
+  bool wiped = false, pushed = false;
+  if (up != static_cast<bool>(c.len & 1U)) {  // a reversal: the last input is a turning point
+    if (c.len >= self.options_.max_turning_points || (c.len > 1 && std::fabs(c.x - tp[c.len - 1]) <= self.options_.merge_tolerance)) [[unlikely]] {
+      --c.len, wiped = true;  // forget the excursion since the last turning point (counted)
+      if constexpr (kCommit) ++self.merges_;
+    } else {
+      if constexpr (kCommit) {
+        self.turning_[c.len] = c.x;
+        if (up) self.closed_[c.len / 2] = c.f;  // a new minimum closes pair N = len/2: the sum through it is f
+      }
+      ++c.len, pushed = true;
+      c.base = c.f;  // Eqs. 6-7: the new branch starts from the force at the reversal
     }
-    len += rev ? 1U : 0U;
-    base = rev ? self.f_ : base;  // Eqs. 6-7: the new branch starts from the force at the reversal
-    last = rev ? self.x_ : last;
   }
-  // Wiping-out, one rule for both directions (no branch on the direction): the turning point
-  // two below the top is of the kind the input moves toward (a maximum when rising, a minimum
-  // when falling); reaching it removes it with the one after it. Falling to δmin clears all.
-  const double toward = up ? 1.0 : -1.0;
-  while (len >= 2 && toward * (x - tp[len - 2]) >= 0.0) {
-    len = len == 2 ? 1 : len - 2;
-    changed = true;
-  }
-  if (changed) {
-    base = self.base_for(len);
-    last = tp[len - 1];
-  }
-  // Rising from m_N: + F(x, m_N); falling from M_N: - F(M_N, x). One lookup, selected without a branch.
-  const bool rising = len & 1U;
-  const double v = t.value_in_range(rising ? x : last, rising ? last : x);
-  const double f = base + (rising ? v : -v);
-  if constexpr (kCommit) {
-    self.len_ = len;
-    self.base_ = base;
-    self.x_ = x;
-    self.f_ = f;
-  }
-  return f + offset;
+  // Wiping-out: the turning point two below the top is of the kind the input moves toward (a
+  // maximum when rising, a minimum when falling); reaching it removes it with the one after it.
+  // Falling to δmin clears all. (len & 1) == up from here on.
+  if (up)
+    while (c.len >= 3 && x >= tp[c.len - 2]) c.len -= 2, wiped = true;
+  else
+    while (c.len >= 2 && x <= tp[c.len - 2]) c.len = c.len == 2 ? 1 : c.len - 2, wiped = true;
+  double last = tp[c.len - 1];
+  if constexpr (!kCommit) last = pushed && !wiped ? c.x : last;  // a peek stored no turning point
+  if (wiped) c.base = c.len & 1U ? self.closed_[c.len / 2] : self.closed_[c.len / 2 - 1] + t.value_in_range(last, tp[c.len - 2]);
+  c.x = x;
+  // Rising from m_N: + F(x, m_N); falling from M_N: - F(M_N, x).
+  c.f = up ? c.base + t.value_in_range(x, last) : c.base - t.value_in_range(last, x);
+  return c.f + offset;
 }
 
 }  // namespace hystlab::models
