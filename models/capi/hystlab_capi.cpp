@@ -14,6 +14,15 @@
 struct hystlab_model {
   std::unique_ptr<hystlab::models::HysteresisModel> model;
   int kind = 0;
+  // The model as a table, when it is one: its step called directly, inlined (PreisachModel is
+  // final), not through the interface's virtual call (issue 27: the C API is the FMU's and the
+  // Python module's yardstick, and a table is what most callers step).
+  hystlab::models::PreisachModel* table = nullptr;
+  void adopt(std::unique_ptr<hystlab::models::HysteresisModel> m) {
+    model = std::move(m);
+    table = dynamic_cast<hystlab::models::PreisachModel*>(model.get());
+  }
+  double step(double x) noexcept { return table ? table->step(x) : model->step(x); }
 };
 
 namespace {
@@ -43,7 +52,7 @@ hystlab_status guarded(F&& f) noexcept {
 hystlab_status make(const std::string& text, hystlab_model** out) {
   hystlab::models::Element e = hystlab::models::element_from_json(text);
   auto m = std::make_unique<hystlab_model>();
-  m->model = std::move(e.model);
+  m->adopt(std::move(e.model));
   m->kind = static_cast<int>(e.kind);
   *out = m.release();
   return HYSTLAB_OK;
@@ -88,7 +97,7 @@ hystlab_status hystlab_model_from_table(int n, double lo, double hi, const doubl
       return fail(HYSTLAB_ERROR_FORMAT,
                   "hystlab_model_from_table: the nodes run from " + std::to_string(grid.lo) + " to " + std::to_string(grid.hi) + ", not from lo_mm to hi_mm");
     auto m = std::make_unique<hystlab_model>();
-    m->model = std::make_unique<hm::PreisachModel>(hm::EverettTable(grid, std::vector<double>(values, values + count), offset));
+    m->adopt(std::make_unique<hm::PreisachModel>(hm::EverettTable(grid, std::vector<double>(values, values + count), offset)));
     m->kind = 1;
     *out = m.release();
     return HYSTLAB_OK;
@@ -98,7 +107,7 @@ hystlab_status hystlab_model_from_table(int n, double lo, double hi, const doubl
 hystlab_status hystlab_model_step(hystlab_model* m, double x, double* force) {
   if (!m || !force) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_step: null argument");
   if (!std::isfinite(x)) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_step: the displacement is not a finite number");
-  *force = m->model->step(x);
+  *force = m->step(x);
   return HYSTLAB_OK;
 }
 
@@ -106,7 +115,7 @@ hystlab_status hystlab_model_evaluate(hystlab_model* m, const double* x, double*
   if (!m || (n > 0 && (!x || !force))) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_evaluate: null argument");
   for (size_t k = 0; k < n; ++k)
     if (!std::isfinite(x[k])) return fail(HYSTLAB_ERROR_ARGUMENT, "hystlab_model_evaluate: x[" + std::to_string(k) + "] is not a finite number");
-  for (size_t k = 0; k < n; ++k) force[k] = m->model->step(x[k]);
+  for (size_t k = 0; k < n; ++k) force[k] = m->step(x[k]);
   return HYSTLAB_OK;
 }
 
@@ -121,7 +130,7 @@ hystlab_status hystlab_model_copy(const hystlab_model* m, hystlab_model** out) {
   *out = nullptr;
   return guarded([&] {
     auto c = std::make_unique<hystlab_model>();
-    c->model = m->model->clone();
+    c->adopt(m->model->clone());
     c->kind = m->kind;
     *out = c.release();
     return HYSTLAB_OK;

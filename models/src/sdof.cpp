@@ -8,6 +8,7 @@
 #include <string>
 
 #include "hystlab/models/everett_table.hpp"
+#include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/sine_fit.hpp"
 
 namespace hystlab::models {
@@ -46,6 +47,7 @@ SdofSystem::SdofSystem(std::vector<SdofSpring> springs, const SdofOptions& o) : 
                      " (ω_max = sqrt(1000·Σk_max/m) = " + short_num(omega_max_) + " rad/s) must stay below 1; use dt ≤ " + short_num(0.5 / omega_max_) + " s");
   // Load the springs monotonically from rest to the preload: the weight is what they then carry.
   for (auto& s : springs_) s.model->reset();
+  group_tables();  // after the reset: every spring's memory is its table's start
   constexpr int kLoadSteps = 200;
   double f = 0;
   for (int k = 1; k <= kLoadSteps; ++k) f = spring_force(o.preload_mm * k / kLoadSteps);
@@ -55,12 +57,31 @@ SdofSystem::SdofSystem(std::vector<SdofSpring> springs, const SdofOptions& o) : 
   s_.force = f;
 }
 
+void SdofSystem::group_tables() {
+  std::vector<TableGroup> groups;
+  for (const auto& s : springs_) {
+    auto* p = dynamic_cast<PreisachModel*>(s.model.get());
+    if (!p) return;  // a spring of another kind: every spring through the interface
+    const auto same =
+        std::find_if(groups.begin(), groups.end(), [p](const TableGroup& g) { return &g.model->table() == &p->table() && g.model->options() == p->options(); });
+    if (same != groups.end())
+      same->count += 1;
+    else
+      groups.push_back({p, 1.0});
+  }
+  tables_ = std::move(groups);
+}
+
 double SdofSystem::spring_force(double delta) noexcept {
   if (delta < 0) {
     ++lift_off_;  // the mass has left the springs: they only push
     delta = 0;
   }
   double f = 0;
+  if (!tables_.empty()) {
+    for (const TableGroup& g : tables_) f += g.count * g.model->step(delta);
+    return f;
+  }
   for (auto& s : springs_) f += s.model->step(delta);
   return f;
 }

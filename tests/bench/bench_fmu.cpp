@@ -1,5 +1,5 @@
 // The FMU's fmi2DoStep throughput against the C API on the same table, in the same run (issue 15:
-// target >= 0.8). One co-simulation step is what an importer does per input: fmi2SetReal(x),
+// target >= 0.8, raised to 0.9 by issue 27). One co-simulation step is what an importer does per input: fmi2SetReal(x),
 // fmi2DoStep, fmi2GetReal(F); the C API's is hystlab_model_step. The FMU is the one the CLI
 // writes (packaged here by the same library), unpacked with unzip and loaded with dlopen. Both
 // run 10^6 random-ramp inputs, interleaved, best of 5; the forces are asserted identical.
@@ -132,7 +132,10 @@ int main(int argc, char** argv) {
   std::printf("bench_fmu: %zu random-ramp inputs on an n = 24 table, best of 5, interleaved\n", n);
   std::printf("  C API hystlab_model_step:               %7.1f ns/step  %6.2f M steps/s\n", 1e9 * best_capi / double(n - 1), double(n - 1) / best_capi / 1e6);
   std::printf("  FMU fmi2SetReal + fmi2DoStep + GetReal: %7.1f ns/step  %6.2f M steps/s\n", 1e9 * best_fmu / double(n - 1), double(n - 1) / best_fmu / 1e6);
-  std::printf("  ratio FMU / C API throughput: %.2f (target >= 0.8)\n", best_capi / best_fmu);
+  // Issue 27 raised the target from 0.8 (issue 15) to 0.9. The C API steps a table inlined since
+  // (no virtual call): the FMU's three calls through the importer's pointers weigh more beside it.
+  const double ratio = best_capi / best_fmu;
+  std::printf("  ratio FMU / C API throughput: %.2f (target >= 0.9, issue 27: %s)\n", ratio, ratio >= 0.9 ? "met" : "NOT met");
   std::printf("  identical forces: %zu of %zu\n", same, n);
   return same == n ? 0 : 1;
 }

@@ -73,7 +73,9 @@ int main(int argc, char** argv) {
     t.join();
     std::printf("bare cpp-httplib (%zu-byte JSON): %.0f requests/s, latency p50 %.3f ms, p99 %.3f ms\n", body.size(), b.rps, b.p50_ms, b.p99_ms);
     std::printf("hystlabd GET /api/status (%zu bytes): %.0f requests/s, latency p50 %.3f ms, p99 %.3f ms\n", size, d.rps, d.p50_ms, d.p99_ms);
-    std::printf("ratio hystlabd / bare: %.2f (target >= 0.50)%s\n", d.rps / b.rps, b.errors + d.errors ? "; wrk reported errors" : "");
+    const double ratio = d.rps / b.rps;  // issue 27 asks 0.95 (an earlier issue 0.5)
+    std::printf("ratio hystlabd / bare: %.2f (target >= 0.95: %s)%s\n", ratio, ratio >= 0.95 ? "met" : "NOT met",
+                b.errors + d.errors ? "; wrk reported errors" : "");
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_http: %s\n", e.what());

@@ -190,8 +190,9 @@ int main(int argc, char** argv) {
     ratios.push_back(h.per_s / b.per_s);
   }
   std::sort(ratios.begin(), ratios.end());
-  std::printf("rig/bare polls per second, median of %d interleaved pairs: %.0f %% (target >= 80 %%); read errors: %d\n", reps, 100 * ratios[ratios.size() / 2],
-              errors);
+  const double median = ratios[ratios.size() / 2];  // issue 27 asks 90 % (an earlier issue 80 %)
+  std::printf("rig/bare polls per second, median of %d interleaved pairs: %.0f %% (target >= 90 %%: %s); read errors: %d\n", reps, 100 * median,
+              median >= 0.9 ? "met" : "NOT met", errors);
   if (jitter_seconds > 0) {
     const std::string policy = realtime_policy(sim.pid());
     jitter_loop(nullptr, jitter_seconds / 3, policy);

@@ -23,7 +23,7 @@ struct H5ExportError : std::runtime_error {
 
 struct H5ExportOptions {
   std::int64_t rows_per_read = 65536;  // samples read from the store and appended at a time (also the chunk length)
-  int deflate_level = 4;               // 0-9; shuffle before deflate makes doubles compress
+  int deflate_level = 1;               // 0-9; shuffle before deflate makes doubles compress (level 4: 1 % smaller, 9 % slower)
 };
 
 struct H5ExportStats {

@@ -24,6 +24,7 @@ namespace hystlab::models {
 struct PreisachOptions {
   double merge_tolerance = 0.0;          // mm; 0 keeps every reversal (the paper's model)
   std::size_t max_turning_points = 512;  // cap on the stack, >= 3; memory is preallocated
+  bool operator==(const PreisachOptions&) const = default;
 };
 
 class PreisachModel final : public HysteresisModel {
