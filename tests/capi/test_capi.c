@@ -61,7 +61,30 @@ int main(void) {
     CHECK(hystlab_model_step(m, NAN, &f) == HYSTLAB_ERROR_ARGUMENT);
     CHECK(strstr(hystlab_last_error(), "finite") != NULL);
     CHECK(hystlab_model_step(m, 1.0, NULL) == HYSTLAB_ERROR_ARGUMENT);
-    hystlab_model_free(m);
+    {
+      /* A table's copy steps its own table (the C API steps a table directly): the original
+         freed first, the copy answers as a fresh model taken along the same inputs does. */
+      double x[3] = {2.5, 1.0, 0.25}, y = 0, z = 0;
+      hystlab_model *c = NULL, *fresh = NULL;
+      CHECK(hystlab_model_reset(m) == HYSTLAB_OK);
+      CHECK(hystlab_model_step(m, 2.0, &f) == HYSTLAB_OK);
+      CHECK(hystlab_model_copy(m, &c) == HYSTLAB_OK);
+      hystlab_model_free(m);
+      m = NULL;
+      CHECK(hystlab_model_from_json(kTable, &fresh) == HYSTLAB_OK);
+      CHECK(c != NULL && fresh != NULL);
+      if (c && fresh) {
+        CHECK(hystlab_model_step(fresh, 2.0, &f) == HYSTLAB_OK);
+        for (int k = 0; k < 3; ++k) {
+          CHECK(hystlab_model_step(c, x[k], &y) == HYSTLAB_OK);
+          CHECK(hystlab_model_step(fresh, x[k], &z) == HYSTLAB_OK);
+          CHECK(y == z);
+        }
+        CHECK(fabs(y - 2.5) < 1e-12);
+      }
+      hystlab_model_free(c);
+      hystlab_model_free(fresh);
+    }
   }
 
   CHECK(hystlab_model_from_json(kTableNodes, &m) == HYSTLAB_OK);

@@ -123,6 +123,42 @@ TEST_CASE("preisach: peek predicts step without changing the state") {
   }
 }
 
+// Every kind of input the step treats apart: the same x again, both ends and beyond, NaN, exactly
+// a node, wiggles under the merge tolerance, a small stack cap (merges often), a refined grid.
+TEST_CASE("preisach: peek equals step and changes nothing, whatever the input (seeded)") {
+  int merged = 0;  // seeds whose stack merged (its cap, or a wiggle under the tolerance)
+  for (std::uint64_t seed = 1; seed <= 48; ++seed) {
+    CAPTURE(seed);
+    std::mt19937_64 rng(seed);
+    const int n = 4 + static_cast<int>(seed % 9);
+    const Grid g = seed % 2 ? Grid::make(0.0, 4.0, n) : Grid::refined(0.0, 4.0, n, 1.5, 1.0);
+    const PreisachOptions o{seed % 3 ? 0.0 : 0.02, 3 + static_cast<std::size_t>(seed % 4)};
+    PreisachModel m(RelayGrid(hystlab::test::random_relays(rng, g)).everett_table(g), o);
+    std::uniform_real_distribution<double> u(-0.5, 4.5), wiggle(-0.03, 0.03);
+    std::uniform_int_distribution<int> pick(0, 9), node(0, n);
+    double x = 2.0;
+    for (int k = 0; k < 4000; ++k) {
+      const int what = pick(rng);
+      if (what == 1) x = g.lo;
+      if (what == 2) x = g.hi;
+      if (what == 3) x = NAN;
+      if (what == 4) x = g.node(node(rng));
+      if (what == 5 || what == 6) x = (std::isnan(x) ? 2.0 : x) + wiggle(rng);
+      if (what >= 7) x = u(rng);
+      CAPTURE(k);
+      CAPTURE(x);
+      CAPTURE(m.depth());
+      const std::vector<double> before = m.save_state();
+      const double p = m.peek(x);
+      REQUIRE(m.save_state() == before);  // the counters included
+      const double s = m.step(x);
+      REQUIRE(((std::isnan(p) && std::isnan(s)) || p == s));
+    }
+    merged += m.merge_count() > 0 ? 1 : 0;
+  }
+  CHECK(merged >= 36);  // the merging path was taken, not only the plain one (a mutation of it fails here)
+}
+
 TEST_CASE("preisach: clamping is counted, NaN is refused, reset clears") {
   const Grid g = Grid::make(1.0, 3.0, 2);
   PreisachModel m(EverettTable(g, {0, 2, 0, 5, 2, 0}));

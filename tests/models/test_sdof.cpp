@@ -6,7 +6,9 @@
 #include <memory>
 #include <numbers>
 
+#include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/linear_spring.hpp"
+#include "hystlab/models/preisach_model.hpp"
 #include "hystlab/models/sdof.hpp"
 #include "hystlab/models/simplified_sma.hpp"
 
@@ -123,4 +125,32 @@ TEST_CASE("sdof: a base motion beyond the preload lifts the mass off the springs
   SdofSystem sys(linear(5.0, 2), linear_options(0.02));
   (void)steady_response(sys, 1.5, 100.0 / (2 * std::numbers::pi), 20, 5);  // resonance, amplitude near the preload
   CHECK(sys.lift_off_steps() > 0);
+}
+
+// Springs of one table are evaluated once and counted (SdofSystem::group_tables): the same
+// motion, to rounding, as the same springs each stepped (separate copies of the table, which
+// are not grouped), with a base that lifts the mass off them now and then.
+TEST_CASE("sdof: springs of one table evaluated once move the mass as springs each stepped") {
+  SimplifiedSmaModel virgin(table1_parameters());
+  const EverettTable t = identify_virtual(virgin, Grid::make(0.0, 5.0, 16));
+  const auto shared = std::make_shared<const EverettTable>(t);
+  std::vector<SdofSpring> one_table, copies;
+  for (int k = 0; k < 3; ++k) {
+    one_table.push_back({std::make_unique<PreisachModel>(shared), max_stiffness(t)});
+    copies.push_back({std::make_unique<PreisachModel>(EverettTable(t)), max_stiffness(t)});
+  }
+  SdofOptions o;
+  o.mass_kg = 3.0;
+  o.preload_mm = 3.0;
+  o.damping_N_s_per_mm = 0.01;
+  SdofSystem grouped(std::move(one_table), o), each(std::move(copies), o);
+  for (SdofSystem* s : {&grouped, &each}) s->set_base(4.0, 80.0);  // above resonance: δ from about -1 to 7 mm
+  for (int k = 0; k < 20000; ++k) {
+    grouped.step(), each.step();
+    CAPTURE(k);
+    REQUIRE(grouped.state().x == doctest::Approx(each.state().x).epsilon(1e-9));
+  }
+  CHECK(grouped.lift_off_steps() == each.lift_off_steps());
+  CHECK(each.lift_off_steps() > 0);
+  CHECK(grouped.energy().spring == doctest::Approx(each.energy().spring).epsilon(1e-9));
 }

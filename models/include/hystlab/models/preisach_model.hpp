@@ -58,7 +58,7 @@ class PreisachModel final : public HysteresisModel {
 
   std::shared_ptr<const EverettTable> table_;
   PreisachOptions options_;
-  std::vector<double> turning_;  // capacity max_turning_points, first len_ valid
+  std::vector<double> turning_;  // capacity max_turning_points + 1, first now_.len valid
   std::vector<double> closed_;   // closed_[k]: sum over the first k closed pairs
   // The state a step moves: stepped in place, peeked in a copy (advance).
   struct Now {

@@ -69,7 +69,9 @@ class SdofSystem {
   // When every spring is a table, the integrator calls the tables' step directly (inlined: the
   // interface's virtual call kept an isolator of two n = 12 tables at 0.63 of linear springs,
   // issue 27), and springs of one table and options are one model evaluated once and counted:
-  // in parallel from one reset, they see the same δ at every step, so their memories are equal.
+  // in parallel from one reset, they see the same δ at every step, so their memories are equal
+  // (the sum equal to rounding). The group's other models stay at their reset: nothing reads
+  // a spring's own state (add an accessor only with that in mind).
   struct TableGroup {
     PreisachModel* model;
     double count;
