@@ -104,8 +104,15 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
   }
   if (!j.is_object()) fail("", "must be a JSON object");
   for (const auto& [k, _] : j.items())
-    if (k != "db" && k != "rigs" && k != "http" && k != "acquisition") fail(k, "is not a known field (db, rigs, http, acquisition)");
+    if (k != "db" && k != "rigs" && k != "http" && k != "acquisition" && k != "lab") fail(k, "is not a known field (db, rigs, http, acquisition, lab)");
   if (j.contains("http")) c.http = parse_http(j["http"], c.http);
+  if (j.contains("lab")) {
+    try {
+      c.lab = lab::parse_lab_config(j["lab"], base_dir);
+    } catch (const lab::LabConfigError& e) {
+      throw ConfigError(e.what());
+    }
+  }
   if (j.contains("acquisition")) c.acquisition = parse_acquisition(j["acquisition"]);
   if (j.contains("db")) {
     if (!j["db"].is_string() || j["db"].get<std::string>().empty()) fail("db", "must be a file name");

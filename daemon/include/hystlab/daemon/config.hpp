@@ -7,7 +7,8 @@
 //   {"db": "hystlab.db",
 //    "rigs": [{"name": "frame A", "transport": "modbus-tcp", "port": 502, "time_scale": 1, ...},
 //             {"name": "sim frame", "simulate": {"time_scale": 20, "noise_N": 0.05}}],
-//    "http": {"bind": "127.0.0.1", "port": 8080, "token": "...", "max_stream_clients": 64}}
+//    "http": {"bind": "127.0.0.1", "port": 8080, "token": "...", "max_stream_clients": 64},
+//    "lab": {"name": "materials-lab", "daemon": "frame-pc-2", "postgresql": "...", "mqtt": {...}}}
 // With no config: one simulated load frame (hystlab-sim, supervised) and ./hystlab.db.
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -19,6 +20,7 @@
 #include "hystlab/daemon/isolator.hpp"
 #include "hystlab/daemon/realtime.hpp"
 #include "hystlab/domain/envelope.hpp"
+#include "hystlab/lab/lab_config.hpp"
 
 namespace hystlab::daemon {
 
@@ -62,6 +64,7 @@ struct DaemonConfig {
   std::string base_dir = ".";
   HttpConfig http;
   AcquisitionSettings acquisition;  // every rig's acquisition thread (and supervised simulator)
+  lab::LabConfig lab;               // "lab": replication to PostgreSQL, rigs live over MQTT (docs/LAB.md)
 };
 
 // Throws ConfigError naming the field. A null json gives the embedded defaults.
