@@ -78,6 +78,19 @@ bool Statement::step() {
 void Statement::reset() { sqlite3_reset(st_); }
 std::int64_t Statement::column_int(int c) const { return sqlite3_column_int64(st_, c); }
 double Statement::column_double(int c) const { return sqlite3_column_double(st_, c); }
+Statement::Type Statement::column_type(int c) const noexcept {
+  switch (sqlite3_column_type(st_, c)) {
+    case SQLITE_INTEGER: return Type::integer;
+    case SQLITE_FLOAT: return Type::real;
+    case SQLITE_TEXT: return Type::text;
+    case SQLITE_BLOB: return Type::blob;
+    default: return Type::null;
+  }
+}
+std::string_view Statement::column_view(int c) const {
+  const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(st_, c));
+  return p ? std::string_view(p, static_cast<std::size_t>(sqlite3_column_bytes(st_, c))) : std::string_view();
+}
 std::string Statement::column_text(int c) const {
   const auto* p = sqlite3_column_text(st_, c);
   return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(st_, c))) : std::string();

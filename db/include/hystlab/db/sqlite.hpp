@@ -54,6 +54,9 @@ class Statement {
   [[nodiscard]] double column_double(int c) const;
   [[nodiscard]] std::string column_text(int c) const;
   [[nodiscard]] bool column_is_null(int c) const;
+  enum class Type { integer, real, text, blob, null };
+  [[nodiscard]] Type column_type(int c) const noexcept;
+  [[nodiscard]] std::string_view column_view(int c) const;  // text, valid until the next step
 
  private:
   sqlite3_stmt* st_ = nullptr;

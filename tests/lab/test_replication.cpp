@@ -1,0 +1,228 @@
+// Replication of a daemon's SQLite store into a real PostgreSQL server of the test's own
+// (tests/support/postgres_server.hpp): every row once, with the same values to the bit, through
+// outages, cut-off batches and restarts; clear errors for a wrong password, no server, a newer
+// schema.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "../support/postgres_server.hpp"
+#include "hystlab/db/replicator.hpp"
+#include "hystlab/db/store.hpp"
+
+using namespace hystlab;
+using test_support::PostgresServer;
+using test_support::TempDir;
+
+namespace {
+std::string iso(int k) { return "2026-11-28T01:00:" + std::string(k < 10 ? "0" : "") + std::to_string(k) + ".000Z"; }
+
+// A checksum of every sample: FNV-1a over (run, seq, every value's bits, status), in key order.
+struct Checksum {
+  std::uint64_t h = 1469598103934665603ULL;
+  std::int64_t rows = 0;
+  void add(const void* p, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (std::size_t k = 0; k < n; ++k) h = (h ^ b[k]) * 1099511628211ULL;
+  }
+  void add_int(std::int64_t v) { add(&v, sizeof v); }
+  void add_double(double v) { add(&v, sizeof v); }
+};
+
+Checksum lite_samples(db::Database& d) {
+  Checksum c;
+  db::Statement st(d, "SELECT run_id, seq, t, cmd, disp, force, status FROM samples ORDER BY run_id, seq");
+  while (st.step()) {
+    c.add_int(st.column_int(0)), c.add_int(st.column_int(1));
+    for (int k = 2; k < 6; ++k) c.add_double(st.column_double(k));
+    c.add_int(st.column_int(6));
+    ++c.rows;
+  }
+  return c;
+}
+
+Checksum pg_samples(db::PgConnection& pg, int daemon) {
+  Checksum c;
+  const std::string id = std::to_string(daemon);
+  const db::PgResult r = pg.query("SELECT run_id, seq, t, cmd, disp, force, status FROM hystlab.samples WHERE daemon_id = $1 ORDER BY run_id, seq", {id.c_str()});
+  for (int row = 0; row < r.rows(); ++row) {
+    c.add_int(r.integer(row, 0)), c.add_int(r.integer(row, 1));
+    for (int k = 2; k < 6; ++k) c.add_double(std::strtod(r.text(row, k).c_str(), nullptr));
+    c.add_int(r.integer(row, 6));
+    ++c.rows;
+  }
+  return c;
+}
+
+std::int64_t lite_count(db::Database& d, const std::string& table) {
+  db::Statement st(d, "SELECT count(*) FROM " + table);
+  st.step();
+  return st.column_int(0);
+}
+std::int64_t pg_count(db::PgConnection& pg, const std::string& table, int daemon) {
+  const std::string id = std::to_string(daemon);
+  return pg.query("SELECT count(*) FROM hystlab." + table + " WHERE daemon_id = $1", {id.c_str()}).integer(0, 0);
+}
+
+// A load frame's campaign in a store: a rig, a campaign running, a run with n samples of values
+// no text round-trip could hide (random doubles of every magnitude, a NaN-free set), events.
+struct Filled {
+  std::int64_t rig = 0, campaign = 0, run = 0, seq = 0;
+};
+void add_samples(db::Store& s, Filled& f, int n, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<db::SampleRow> rows;
+  for (int k = 0; k < n; ++k, ++f.seq)
+    rows.push_back({f.run, f.seq, static_cast<double>(f.seq) * 1e-3, u(rng) * 1e-7, u(rng) * 3, u(rng) * 1e5, static_cast<std::int64_t>(f.seq % 7)});
+  s.insert_samples(rows);
+}
+Filled fill(db::Store& s, int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  Filled f;
+  f.rig = s.upsert_rig("frame A", R"({"transport":"modbus-tcp"})", iso(0));
+  f.campaign = s.create_campaign(f.rig, domain::CampaignKind::fot, R"({"kind":"fot","specimen":"SMA spring 7","n":12})", iso(1));
+  s.transition(f.campaign, domain::CampaignState::arming, "operator", iso(2));
+  s.transition(f.campaign, domain::CampaignState::running, "armed", iso(3));
+  f.run = s.add_run(f.campaign, iso(3), 1.8e9, 12.5);
+  add_samples(s, f, n, rng);
+  s.add_fot_node(f.run, 0.5, 0.25, 10.0, 5.0, 1.5);
+  return f;
+}
+
+db::Replicator replicator(const PostgresServer& pg, const std::string& path, const std::string& daemon, std::size_t batch = 5000) {
+  return db::Replicator(path, {"materials-lab", daemon, "test"}, pg.url(), PostgresServer::kPassword, batch);
+}
+int until_caught_up(db::Replicator& r) {
+  for (int k = 0; k < 100; ++k)
+    if (r.pass(4).caught_up) return k + 1;
+  FAIL("not caught up in 100 passes");
+  return 0;
+}
+}  // namespace
+
+TEST_CASE("replication: every row once, samples equal to the bit, changes followed until final; two daemons apart") {
+  PostgresServer server;
+  TempDir dir("replica");
+  db::Store a((dir / "a.db").string()), b((dir / "b.db").string());
+  Filled fa = fill(a, 23456, 1), fb = fill(b, 3000, 2);
+  CHECK(fa.run == fb.run);  // the same local ids in both files: kept apart by daemon_id
+  auto ra = replicator(server, (dir / "a.db").string(), "frame-pc-1");
+  auto rb = replicator(server, (dir / "b.db").string(), "frame-pc-2");
+  CHECK(until_caught_up(ra) >= 2);  // 23456 samples in batches of 5000, 4 to a pass
+  until_caught_up(rb);
+  CHECK(ra.backlog_samples() == 0);
+  CHECK(ra.daemon_id() != rb.daemon_id());
+
+  db::PgConnection pg(server.url(), PostgresServer::kPassword);
+  for (auto [store, rep] : {std::pair{&a, &ra}, std::pair{&b, &rb}}) {
+    const Checksum lite = lite_samples(store->database()), copy = pg_samples(pg, rep->daemon_id());
+    CHECK(copy.rows == lite.rows);
+    CHECK(copy.h == lite.h);
+    for (const char* t : {"rigs", "campaigns", "runs", "events", "fot_nodes"}) {
+      CAPTURE(t);
+      CHECK(pg_count(pg, t, rep->daemon_id()) == lite_count(store->database(), t));
+    }
+  }
+  CHECK(pg.query("SELECT specimen FROM hystlab.lab_campaigns WHERE daemon = 'frame-pc-1'").text(0, 0) == "SMA spring 7");
+
+  // The campaign goes on and ends: new samples, a sweep point whose prediction comes later, the
+  // run ended, the campaign completed, a table stored; all of it followed.
+  std::mt19937_64 rng(3);
+  add_samples(a, fa, 777, rng);
+  const auto point = a.add_transmissibility(fa.run, 20.0, 0.05, 0.1, 2.0, -0.3);
+  ra.pass();
+  a.set_prediction(point, 2.1, -0.31);
+  a.end_run(fa.run, domain::CampaignState::completed, iso(40));
+  a.add_table(fa.campaign, fa.run, "fot", 12, 0, 1, iso(41), R"({"rms_N":0.2})", R"({"n":12})");
+  a.transition(fa.campaign, domain::CampaignState::completed, "done", iso(42));
+  until_caught_up(ra);
+  const std::string id = std::to_string(ra.daemon_id());
+  CHECK(pg.query("SELECT predicted_ratio FROM hystlab.transmissibility WHERE daemon_id = $1", {id.c_str()}).text(0, 0) == "2.1");
+  CHECK_FALSE(pg.query("SELECT ended_at FROM hystlab.runs WHERE daemon_id = $1", {id.c_str()}).is_null(0, 0));
+  CHECK(pg.query("SELECT state FROM hystlab.campaigns WHERE daemon_id = $1", {id.c_str()}).text(0, 0) == "completed");
+  CHECK(pg_count(pg, "tables", ra.daemon_id()) == 1);
+  CHECK(pg_samples(pg, ra.daemon_id()).h == lite_samples(a.database()).h);
+  CHECK(pg_count(pg, "events", ra.daemon_id()) == lite_count(a.database(), "events"));
+  // Nothing left to do: a pass copies no sample and no appended row.
+  CHECK(ra.pass().samples == 0);
+  CHECK(pg_count(pg, "samples", ra.daemon_id()) == 23456 + 777);
+  CHECK(pg_count(pg, "samples", rb.daemon_id()) == 3000);
+}
+
+TEST_CASE("replication: PostgreSQL stopped mid-campaign and started again, or a batch cut off: caught up, nothing lost or doubled") {
+  PostgresServer server;
+  TempDir dir("replica");
+  const std::string path = (dir / "a.db").string();
+  db::Store a(path);
+  Filled f = fill(a, 5000, 4);
+  std::mt19937_64 rng(5);
+  auto r = replicator(server, path, "frame-pc-1", 1000);
+  until_caught_up(r);
+  server.stop();
+  add_samples(a, f, 4321, rng);  // the campaign goes on while the lab database is down
+  a.end_run(f.run, domain::CampaignState::completed, iso(50));
+  a.transition(f.campaign, domain::CampaignState::completed, "done", iso(51));
+  CHECK_THROWS_AS(r.pass(), db::PgError);
+  CHECK_FALSE(r.connected());
+  server.start();
+  until_caught_up(r);
+  db::PgConnection pg(server.url(), PostgresServer::kPassword);
+  CHECK(pg_samples(pg, r.daemon_id()).rows == 9321);
+  CHECK(pg_samples(pg, r.daemon_id()).h == lite_samples(a.database()).h);
+  const std::string id = std::to_string(r.daemon_id());
+  CHECK(pg.query("SELECT state FROM hystlab.campaigns WHERE daemon_id = $1", {id.c_str()}).text(0, 0) == "completed");
+
+  // A batch cut off before its commit (the daemon killed mid-COPY): neither its rows nor its mark
+  // are there, and a new replicator (the daemon restarted) copies it whole, once.
+  add_samples(a, f, 2500, rng);
+  {
+    db::PgConnection cut(server.url(), PostgresServer::kPassword);
+    cut.exec("BEGIN");
+    cut.copy_in("COPY hystlab.samples(daemon_id, run_id, seq, t) FROM STDIN", id + "\t" + std::to_string(f.run) + "\t9321\t9.321\n");
+    cut.exec("INSERT INTO hystlab.marks VALUES(" + id + ", 'samples', " + std::to_string(f.run) + ", 9321) ON CONFLICT (daemon_id, tbl, key) DO UPDATE SET mark = 9321");
+  }  // the connection closes without COMMIT, as a killed process's does
+  auto again = replicator(server, path, "frame-pc-1", 1000);
+  until_caught_up(again);
+  CHECK(again.daemon_id() == r.daemon_id());
+  CHECK(pg_samples(pg, r.daemon_id()).rows == 9321 + 2500);
+  CHECK(pg_samples(pg, r.daemon_id()).h == lite_samples(a.database()).h);
+}
+
+TEST_CASE("replication: a wrong password, no server, a newer schema: one clear error each, nothing written") {
+  PostgresServer server;
+  TempDir dir("replica");
+  const std::string path = (dir / "a.db").string();
+  db::Store a(path);
+  fill(a, 10, 6);
+  db::Replicator wrong(path, {"materials-lab", "frame-pc-1", "test"}, server.url(), "not-the-password");
+  try {
+    wrong.connect();
+    FAIL("connected with a wrong password");
+  } catch (const db::PgError& e) {
+    CHECK(std::string(e.what()).find("password authentication failed for user \"hystlab\"") != std::string::npos);
+    CHECK(std::string(e.what()).find("not-the-password") == std::string::npos);
+    CHECK(e.sqlstate == "28P01");
+  }
+  db::Replicator nobody(path, {"materials-lab", "frame-pc-1", "test"}, "postgresql://hystlab@127.0.0.1:" + std::to_string(test_support::free_port()) + "/lab",
+                        PostgresServer::kPassword);
+  try {
+    nobody.connect();
+    FAIL("connected to no server");
+  } catch (const db::PgError& e) {
+    CHECK(std::string(e.what()).find("cannot connect") != std::string::npos);
+    CHECK(std::string(e.what()).find("Connection refused") != std::string::npos);
+  }
+  db::PgConnection pg(server.url(), PostgresServer::kPassword);
+  db::pg_migrate(pg);
+  pg.exec("INSERT INTO hystlab.schema_version(version) VALUES(99)");
+  auto newer = replicator(server, path, "frame-pc-1");
+  try {
+    newer.connect();
+    FAIL("replicated into a newer schema");
+  } catch (const db::PgSchemaError& e) {
+    CHECK(std::string(e.what()).find("schema version 99, newer than this hystlabd's (1)") != std::string::npos);
+  }
+  CHECK(pg.query("SELECT count(*) FROM hystlab.daemons").integer(0, 0) == 0);
+}
