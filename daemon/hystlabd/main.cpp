@@ -15,6 +15,7 @@
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/daemon/daemon_control.hpp"
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/lab/replication.hpp"
 #include "hystlab/web/http_api.hpp"
 
 namespace {
@@ -84,15 +85,27 @@ int main(int argc, char** argv) {
     hystlab::daemon::check_http_security(cfg.http, std::getenv("HYSTLAB_TOKEN"));
     hystlab::daemon::Daemon daemon(cfg);
     const auto control = hystlab::daemon::make_control(daemon);
+    // The lab (docs/LAB.md): its own threads, which read the daemon only through its interface;
+    // a lab server down or refusing is a status with its reason, never a reason to stop here.
+    hystlab::lab::ReplicationThread replication(*control, cfg.lab, HYSTLAB_VERSION);
+    replication.start();
+    auto lab_counters = [&cfg, &replication] {
+      hystlab::control::LabCounters l;
+      l.lab = cfg.lab.name, l.daemon = cfg.lab.daemon;
+      l.replication = replication.counters();
+      return l;
+    };
     std::unique_ptr<hystlab::web::HttpApi> http;
     try {
-      if (cfg.http.enabled) http = std::make_unique<hystlab::web::HttpApi>(*control, cfg.http);
+      if (cfg.http.enabled)
+        http = std::make_unique<hystlab::web::HttpApi>(*control, cfg.http, cfg.lab.enabled ? hystlab::web::HttpApi::LabSource(lab_counters) : nullptr);
     } catch (const std::runtime_error& e) {  // the port is taken (another daemon?): refused, nothing ran
       std::cerr << "hystlabd: error: " << e.what() << "\n";
       return 2;
     }
     daemon.run(g_stop);
     if (http) http->stop();
+    replication.stop();
     return 0;
   } catch (const hystlab::daemon::ConfigError& e) {
     std::cerr << "hystlabd: error: " << e.what() << "\n";

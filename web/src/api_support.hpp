@@ -59,6 +59,7 @@ struct ApiContext {
   std::atomic<int> stream_clients{0};
   std::atomic<bool> stopping{false};
   std::atomic<std::uint64_t> requests{0};
+  std::function<control::LabCounters()> lab;  // empty: no lab section (HttpApi::LabSource)
   // Every POST route, for requests with no body at all (request_guard.hpp); filled before listening.
   std::vector<std::pair<std::regex, httplib::Server::Handler>> post_routes;
 };

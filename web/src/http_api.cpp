@@ -25,7 +25,7 @@ std::string default_dir(const std::string& configured, const std::string& instal
 }  // namespace
 
 struct HttpApi::Impl {
-  Impl(control::DaemonInterface& d, const control::HttpConfig& cfg) : config(cfg), ctx(d, config, d.db_path()) {}
+  Impl(control::DaemonInterface& d, const control::HttpConfig& cfg, LabSource lab) : config(cfg), ctx(d, config, d.db_path()) { ctx.lab = std::move(lab); }
   control::HttpConfig config;
   ApiContext ctx;
   httplib::Server server;
@@ -33,7 +33,7 @@ struct HttpApi::Impl {
   int port = 0;
 };
 
-HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg) : impl_(std::make_unique<Impl>(d, cfg)) {
+HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg, LabSource lab) : impl_(std::make_unique<Impl>(d, cfg, std::move(lab))) {
   Impl& m = *impl_;
   httplib::Server& s = m.server;
   s.set_tcp_nodelay(true);  // without it every answer waits ~40 ms for the client's delayed ACK

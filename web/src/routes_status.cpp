@@ -56,6 +56,8 @@ void metric(std::string& out, const char* name, const char* type, const char* he
   out += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n";
 }
 
+void lab_metrics(std::string& o, const control::LabCounters& l);
+
 std::string metrics_text(ApiContext& c) {
   const control::DaemonInterface& d = c.daemon;
   std::string o;
@@ -132,7 +134,56 @@ std::string metrics_text(ApiContext& c) {
     line("hystlab_rig_link_losses_total", "rig=\"" + label(d.rig_info(k).name) + "\"", static_cast<double>(d.rig_supervision(k).link_losses));
   metric(o, "hystlab_uptime_seconds", "gauge", "Seconds since the daemon started.");
   line("hystlab_uptime_seconds", "", d.uptime_s());
+  if (c.lab) lab_metrics(o, c.lab());
   return o;
+}
+
+// The lab section of /api/status (docs/LAB.md): replication's backlog and lag, MQTT's link.
+json lab_json(const control::LabCounters& l) {
+  const control::ReplicationCounters& r = l.replication;
+  const control::MqttCounters& m = l.mqtt;
+  auto err = [](const std::string& e) { return e.empty() ? json(nullptr) : json(e); };
+  return {{"name", l.lab},
+          {"daemon", l.daemon},
+          {"postgresql",
+           r.configured ? json{{"connected", r.connected},
+                               {"error", err(r.error)},
+                               {"backlog_samples", r.backlog_samples},
+                               {"lag_s", r.lag_s},
+                               {"samples", r.samples},
+                               {"rows", r.rows},
+                               {"passes", r.passes},
+                               {"failures", r.failures}}
+                        : json(nullptr)},
+          {"mqtt", m.configured ? json{{"connected", m.connected},
+                                       {"error", err(m.error)},
+                                       {"published", m.published},
+                                       {"dropped", m.dropped},
+                                       {"reconnects", m.reconnects}}
+                                : json(nullptr)}};
+}
+
+void lab_metrics(std::string& o, const control::LabCounters& l) {
+  auto line = [&o](const char* name, const char* type, const char* help, const json& v) {
+    metric(o, name, type, help);
+    o += std::string(name) + " " + json(v).dump() + "\n";
+  };
+  if (l.replication.configured) {
+    const control::ReplicationCounters& r = l.replication;
+    line("hystlab_replication_connected", "gauge", "1 while the lab's PostgreSQL takes this daemon's rows.", json(r.connected ? 1 : 0));
+    line("hystlab_replication_backlog_samples", "gauge", "Samples in SQLite not yet in the lab's PostgreSQL.", json(r.backlog_samples));
+    line("hystlab_replication_lag_seconds", "gauge", "Everything SQLite held this long ago is in the lab's PostgreSQL.", r.lag_s);
+    line("hystlab_replication_samples_total", "counter", "Samples copied to the lab's PostgreSQL since start.", json(r.samples));
+    line("hystlab_replication_rows_total", "counter", "Rows of every table copied to the lab's PostgreSQL since start.", json(r.rows));
+    line("hystlab_replication_failures_total", "counter", "Replication passes that failed (the reason: /api/status).", json(r.failures));
+  }
+  if (l.mqtt.configured) {
+    const control::MqttCounters& m = l.mqtt;
+    line("hystlab_mqtt_connected", "gauge", "1 while the lab's MQTT broker is connected.", json(m.connected ? 1 : 0));
+    line("hystlab_mqtt_published_total", "counter", "MQTT messages handed to the broker.", json(m.published));
+    line("hystlab_mqtt_dropped_total", "counter", "MQTT messages dropped (broker down or slow, queue full).", json(m.dropped));
+    line("hystlab_mqtt_reconnects_total", "counter", "Reconnections to the MQTT broker.", json(m.reconnects));
+  }
 }
 
 // /api/status is what monitors poll: served from a snapshot at most 0.25 s old.
@@ -221,7 +272,8 @@ void add_status_routes(httplib::Server& s, ApiContext& c) {
                              {"rigs", rigs},
                              {"campaigns", campaigns_by_state(reader(c.db_path))},
                              {"writer", {{"written", w.written}, {"queue_depth", w.depth}, {"dropped", w.dropped}}},
-                             {"stream_clients", c.stream_clients.load()}}
+                             {"stream_clients", c.stream_clients.load()},
+                             {"lab", c.lab ? lab_json(c.lab()) : json(nullptr)}}
                             .dump();
           cache->at = now;
         }

@@ -3,6 +3,7 @@
 // The HTTP threads reach the daemon only through its interface (snapshots, live samples, plans and
 // commands) and read the database through their own connections: they never touch a rig and
 // never write a sample.
+#include <functional>
 #include <memory>
 
 #include "hystlab/control/daemon_interface.hpp"
@@ -14,7 +15,10 @@ class HttpApi {
  public:
   // Binds http.bind:http.port (port 0: a free one) and starts serving on its own threads.
   // Throws std::runtime_error when the address cannot be bound.
-  HttpApi(control::DaemonInterface& daemon, const control::HttpConfig& config);
+  // lab: what the daemon shares with its lab (replication, MQTT), read for /api/status and
+  // /metrics from the HTTP threads; empty: no lab section.
+  using LabSource = std::function<control::LabCounters()>;
+  HttpApi(control::DaemonInterface& daemon, const control::HttpConfig& config, LabSource lab = {});
   ~HttpApi();  // stop()
   HttpApi(const HttpApi&) = delete;
   HttpApi& operator=(const HttpApi&) = delete;

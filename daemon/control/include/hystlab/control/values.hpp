@@ -111,6 +111,26 @@ struct WriterCounters {
   std::uint64_t written = 0, depth = 0, dropped = 0, commits = 0;
 };
 
+// What a daemon shares with its lab (docs/LAB.md), as /api/status, /metrics and the page show it.
+struct ReplicationCounters {
+  bool configured = false, connected = false;
+  std::string error;                   // the last failure's reason; empty once a pass succeeds
+  std::int64_t backlog_samples = 0;    // samples in SQLite not yet in PostgreSQL
+  std::int64_t samples = 0, rows = 0;  // copied since the daemon started (rows: every table's)
+  double lag_s = 0;                    // everything SQLite held this long ago is in PostgreSQL
+  std::uint64_t passes = 0, failures = 0;
+};
+struct MqttCounters {
+  bool configured = false, connected = false;
+  std::string error;
+  std::uint64_t published = 0, dropped = 0, reconnects = 0;
+};
+struct LabCounters {
+  std::string lab, daemon;  // empty: no "lab" section
+  ReplicationCounters replication;
+  MqttCounters mqtt;
+};
+
 // What a plan will do, before it is submitted.
 struct PlanPreview {
   domain::CampaignKind kind = domain::CampaignKind::fot;

@@ -1,0 +1,170 @@
+// Two hystlabd processes with simulated load frames replicate into one PostgreSQL of the test's
+// own: the lab database is stopped for 30 s mid-campaign (the daemons keep acquiring, the
+// campaigns end while it is down), one daemon is killed with SIGKILL while catching up and
+// restarted; in the end every sample of both is there once, equal to the bit to SQLite's. A
+// wrong password is one clear error in /api/status and the daemon acquires anyway.
+#include <doctest/doctest.h>
+#include <httplib.h>
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "../support/daemon_process.hpp"
+#include "../support/postgres_server.hpp"
+#include "hystlab/db/pg.hpp"
+#include "hystlab/db/sqlite.hpp"
+#include "lab_checksum.hpp"
+
+using namespace hystlab;
+using nlohmann::json;
+using test_support::PostgresServer;
+using test_support::TempDir;
+
+namespace {
+const char* kPlan = R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 6, "ramp_rate_mm_s": 0.1, "sample_rate_hz": 500,
+                        "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 400, "rate_mm_s": 50}})";
+
+template <class F>
+bool eventually(F f, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (f()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  return f();
+}
+
+// A hystlabd of the lab with one simulated load frame; restartable on the same files.
+class LabDaemon {
+ public:
+  LabDaemon(const std::string& name, const PostgresServer& pg, const std::string& password_env) : name_(name) {
+    json cfg = {{"rigs", json::array({{{"name", "sim frame"}, {"simulate", {{"time_scale", 20}, {"noise_N", 0.05}}}}})},
+                {"lab",
+                 {{"name", "materials-lab"},
+                  {"daemon", name},
+                  {"postgresql", pg.url()},
+                  {"postgresql_password_env", password_env},
+                  {"replicate_every_s", 0.2}}}};
+    dir_.write("hystlab.json", cfg.dump());
+    start();
+  }
+  ~LabDaemon() { stop(SIGTERM); }
+  LabDaemon(const LabDaemon&) = delete;
+  LabDaemon& operator=(const LabDaemon&) = delete;
+
+  void start() {
+    const std::string log = (dir_ / ("daemon" + std::to_string(++starts_) + ".log")).string();
+    pid_ = test_support::spawn_logged({HYSTLABD, "--config", (dir_ / "hystlab.json").string(), "--db", db(), "--port", "0"}, log);
+    port_ = test_support::served_port(log);
+    REQUIRE_MESSAGE(port_ != 0, test_support::read_log(log));
+  }
+  void stop(int signal) {
+    if (pid_ <= 0) return;
+    kill(pid_, signal);
+    int st = 0;
+    for (int k = 0; k < 300 && waitpid(pid_, &st, WNOHANG) == 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (waitpid(pid_, &st, WNOHANG) == 0) kill(pid_, SIGKILL), waitpid(pid_, &st, 0);
+    pid_ = -1;
+  }
+  std::string text(const std::string& path) {
+    httplib::Client c("127.0.0.1", port_);
+    const auto r = c.Get(path);
+    REQUIRE(r);
+    return r->body;
+  }
+  json get(const std::string& path) { return json::parse(text(path)); }
+  std::int64_t submit() {
+    httplib::Client c("127.0.0.1", port_);
+    const auto r = c.Post("/api/campaigns", json{{"plan", json::parse(kPlan)}}.dump(), "application/json");
+    REQUIRE(r);
+    REQUIRE_MESSAGE(r->status == 201, r->body);
+    return json::parse(r->body).at("id").get<std::int64_t>();
+  }
+  [[nodiscard]] std::string db() const { return (dir_ / "hystlab.db").string(); }
+  [[nodiscard]] const std::string& name() const { return name_; }
+
+ private:
+  std::string name_;
+  TempDir dir_{"labd"};
+  pid_t pid_ = -1;
+  int port_ = 0, starts_ = 0;
+};
+
+std::string campaign_state(const std::string& db_path, std::int64_t id) {
+  db::Database d(db_path, false);
+  db::Statement st(d, "SELECT state FROM campaigns WHERE id = ?");
+  st.bind(1, id);
+  return st.step() ? st.column_text(0) : "";
+}
+int daemon_id(db::PgConnection& pg, const std::string& name) {
+  const db::PgResult r = pg.query("SELECT id FROM hystlab.daemons WHERE name = $1", {name.c_str()});
+  return r.rows() == 1 ? static_cast<int>(r.integer(0, 0)) : 0;
+}
+// Both sides hold the same samples, campaigns and events.
+bool same(db::PgConnection& pg, const LabDaemon& d) {
+  const int id = daemon_id(pg, d.name());
+  if (id == 0) return false;
+  db::Database lite(d.db(), false);
+  for (const char* t : {"campaigns", "runs", "events", "fot_nodes", "tables"})
+    if (lab_test::lite_count(lite, t) != lab_test::pg_count(pg, t, id)) return false;
+  const lab_test::Checksum a = lab_test::lite_samples(lite), b = lab_test::pg_samples(pg, id);
+  return a.rows > 0 && a.rows == b.rows && a.h == b.h;
+}
+}  // namespace
+
+TEST_CASE("lab: two daemons replicate into one database through a 30 s outage and a kill -9; a wrong password is one clear error") {
+  PostgresServer server;
+  setenv("HYSTLAB_TEST_PG_PASSWORD", PostgresServer::kPassword, 1);
+  setenv("HYSTLAB_TEST_PG_WRONG", "not-the-password", 1);
+  LabDaemon a("frame-pc-1", server, "HYSTLAB_TEST_PG_PASSWORD"), b("frame-pc-2", server, "HYSTLAB_TEST_PG_PASSWORD");
+  const std::int64_t ca = a.submit(), cb = b.submit();
+  REQUIRE(eventually([&] { return a.get("/api/status")["lab"]["postgresql"]["samples"].get<std::int64_t>() > 1000; }, 60));
+  CHECK(a.get("/api/status")["lab"]["postgresql"]["connected"] == true);
+
+  // The lab database goes away for 30 s mid-campaign: the daemons keep acquiring, and say why
+  // nothing is replicated.
+  server.stop();
+  const auto acquired = [](LabDaemon& d) { return d.get("/api/rigs")[0]["samples"].get<std::int64_t>(); };
+  const std::int64_t before = acquired(a);
+  std::this_thread::sleep_for(std::chrono::seconds(30));
+  const json down = a.get("/api/status")["lab"]["postgresql"];
+  CHECK(down["connected"] == false);
+  CHECK(down["error"].get<std::string>().find("PostgreSQL") != std::string::npos);
+  CHECK(down["lag_s"].get<double>() > 20);
+  CHECK(acquired(a) > before);  // acquisition went on
+  server.start();
+
+  // Killed while catching up, restarted on the same files: it resumes from PostgreSQL's marks.
+  REQUIRE(eventually([&] { return a.get("/api/status")["lab"]["postgresql"]["connected"] == true; }, 30));
+  a.stop(SIGKILL);
+  a.start();
+  db::PgConnection pg(server.url(), PostgresServer::kPassword);
+  REQUIRE(eventually([&] { return campaign_state(b.db(), cb) == "completed"; }, 120));
+  CHECK(eventually([&] { return same(pg, b); }, 30));
+  // Daemon a's campaign was interrupted by the kill: it is final there, and so here.
+  CHECK(eventually([&] { return same(pg, a); }, 30));
+  const std::string ida = std::to_string(daemon_id(pg, "frame-pc-1"));
+  CHECK(eventually(
+      [&] {
+        const db::PgResult r = pg.query("SELECT state FROM hystlab.campaigns WHERE daemon_id = $1 AND id = $2", {ida.c_str(), std::to_string(ca).c_str()});
+        return r.rows() == 1 && r.text(0, 0) == campaign_state(a.db(), ca);
+      },
+      30));
+  CHECK(a.get("/api/status")["lab"]["postgresql"]["backlog_samples"] == 0);
+  const std::string metrics = a.text("/metrics");
+  CHECK(metrics.find("hystlab_replication_backlog_samples 0\n") != std::string::npos);
+  CHECK(metrics.find("hystlab_replication_connected 1\n") != std::string::npos);
+
+  // A wrong password: one clear error, and the daemon acquires anyway.
+  LabDaemon wrong("frame-pc-3", server, "HYSTLAB_TEST_PG_WRONG");
+  wrong.submit();
+  REQUIRE(eventually([&] { return !wrong.get("/api/status")["lab"]["postgresql"]["error"].is_null(); }, 30));
+  const std::string why = wrong.get("/api/status")["lab"]["postgresql"]["error"];
+  CHECK(why.find("password authentication failed for user \"hystlab\"") != std::string::npos);
+  CHECK(why.find("not-the-password") == std::string::npos);
+  CHECK(eventually([&] { return acquired(wrong) > 500; }, 30));
+  CHECK(daemon_id(pg, "frame-pc-3") == 0);
+}
