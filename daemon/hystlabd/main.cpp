@@ -15,6 +15,7 @@
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/daemon/daemon_control.hpp"
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/lab/mqtt_publisher.hpp"
 #include "hystlab/web/http_api.hpp"
 
 namespace {
@@ -91,7 +92,15 @@ int main(int argc, char** argv) {
       std::cerr << "hystlabd: error: " << e.what() << "\n";
       return 2;
     }
+    // Every rig live over the lab's MQTT broker (docs/LAB.md): a thread of its own, started once
+    // the daemon is built; an unreachable broker only makes it retry, never stops the daemon.
+    std::unique_ptr<hystlab::lab::MqttPublisher> mqtt;
+    if (cfg.lab.has_mqtt) {
+      mqtt = std::make_unique<hystlab::lab::MqttPublisher>(*control, cfg.lab, control->db_path());
+      mqtt->start();
+    }
     daemon.run(g_stop);
+    if (mqtt) mqtt->stop();  // "offline", retained, before the process goes
     if (http) http->stop();
     return 0;
   } catch (const hystlab::daemon::ConfigError& e) {
