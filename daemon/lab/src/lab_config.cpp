@@ -93,6 +93,13 @@ MqttSettings parse_mqtt(const json& m, const std::string& base_dir, const char* 
   s.password = secret(m, "password", "mqtt.", base_dir, env);
   if (!s.password.empty() && s.username.empty()) fail("mqtt.username", "is missing: a password was given without a user name");
   if (s.cert_file.empty() != s.key_file.empty()) fail(s.cert_file.empty() ? "mqtt.cert_file" : "mqtt.key_file", "is missing: a client certificate needs both");
+  // TLS is on when ca_file is set; a client certificate without it would be silently unused.
+  if (!s.cert_file.empty() && s.ca_file.empty())
+    fail("mqtt.cert_file", "is given without lab.mqtt.ca_file: TLS needs the CA that signed the broker's certificate");
+  // Read now, not at the first connection: a wrong path is a config error at start, not a
+  // publisher that retries for ever.
+  for (const auto& [field, file] : {std::pair{"ca_file", &s.ca_file}, {"cert_file", &s.cert_file}, {"key_file", &s.key_file}})
+    if (!file->empty() && !std::ifstream(*file)) fail(std::string("mqtt.") + field, "names '" + *file + "', which cannot be read");
   return s;
 }
 }  // namespace

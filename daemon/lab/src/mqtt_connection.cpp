@@ -76,8 +76,9 @@ void MqttConnection::disconnect() noexcept { (void)mosquitto_disconnect(m_); }
 bool MqttConnection::wants_write() const noexcept { return mosquitto_want_write(m_); }
 
 std::string MqttConnection::error_text(int rc) const {
-  if (rc == MOSQ_ERR_ERRNO) return std::strerror(errno_);
-  return mosquitto_strerror(rc);
+  std::string s = rc == MOSQ_ERR_ERRNO ? std::strerror(errno_) : mosquitto_strerror(rc);
+  while (!s.empty() && s.back() == '.') s.pop_back();  // "...: The connection was lost; retrying"
+  return s;
 }
 
 std::string MqttConnection::connack_text(int rc) { return mosquitto_connack_string(rc); }
