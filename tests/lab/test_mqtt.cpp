@@ -68,22 +68,28 @@ TEST_CASE("a bad lab.mqtt config is one clear error naming the field") {
   CHECK(error_of({{"host", "broker.lab"}}) == "no error");
 }
 
-TEST_CASE("state and online are retained for a later subscriber; every live batch of a run arrives in order; events and changes follow") {
-  TempDir dir("mqtt");
+// A broker, a fake daemon with two rigs (one name to escape) and a publisher, connected.
+struct Running {
+  TempDir dir{"mqtt"};
   MosquittoBroker broker;
-  FakeDaemon fake({"frame/1 #a", "shaker"}, make_store(dir));
-  lab::MqttPublisher pub(fake, lab_for(broker.port()), fake.db_path());
-  pub.start();
-  REQUIRE(wait_until([&] { return pub.status().connected && pub.status().published >= 3; }, 10));
+  FakeDaemon fake{{"frame/1 #a", "shaker"}, make_store(dir)};
+  lab::MqttPublisher pub{fake, lab_for(broker.port()), fake.db_path()};
+  Running() {
+    pub.start();
+    REQUIRE(wait_until([&] { return pub.status().connected && pub.status().published >= 3; }, 10));
+  }
+};
 
-  // A subscriber that comes later still sees the retained documents.
-  Subscriber later(broker.port(), {kPrefix + "/status", kPrefix + "/+/state"});
+TEST_CASE("state and online are retained for a subscriber that comes later; a clean stop says offline itself") {
+  Running r;
+  Subscriber later(r.broker.port(), {kPrefix + "/status", kPrefix + "/+/state"});
   REQUIRE(wait_until([&] { return later.on(kFrame + "/state").size() == 1 && later.on(kPrefix + "/status").size() == 1; }, 10));
   CHECK(later.on(kFrame + "/state")[0].retained);
   const json state = last_json(later.on(kFrame + "/state"));
   CHECK(state["rig"] == "frame/1 #a");
   CHECK(state["state"] == "idle");
   CHECK(state["latched"] == false);
+  CHECK(state["campaign"].is_null());
   const json online = last_json(later.on(kPrefix + "/status"));
   CHECK(later.on(kPrefix + "/status")[0].retained);
   CHECK(online["state"] == "online");
@@ -91,19 +97,39 @@ TEST_CASE("state and online are retained for a later subscriber; every live batc
   CHECK(online["rigs"] == json::array({"frame/1 #a", "shaker"}));
   CHECK(later.on(kPrefix + "/shaker/state").size() == 1);
 
-  // A run of about 1.5 s: every batch, seq consecutive, samples contiguous in index and time.
-  Subscriber live(broker.port(), {kFrame + "/live", kFrame + "/event", kFrame + "/state"});
+  r.pub.stop();  // no will: the client said DISCONNECT, after its own "offline"
+  Subscriber after(r.broker.port(), {kPrefix + "/status"});
+  REQUIRE(wait_until([&] { return !after.on(kPrefix + "/status").empty(); }, 10));
+  CHECK(after.on(kPrefix + "/status")[0].retained);
+  CHECK(last_json(after.on(kPrefix + "/status"))["state"] == "offline");
+  CHECK(last_json(after.on(kPrefix + "/status"))["reason"] == "stopped");
+  CHECK(!r.pub.status().connected);
+  CHECK(r.pub.status().dropped == 0);
+}
+
+// The batches of run 42 the subscriber saw.
+std::vector<json> batches_of_run(const Subscriber& s, int run) {
+  std::vector<json> out;
+  for (const auto& m : s.on(kFrame + "/live"))
+    if (json b = json::parse(m.payload); b["run"] == run) out.push_back(b);
+  return out;
+}
+
+TEST_CASE("a subscriber receives every live batch of a run in order, samples contiguous; the state follows the run and the latch") {
+  Running r;
+  Subscriber live(r.broker.port(), {kFrame + "/live", kFrame + "/state"});
   REQUIRE(wait_until([&] { return !live.on(kFrame + "/state").empty(); }, 10));  // subscribed
-  fake.set_state("running", false, 7, 42);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the run's length, not an assertion
-  fake.set_state("estopped", true);
+  r.fake.set_state("running", false, 7, 42);
+  REQUIRE(wait_until([&] { return last_json(live.on(kFrame + "/state"))["state"] == "running"; }, 10));
+  const json running = last_json(live.on(kFrame + "/state"));
+  CHECK(running["campaign"]["id"] == 7);
+  CHECK(running["campaign"]["run"] == 42);
+  REQUIRE(wait_until([&] { return batches_of_run(live, 42).size() >= 20; }, 20));  // 20 a second: about 1 s
+  r.fake.set_state("estopped", true);
   REQUIRE(wait_until([&] { return last_json(live.on(kFrame + "/state"))["latched"] == true; }, 10));
-  std::vector<json> batches;
-  for (const auto& m : live.on(kFrame + "/live")) {
-    json b = json::parse(m.payload);
-    if (b["run"] == 42) batches.push_back(b);
-  }
-  REQUIRE(batches.size() >= 10);  // 20 a second
+  CHECK(last_json(live.on(kFrame + "/state"))["latch_reason"] == "operator e-stop");
+
+  const std::vector<json> batches = batches_of_run(live, 42);
   std::uint64_t samples = 0;
   for (std::size_t k = 0; k < batches.size(); ++k) {
     const json& b = batches[k];
@@ -116,42 +142,32 @@ TEST_CASE("state and online are retained for a later subscriber; every live batc
     CHECK(b["seq"].get<std::uint64_t>() == batches[k - 1]["seq"].get<std::uint64_t>() + 1);
     CHECK(first == batches[k - 1]["first"].get<std::uint64_t>() + batches[k - 1]["samples"].size());
   }
-  CHECK(samples >= 1000);
-  const json running = [&] {
-    for (const auto& m : live.on(kFrame + "/state"))
-      if (json::parse(m.payload)["state"] == "running") return json::parse(m.payload);
-    return json();
-  }();
-  REQUIRE(running.is_object());
-  CHECK(running["campaign"]["id"] == 7);
-  CHECK(running["campaign"]["run"] == 42);
+  CHECK(samples >= 900);
+}
 
-  // An event row of a campaign on this rig, on the rig's event topic with its id.
+TEST_CASE("the events table's new rows reach the rig's event topic, in id order") {
+  Running r;
+  Subscriber events(r.broker.port(), {kFrame + "/event", kPrefix + "/status"});
+  REQUIRE(wait_until([&] { return !events.on(kPrefix + "/status").empty(); }, 10));  // subscribed
   {
-    db::Store s(fake.db_path());
+    db::Store s(r.fake.db_path());
     const auto campaign = s.create_campaign(s.upsert_rig("frame/1 #a", "{}", "t"), domain::CampaignKind::fot, "{}", "t");
     s.add_event(campaign, domain::RecordEvent{"S-1", "seated"}, "2026-01-01T00:00:00.000Z");
   }
-  REQUIRE(wait_until([&] { return live.on(kFrame + "/event").size() >= 2; }, 10));
-  const auto events = live.on(kFrame + "/event");
-  CHECK(json::parse(events[0].payload)["kind"] == "state");
-  CHECK(json::parse(events[0].payload)["to"] == "queued");
-  CHECK(json::parse(events[1].payload)["kind"] == "record");
-  CHECK(json::parse(events[1].payload)["id"].get<std::int64_t>() > json::parse(events[0].payload)["id"].get<std::int64_t>());
-
-  // A clean stop says offline itself (no will: the client said DISCONNECT).
-  pub.stop();
-  Subscriber after(broker.port(), {kPrefix + "/status"});
-  REQUIRE(wait_until([&] { return !after.on(kPrefix + "/status").empty(); }, 10));
-  CHECK(last_json(after.on(kPrefix + "/status"))["state"] == "offline");
-  CHECK(last_json(after.on(kPrefix + "/status"))["reason"] == "stopped");
-  CHECK(pub.status().dropped == 0);
+  REQUIRE(wait_until([&] { return events.on(kFrame + "/event").size() >= 2; }, 10));
+  const json submitted = json::parse(events.on(kFrame + "/event")[0].payload), record = json::parse(events.on(kFrame + "/event")[1].payload);
+  CHECK(submitted["kind"] == "state");
+  CHECK(submitted["to"] == "queued");
+  CHECK(submitted["rig"] == "frame/1 #a");
+  CHECK(record["kind"] == "record");
+  CHECK(record["detail"]["specimen"] == "S-1");
+  CHECK(record["id"].get<std::int64_t>() > submitted["id"].get<std::int64_t>());
 }
 
 TEST_CASE("a broker stopped and started again: drops counted, reconnected, state and online published again, the reads kept their pace") {
   TempDir dir("mqtt");
   MosquittoBroker broker;
-  FakeDaemon fake({"frame/1 #a"}, make_store(dir));
+  FakeDaemon fake({"frame/1 #a", "shaker"}, make_store(dir));
   lab::LabConfig cfg = lab_for(broker.port());
   cfg.mqtt.queue_limit = 10;  // half a second of live batches
   lab::MqttPublisher pub(fake, cfg, fake.db_path());
@@ -172,11 +188,13 @@ TEST_CASE("a broker stopped and started again: drops counted, reconnected, state
 
   broker.start();
   REQUIRE(wait_until([&] { return pub.status().connected && pub.status().reconnects == 1; }, 15));
-  Subscriber fresh(broker.port(), {kPrefix + "/status", kFrame + "/state"});
-  // The broker lost every retained message (no persistence): these are the publisher's again.
+  Subscriber fresh(broker.port(), {kPrefix + "/status", kPrefix + "/+/state"});
+  // The broker lost every retained message (no persistence): these are the publisher's again,
+  // the unchanged shaker's state too.
   REQUIRE(wait_until([&] { return !fresh.on(kPrefix + "/status").empty() && !fresh.on(kFrame + "/state").empty(); }, 10));
   CHECK(last_json(fresh.on(kPrefix + "/status"))["state"] == "online");
   CHECK(last_json(fresh.on(kFrame + "/state"))["latched"] == true);
+  CHECK(wait_until([&] { return !fresh.on(kPrefix + "/shaker/state").empty(); }, 5));
   // The publisher read the live ring at its pace all along (20 a second), and lost nothing of it.
   CHECK(fake.max_read_gap_s() < 0.5);
   CHECK(pub.status().lost_samples == 0);

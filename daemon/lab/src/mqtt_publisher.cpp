@@ -349,6 +349,7 @@ void MqttPublisher::Impl::run() noexcept {
     }
   }
   say_offline();
+  link = Link::down;  // a later start() connects afresh
   try {
     with_status([](MqttStatus& s) { s.connected = false; });
   } catch (...) {
