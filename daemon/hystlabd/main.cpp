@@ -15,6 +15,7 @@
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/daemon/daemon_control.hpp"
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/lab/mqtt_publisher.hpp"
 #include "hystlab/lab/replication.hpp"
 #include "hystlab/web/http_api.hpp"
 
@@ -89,10 +90,14 @@ int main(int argc, char** argv) {
     // a lab server down or refusing is a status with its reason, never a reason to stop here.
     hystlab::lab::ReplicationThread replication(*control, cfg.lab, HYSTLAB_VERSION);
     replication.start();
-    auto lab_counters = [&cfg, &replication] {
+    // Every rig live over the lab's MQTT broker: an unreachable broker only makes it retry.
+    std::unique_ptr<hystlab::lab::MqttPublisher> mqtt;
+    if (cfg.lab.has_mqtt) mqtt = std::make_unique<hystlab::lab::MqttPublisher>(*control, cfg.lab, control->db_path());
+    auto lab_counters = [&cfg, &replication, &mqtt] {
       hystlab::control::LabCounters l;
       l.lab = cfg.lab.name, l.daemon = cfg.lab.daemon;
       l.replication = replication.counters();
+      if (mqtt) l.mqtt = hystlab::lab::counters_of(mqtt->status());
       return l;
     };
     std::unique_ptr<hystlab::web::HttpApi> http;
@@ -103,7 +108,9 @@ int main(int argc, char** argv) {
       std::cerr << "hystlabd: error: " << e.what() << "\n";
       return 2;
     }
+    if (mqtt) mqtt->start();
     daemon.run(g_stop);
+    if (mqtt) mqtt->stop();  // "offline", retained, before the process goes
     if (http) http->stop();
     replication.stop();
     return 0;

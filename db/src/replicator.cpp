@@ -31,8 +31,8 @@ constexpr Spec kSweepPoints{"transmissibility",
 constexpr Spec kLoops{"loops", "run_id, k, phase, figures", "run_id, k"};
 constexpr Spec kSamples[] = {
     {"samples", "seq, t, cmd, disp, force, status", "seq"},
-    {"shaker_samples",
-     "seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, mass_displacement_mm, base_accel_m_s2, mass_accel_m_s2, status", "seq"},
+    {"shaker_samples", "seq, t, drive_frequency_hz, drive_amplitude_mm, base_displacement_mm, mass_displacement_mm, base_accel_m_s2, mass_accel_m_s2, status",
+     "seq"},
 };
 // Campaigns in these states never change again; any other is read again every pass.
 constexpr const char* kOpenCampaigns = "SELECT id FROM hystlab.campaigns WHERE daemon_id = $1 AND state NOT IN ('completed', 'aborted', 'failed')";
@@ -49,10 +49,17 @@ void encode_row(const Statement& st, int columns, std::string& out) {
   for (int c = 0; c < columns; ++c) {
     out += '\t';
     switch (st.column_type(c)) {
-      case Statement::Type::integer: append_int(out, st.column_int(c)); break;
-      case Statement::Type::real: append_copy_double(out, st.column_double(c)); break;
-      case Statement::Type::text: append_copy_text(out, st.column_view(c)); break;
-      default: out += "\\N";  // NULL (and a BLOB, which no replicated column holds)
+      case Statement::Type::integer:
+        append_int(out, st.column_int(c));
+        break;
+      case Statement::Type::real:
+        append_copy_double(out, st.column_double(c));
+        break;
+      case Statement::Type::text:
+        append_copy_text(out, st.column_view(c));
+        break;
+      default:
+        out += "\\N";  // NULL (and a BLOB, which no replicated column holds)
     }
   }
   out += '\n';
@@ -241,8 +248,7 @@ std::vector<std::int64_t> Replicator::upsert(const Spec& s, const std::string& w
   }
   if (seen.empty()) return seen;
   const std::string temp = std::string("up_") + s.name;
-  if (temp_tables_.insert(temp).second)
-    pg_->exec("CREATE TEMP TABLE IF NOT EXISTS " + temp + " (LIKE hystlab." + s.name + ") ON COMMIT DELETE ROWS");
+  if (temp_tables_.insert(temp).second) pg_->exec("CREATE TEMP TABLE IF NOT EXISTS " + temp + " (LIKE hystlab." + s.name + ") ON COMMIT DELETE ROWS");
   PgTransaction tx(*pg_);
   pg_->copy_in("COPY " + temp + "(daemon_id, " + s.columns + ") FROM STDIN", buf_);
   pg_->exec("INSERT INTO hystlab." + std::string(s.name) + " SELECT * FROM " + temp + " ON CONFLICT (daemon_id, " + s.key + ") DO UPDATE SET " +

@@ -80,11 +80,16 @@ std::int64_t Statement::column_int(int c) const { return sqlite3_column_int64(st
 double Statement::column_double(int c) const { return sqlite3_column_double(st_, c); }
 Statement::Type Statement::column_type(int c) const noexcept {
   switch (sqlite3_column_type(st_, c)) {
-    case SQLITE_INTEGER: return Type::integer;
-    case SQLITE_FLOAT: return Type::real;
-    case SQLITE_TEXT: return Type::text;
-    case SQLITE_BLOB: return Type::blob;
-    default: return Type::null;
+    case SQLITE_INTEGER:
+      return Type::integer;
+    case SQLITE_FLOAT:
+      return Type::real;
+    case SQLITE_TEXT:
+      return Type::text;
+    case SQLITE_BLOB:
+      return Type::blob;
+    default:
+      return Type::null;
   }
 }
 std::string_view Statement::column_view(int c) const {

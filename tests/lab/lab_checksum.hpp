@@ -36,7 +36,8 @@ inline Checksum lite_samples(db::Database& d) {
 inline Checksum pg_samples(db::PgConnection& pg, int daemon) {
   Checksum c;
   const std::string id = std::to_string(daemon);
-  const db::PgResult r = pg.query("SELECT run_id, seq, t, cmd, disp, force, status FROM hystlab.samples WHERE daemon_id = $1 ORDER BY run_id, seq", {id.c_str()});
+  const db::PgResult r =
+      pg.query("SELECT run_id, seq, t, cmd, disp, force, status FROM hystlab.samples WHERE daemon_id = $1 ORDER BY run_id, seq", {id.c_str()});
   for (int row = 0; row < r.rows(); ++row) {
     c.add_int(r.integer(row, 0)), c.add_int(r.integer(row, 1));
     for (int k = 2; k < 6; ++k) c.add_double(std::strtod(r.text(row, k).c_str(), nullptr));

@@ -27,27 +27,16 @@ namespace {
 const char* kPlan = R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 6, "ramp_rate_mm_s": 0.1, "sample_rate_hz": 500,
                         "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 400, "rate_mm_s": 50}})";
 
-template <class F>
-bool eventually(F f, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) {
-    if (f()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  }
-  return f();
-}
+using test_support::wait_until;
 
 // A hystlabd of the lab with one simulated load frame; restartable on the same files.
 class LabDaemon {
  public:
   LabDaemon(const std::string& name, const PostgresServer& pg, const std::string& password_env) : name_(name) {
-    json cfg = {{"rigs", json::array({{{"name", "sim frame"}, {"simulate", {{"time_scale", 20}, {"noise_N", 0.05}}}}})},
-                {"lab",
-                 {{"name", "materials-lab"},
-                  {"daemon", name},
-                  {"postgresql", pg.url()},
-                  {"postgresql_password_env", password_env},
-                  {"replicate_every_s", 0.2}}}};
+    json cfg = {
+        {"rigs", json::array({{{"name", "sim frame"}, {"simulate", {{"time_scale", 20}, {"noise_N", 0.05}}}}})},
+        {"lab",
+         {{"name", "materials-lab"}, {"daemon", name}, {"postgresql", pg.url()}, {"postgresql_password_env", password_env}, {"replicate_every_s", 0.2}}}};
     dir_.write("hystlab.json", cfg.dump());
     start();
   }
@@ -121,7 +110,7 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   setenv("HYSTLAB_TEST_PG_WRONG", "not-the-password", 1);
   LabDaemon a("frame-pc-1", server, "HYSTLAB_TEST_PG_PASSWORD"), b("frame-pc-2", server, "HYSTLAB_TEST_PG_PASSWORD");
   const std::int64_t ca = a.submit(), cb = b.submit();
-  REQUIRE(eventually([&] { return a.get("/api/status")["lab"]["postgresql"]["samples"].get<std::int64_t>() > 1000; }, 60));
+  REQUIRE(wait_until([&] { return a.get("/api/status")["lab"]["postgresql"]["samples"].get<std::int64_t>() > 1000; }, 60));
   CHECK(a.get("/api/status")["lab"]["postgresql"]["connected"] == true);
 
   // The lab database goes away for 30 s mid-campaign: the daemons keep acquiring, and say why
@@ -138,16 +127,16 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   server.start();
 
   // Killed while catching up, restarted on the same files: it resumes from PostgreSQL's marks.
-  REQUIRE(eventually([&] { return a.get("/api/status")["lab"]["postgresql"]["connected"] == true; }, 30));
+  REQUIRE(wait_until([&] { return a.get("/api/status")["lab"]["postgresql"]["connected"] == true; }, 30));
   a.stop(SIGKILL);
   a.start();
   db::PgConnection pg(server.url(), PostgresServer::kPassword);
-  REQUIRE(eventually([&] { return campaign_state(b.db(), cb) == "completed"; }, 120));
-  CHECK(eventually([&] { return same(pg, b); }, 30));
+  REQUIRE(wait_until([&] { return campaign_state(b.db(), cb) == "completed"; }, 120));
+  CHECK(wait_until([&] { return same(pg, b); }, 30));
   // Daemon a's campaign was interrupted by the kill: it is final there, and so here.
-  CHECK(eventually([&] { return same(pg, a); }, 30));
+  CHECK(wait_until([&] { return same(pg, a); }, 30));
   const std::string ida = std::to_string(daemon_id(pg, "frame-pc-1"));
-  CHECK(eventually(
+  CHECK(wait_until(
       [&] {
         const db::PgResult r = pg.query("SELECT state FROM hystlab.campaigns WHERE daemon_id = $1 AND id = $2", {ida.c_str(), std::to_string(ca).c_str()});
         return r.rows() == 1 && r.text(0, 0) == campaign_state(a.db(), ca);
@@ -161,10 +150,10 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   // A wrong password: one clear error, and the daemon acquires anyway.
   LabDaemon wrong("frame-pc-3", server, "HYSTLAB_TEST_PG_WRONG");
   wrong.submit();
-  REQUIRE(eventually([&] { return !wrong.get("/api/status")["lab"]["postgresql"]["error"].is_null(); }, 30));
+  REQUIRE(wait_until([&] { return !wrong.get("/api/status")["lab"]["postgresql"]["error"].is_null(); }, 30));
   const std::string why = wrong.get("/api/status")["lab"]["postgresql"]["error"];
   CHECK(why.find("password authentication failed for user \"hystlab\"") != std::string::npos);
   CHECK(why.find("not-the-password") == std::string::npos);
-  CHECK(eventually([&] { return acquired(wrong) > 500; }, 30));
+  CHECK(wait_until([&] { return acquired(wrong) > 500; }, 30));
   CHECK(daemon_id(pg, "frame-pc-3") == 0);
 }

@@ -14,13 +14,13 @@
 #include "lab_checksum.hpp"
 
 using namespace hystlab;
-using test_support::PostgresServer;
-using test_support::TempDir;
+using lab_test::Checksum;
 using lab_test::lite_count;
 using lab_test::lite_samples;
 using lab_test::pg_count;
 using lab_test::pg_samples;
-using lab_test::Checksum;
+using test_support::PostgresServer;
+using test_support::TempDir;
 
 namespace {
 std::string iso(int k) { return "2026-11-28T01:00:" + std::string(k < 10 ? "0" : "") + std::to_string(k) + ".000Z"; }
@@ -140,7 +140,8 @@ TEST_CASE("replication: PostgreSQL stopped mid-campaign and started again, or a 
     db::PgConnection cut(server.url(), PostgresServer::kPassword);
     cut.exec("BEGIN");
     cut.copy_in("COPY hystlab.samples(daemon_id, run_id, seq, t) FROM STDIN", id + "\t" + std::to_string(f.run) + "\t9321\t9.321\n");
-    cut.exec("INSERT INTO hystlab.marks VALUES(" + id + ", 'samples', " + std::to_string(f.run) + ", 9321) ON CONFLICT (daemon_id, tbl, key) DO UPDATE SET mark = 9321");
+    cut.exec("INSERT INTO hystlab.marks VALUES(" + id + ", 'samples', " + std::to_string(f.run) +
+             ", 9321) ON CONFLICT (daemon_id, tbl, key) DO UPDATE SET mark = 9321");
   }  // the connection closes without COMMIT, as a killed process's does
   auto again = replicator(server, path, "frame-pc-1", 1000);
   until_caught_up(again);

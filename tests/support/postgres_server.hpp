@@ -20,30 +20,6 @@
 
 namespace hystlab::test_support {
 
-// A port nothing listens on now (bound and released: another process could take it in between).
-inline int free_port() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  socklen_t len = sizeof a;
-  if (::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 || ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-    ::close(s);
-    throw std::runtime_error("no free port");
-  }
-  ::close(s);
-  return ntohs(a.sin_port);
-}
-
-// Runs args to its end, output into log; returns its exit status (-1: killed by a signal).
-inline int run_logged(const std::vector<std::string>& args, const std::string& log) {
-  const pid_t pid = spawn_logged(args, log);
-  int status = 0;
-  if (::waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
-  return WEXITSTATUS(status);
-}
-
 inline std::string postgres_bindir() {
   for (const int v : {17, 16, 15, 14, 13})
     if (const std::string d = "/usr/lib/postgresql/" + std::to_string(v) + "/bin"; std::filesystem::exists(d + "/initdb")) return d;
@@ -67,14 +43,15 @@ class PostgresServer {
         if (::chown(p.c_str(), pw->pw_uid, pw->pw_gid) != 0) throw std::runtime_error("cannot give " + p + " to nobody");
       ::chmod(data_.c_str(), 0700);
     }
-    const int rc = run(
-        {bin_ + "/initdb", "-D", data_, "-U", kUser, "--pwfile=" + (dir_ / "pwfile").string(), "--auth=scram-sha-256", "-E", "UTF8", "--no-sync"},
-        "initdb.log");
+    const int rc =
+        run({bin_ + "/initdb", "-D", data_, "-U", kUser, "--pwfile=" + (dir_ / "pwfile").string(), "--auth=scram-sha-256", "-E", "UTF8", "--no-sync"},
+            "initdb.log");
     if (rc != 0) throw std::runtime_error("initdb failed: " + read_log((dir_ / "initdb.log").string()));
     start();
     // The lab's database, as a lab's administrator would make it.
-    const int c = run({"/usr/bin/env", "PGPASSWORD=" + std::string(kPassword), bin_ + "/createdb", "-h", "127.0.0.1", "-p", std::to_string(port_), "-U", kUser, "lab"},
-                      "createdb.log");
+    const int c =
+        run({"/usr/bin/env", "PGPASSWORD=" + std::string(kPassword), bin_ + "/createdb", "-h", "127.0.0.1", "-p", std::to_string(port_), "-U", kUser, "lab"},
+            "createdb.log");
     if (c != 0) throw std::runtime_error("createdb failed: " + read_log((dir_ / "createdb.log").string()));
   }
   ~PostgresServer() { run({bin_ + "/pg_ctl", "-D", data_, "-m", "immediate", "-w", "stop"}, "stop.log"); }
@@ -83,8 +60,8 @@ class PostgresServer {
 
   void start() {
     // The log and the socket in the data folder: the only one the server's user may write to.
-    const std::string opts = "-p " + std::to_string(port_) + " -k " + data_ +
-                             " -c listen_addresses=127.0.0.1 -c fsync=off -c synchronous_commit=off -c full_page_writes=off";
+    const std::string opts =
+        "-p " + std::to_string(port_) + " -k " + data_ + " -c listen_addresses=127.0.0.1 -c fsync=off -c synchronous_commit=off -c full_page_writes=off";
     if (run({bin_ + "/pg_ctl", "-D", data_, "-l", data_ + "/server.log", "-w", "-t", "60", "-o", opts, "start"}, "start.log") != 0)
       throw std::runtime_error("pg_ctl start failed: " + read_log((dir_ / "start.log").string()) + read_log(data_ + "/server.log"));
   }

@@ -143,24 +143,21 @@ json lab_json(const control::LabCounters& l) {
   const control::ReplicationCounters& r = l.replication;
   const control::MqttCounters& m = l.mqtt;
   auto err = [](const std::string& e) { return e.empty() ? json(nullptr) : json(e); };
-  return {{"name", l.lab},
-          {"daemon", l.daemon},
-          {"postgresql",
-           r.configured ? json{{"connected", r.connected},
-                               {"error", err(r.error)},
-                               {"backlog_samples", r.backlog_samples},
-                               {"lag_s", r.lag_s},
-                               {"samples", r.samples},
-                               {"rows", r.rows},
-                               {"passes", r.passes},
-                               {"failures", r.failures}}
-                        : json(nullptr)},
-          {"mqtt", m.configured ? json{{"connected", m.connected},
-                                       {"error", err(m.error)},
-                                       {"published", m.published},
-                                       {"dropped", m.dropped},
-                                       {"reconnects", m.reconnects}}
-                                : json(nullptr)}};
+  return {
+      {"name", l.lab},
+      {"daemon", l.daemon},
+      {"postgresql", r.configured ? json{{"connected", r.connected},
+                                         {"error", err(r.error)},
+                                         {"backlog_samples", r.backlog_samples},
+                                         {"lag_s", r.lag_s},
+                                         {"samples", r.samples},
+                                         {"rows", r.rows},
+                                         {"passes", r.passes},
+                                         {"failures", r.failures}}
+                                  : json(nullptr)},
+      {"mqtt", m.configured
+                   ? json{{"connected", m.connected}, {"error", err(m.error)}, {"published", m.published}, {"dropped", m.dropped}, {"reconnects", m.reconnects}}
+                   : json(nullptr)}};
 }
 
 void lab_metrics(std::string& o, const control::LabCounters& l) {

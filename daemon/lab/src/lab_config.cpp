@@ -20,8 +20,7 @@ std::string text(const json& v, const std::string& where) {
 const char* real_env(const char* name) { return std::getenv(name); }
 
 // A password named by a file (its first line) or an environment variable: never the JSON itself.
-std::string secret(const json& section, const std::string& prefix, const std::string& where, const std::string& base_dir,
-                   const char* (*env)(const char*)) {
+std::string secret(const json& section, const std::string& prefix, const std::string& where, const std::string& base_dir, const char* (*env)(const char*)) {
   const std::string file_key = prefix + "_file", env_key = prefix + "_env";
   if (section.contains(file_key) && section.contains(env_key)) fail(where + file_key, "and " + env_key + " name two passwords: give one");
   if (section.contains(file_key)) {
@@ -68,9 +67,13 @@ MqttSettings parse_mqtt(const json& m, const std::string& base_dir, const char* 
     const std::string where = "mqtt." + k;
     if (k == "host" || k == "client_id" || k == "username" || k == "ca_file" || k == "cert_file" || k == "key_file") {
       std::string t = text(v, where);
-      if ((k == "ca_file" || k == "cert_file" || k == "key_file") && std::filesystem::path(t).is_relative())
-        t = (std::filesystem::path(base_dir) / t).string();
-      (k == "host" ? s.host : k == "client_id" ? s.client_id : k == "username" ? s.username : k == "ca_file" ? s.ca_file : k == "cert_file" ? s.cert_file : s.key_file) = t;
+      if ((k == "ca_file" || k == "cert_file" || k == "key_file") && std::filesystem::path(t).is_relative()) t = (std::filesystem::path(base_dir) / t).string();
+      (k == "host"        ? s.host
+       : k == "client_id" ? s.client_id
+       : k == "username"  ? s.username
+       : k == "ca_file"   ? s.ca_file
+       : k == "cert_file" ? s.cert_file
+                          : s.key_file) = t;
     } else if (k == "port") {
       if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > 65535) fail(where, "must be a port number (1 to 65535)");
       s.port = v.get<int>();
@@ -86,13 +89,21 @@ MqttSettings parse_mqtt(const json& m, const std::string& base_dir, const char* 
     } else if (k == "password") {
       fail(where, "is refused: a password never sits in the config; name it with mqtt.password_file or mqtt.password_env");
     } else if (k != "password_file" && k != "password_env") {
-      fail(where, "is not a known field (host, port, client_id, username, password_file, password_env, ca_file, cert_file, key_file, "
-                  "keepalive_s, live_rate_hz, queue_limit)");
+      fail(where,
+           "is not a known field (host, port, client_id, username, password_file, password_env, ca_file, cert_file, key_file, "
+           "keepalive_s, live_rate_hz, queue_limit)");
     }
   }
   s.password = secret(m, "password", "mqtt.", base_dir, env);
   if (!s.password.empty() && s.username.empty()) fail("mqtt.username", "is missing: a password was given without a user name");
   if (s.cert_file.empty() != s.key_file.empty()) fail(s.cert_file.empty() ? "mqtt.cert_file" : "mqtt.key_file", "is missing: a client certificate needs both");
+  // TLS is on when ca_file is set; a client certificate without it would be silently unused.
+  if (!s.cert_file.empty() && s.ca_file.empty())
+    fail("mqtt.cert_file", "is given without lab.mqtt.ca_file: TLS needs the CA that signed the broker's certificate");
+  // Read now, not at the first connection: a wrong path is a config error at start, not a
+  // publisher that retries for ever.
+  for (const auto& [field, file] : {std::pair{"ca_file", &s.ca_file}, {"cert_file", &s.cert_file}, {"key_file", &s.key_file}})
+    if (!file->empty() && !std::ifstream(*file)) fail(std::string("mqtt.") + field, "names '" + *file + "', which cannot be read");
   return s;
 }
 }  // namespace

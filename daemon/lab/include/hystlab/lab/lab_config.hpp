@@ -23,9 +23,9 @@ struct LabConfigError : std::invalid_argument {
 };
 
 struct PostgresTarget {
-  std::string conninfo;  // a libpq URL or key=value string, without a password
-  std::string password;  // from the file or the environment; empty: libpq's own (~/.pgpass, PGPASSWORD)
-  double period_s = 1.0;       // a replication pass at most this often while there is nothing to copy
+  std::string conninfo;            // a libpq URL or key=value string, without a password
+  std::string password;            // from the file or the environment; empty: libpq's own (~/.pgpass, PGPASSWORD)
+  double period_s = 1.0;           // a replication pass at most this often while there is nothing to copy
   std::size_t batch_rows = 20000;  // samples per transaction (each with its high-water mark)
 };
 
