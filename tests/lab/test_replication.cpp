@@ -9,6 +9,7 @@
 #include <random>
 
 #include "../support/postgres_server.hpp"
+#include "hystlab/db/lab_reads.hpp"
 #include "hystlab/db/replicator.hpp"
 #include "hystlab/db/store.hpp"
 #include "lab_checksum.hpp"
@@ -108,6 +109,46 @@ TEST_CASE("replication: every row once, samples equal to the bit, changes follow
   CHECK(ra.pass().samples == 0);
   CHECK(pg_count(pg, "samples", ra.daemon_id()) == 23456 + 777);
   CHECK(pg_count(pg, "samples", rb.daemon_id()) == 3000);
+
+  // What the lab view and `hystlab lab` read: both daemons, their rigs, campaigns and tables by
+  // name, a run's overview with every peak kept, every sample back in order.
+  db::LabReads lab(pg);
+  REQUIRE(lab.daemons("materials-lab").size() == 2);
+  CHECK(lab.rigs().size() == 2);
+  const auto campaigns = lab.campaigns({"materials-lab", "frame-pc-1", "SMA spring 7", "", 10});
+  REQUIRE(campaigns.size() == 1);
+  CHECK(campaigns[0].state == "completed");
+  CHECK(campaigns[0].rig == "frame A");
+  CHECK(lab.campaigns({"", "", "no such specimen", "", 10}).empty());
+  const auto one = lab.campaign("frame-pc-1", fa.campaign);
+  REQUIRE(one);
+  CHECK(one->plan.find("SMA spring 7") != std::string::npos);
+  const auto runs = lab.runs(one->daemon_id, fa.campaign);
+  REQUIRE(runs.size() == 1);
+  CHECK(runs[0].samples == 23456 + 777);
+  CHECK_FALSE(runs[0].shaker);
+  CHECK(lab.events(one->daemon_id, fa.campaign).size() == static_cast<std::size_t>(lite_count(a.database(), "events")));
+  const auto tables = lab.tables({"materials-lab", "", "SMA spring 7", "", 10});
+  REQUIRE(tables.size() == 1);
+  CHECK(tables[0].accuracy.find("rms_N") != std::string::npos);
+  CHECK(lab.table_document("frame-pc-1", tables[0].id).has_value());
+  const db::LabOverview o = lab.overview(one->daemon_id, fa.run, false, 100);
+  REQUIRE(o.columns.size() == 4);
+  REQUIRE(o.max[3].size() >= 90);
+  double peak = -1e300, lite_peak = -1e300;
+  for (const double v : o.max[3]) peak = std::max(peak, v);
+  db::Statement st(a.database(), "SELECT max(force) FROM samples");
+  st.step();
+  lite_peak = st.column_double(0);
+  CHECK(peak == lite_peak);
+  std::int64_t n = 0, last = -1;
+  bool ordered = true;
+  lab.for_each_sample(one->daemon_id, fa.run, false, [&](std::int64_t seq, const std::vector<double>&) {
+    ordered = ordered && seq == last + 1;
+    last = seq, ++n;
+  });
+  CHECK(n == 23456 + 777);
+  CHECK(ordered);
 }
 
 TEST_CASE("replication: PostgreSQL stopped mid-campaign and started again, or a batch cut off: caught up, nothing lost or doubled") {
