@@ -11,13 +11,16 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/daemon/daemon_control.hpp"
 #include "hystlab/db/sqlite.hpp"
+#include "hystlab/lab/lab_watch.hpp"
 #include "hystlab/lab/mqtt_publisher.hpp"
 #include "hystlab/lab/replication.hpp"
 #include "hystlab/web/http_api.hpp"
+#include "hystlab/web/lab_view.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -34,6 +37,24 @@ campaigns from the page, the API (docs/API.md) or 'hystlab campaign ...'. SIGTER
 stops it cleanly.
 )";
 }  // namespace
+
+// A lab section and no rigs: the read-only view of the lab (docs/LAB.md), no rig and no store.
+int run_lab_view(const hystlab::daemon::DaemonConfig& cfg) {
+  hystlab::lab::LabWatch watch(cfg.lab);
+  watch.start();
+  std::unique_ptr<hystlab::web::LabView> view;
+  try {
+    view = std::make_unique<hystlab::web::LabView>(cfg.http, cfg.lab, [&watch] { return watch.snapshot(); });
+  } catch (const std::runtime_error& e) {
+    std::cerr << "hystlabd: error: " << e.what() << "\n";
+    return 2;
+  }
+  spdlog::info("lab view of {}: serving the API and the page on http://{}:{}/", cfg.lab.name, cfg.http.bind, view->port());
+  while (!g_stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));  // a signal's flag: nothing to wait on
+  view->stop();
+  watch.stop();
+  return 0;
+}
 
 int main(int argc, char** argv) {
   std::string config_path, db_path, port, bind;
@@ -84,6 +105,7 @@ int main(int argc, char** argv) {
       cfg.http.port = std::stoi(port);
     }
     hystlab::daemon::check_http_security(cfg.http, std::getenv("HYSTLAB_TOKEN"));
+    if (cfg.lab_view) return run_lab_view(cfg);
     hystlab::daemon::Daemon daemon(cfg);
     const auto control = hystlab::daemon::make_control(daemon);
     // The lab (docs/LAB.md): its own threads, which read the daemon only through its interface;

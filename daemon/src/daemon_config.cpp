@@ -118,6 +118,13 @@ DaemonConfig parse_daemon_config(const json& j, const std::string& base_dir) {
     if (!j["db"].is_string() || j["db"].get<std::string>().empty()) fail("db", "must be a file name");
     c.db_path = j["db"].get<std::string>();
   }
+  // Only a lab section: the lab view (docs/LAB.md), no rig, no store of its own; it reads the lab's
+  // PostgreSQL (and its broker, for the rigs' live state).
+  if (c.lab.enabled && !j.contains("rigs")) {
+    if (!c.lab.has_postgres) fail("lab.postgresql", "is missing: the lab view (a config with a lab section and no rigs) reads the lab's database");
+    c.lab_view = true;
+    return c;
+  }
   if (!j.contains("rigs")) {
     c.rigs.push_back(
         RigEntry{"simulated load frame", json::object(), 1.0, true, SimulatorOptions{}, domain::RigEnvelope{}, domain::SupervisionSettings{}, nullptr});

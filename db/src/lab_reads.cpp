@@ -39,11 +39,11 @@ std::string filtered(std::string sql, const LabFilter& f, std::vector<const char
 
 std::vector<LabDaemon> LabReads::daemons(const std::string& lab) {
   const PgResult r = pg_.query(
-      "SELECT id, lab, name, coalesce(software, ''), first_seen::text, last_seen::text FROM hystlab.daemons "
+      "SELECT id, lab, name, coalesce(software, ''), first_seen::text, last_seen::text, coalesce(url, '') FROM hystlab.daemons "
       "WHERE $1 = '' OR lab = $1 ORDER BY lab, name",
       {lab.c_str()});
   std::vector<LabDaemon> out;
-  for (int k = 0; k < r.rows(); ++k) out.push_back({static_cast<int>(r.integer(k, 0)), r.text(k, 1), r.text(k, 2), r.text(k, 3), r.text(k, 4), r.text(k, 5)});
+  for (int k = 0; k < r.rows(); ++k) out.push_back({static_cast<int>(r.integer(k, 0)), r.text(k, 1), r.text(k, 2), r.text(k, 3), r.text(k, 4), r.text(k, 5), r.text(k, 6)});
   return out;
 }
 

@@ -105,9 +105,9 @@ void Replicator::connect() {
   auto pg = std::make_unique<PgConnection>(conninfo_, password_);
   pg_migrate(*pg);
   const PgResult d = pg->query(
-      "INSERT INTO hystlab.daemons(lab, name, software) VALUES($1, $2, $3) "
-      "ON CONFLICT(lab, name) DO UPDATE SET software = excluded.software, last_seen = now() RETURNING id",
-      {id_.lab.c_str(), id_.daemon.c_str(), id_.software.c_str()});
+      "INSERT INTO hystlab.daemons(lab, name, software, url) VALUES($1, $2, $3, nullif($4, '')) "
+      "ON CONFLICT(lab, name) DO UPDATE SET software = excluded.software, url = excluded.url, last_seen = now() RETURNING id",
+      {id_.lab.c_str(), id_.daemon.c_str(), id_.software.c_str(), id_.url.c_str()});
   daemon_id_ = static_cast<int>(d.integer(0, 0));
   daemon_text_ = std::to_string(daemon_id_);
   // The marks as PostgreSQL committed them: after any failure, the truth is there, never here.

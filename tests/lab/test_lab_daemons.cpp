@@ -17,6 +17,7 @@
 #include "hystlab/db/pg.hpp"
 #include "hystlab/db/sqlite.hpp"
 #include "lab_checksum.hpp"
+#include "lab_daemon.hpp"
 
 using namespace hystlab;
 using nlohmann::json;
@@ -24,63 +25,8 @@ using test_support::PostgresServer;
 using test_support::TempDir;
 
 namespace {
-const char* kPlan = R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 6, "ramp_rate_mm_s": 0.1, "sample_rate_hz": 500,
-                        "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 400, "rate_mm_s": 50}})";
-
+using lab_test::LabDaemon;
 using test_support::wait_until;
-
-// A hystlabd of the lab with one simulated load frame; restartable on the same files.
-class LabDaemon {
- public:
-  LabDaemon(const std::string& name, const PostgresServer& pg, const std::string& password_env) : name_(name) {
-    json cfg = {
-        {"rigs", json::array({{{"name", "sim frame"}, {"simulate", {{"time_scale", 20}, {"noise_N", 0.05}}}}})},
-        {"lab",
-         {{"name", "materials-lab"}, {"daemon", name}, {"postgresql", pg.url()}, {"postgresql_password_env", password_env}, {"replicate_every_s", 0.2}}}};
-    dir_.write("hystlab.json", cfg.dump());
-    start();
-  }
-  ~LabDaemon() { stop(SIGTERM); }
-  LabDaemon(const LabDaemon&) = delete;
-  LabDaemon& operator=(const LabDaemon&) = delete;
-
-  void start() {
-    const std::string log = (dir_ / ("daemon" + std::to_string(++starts_) + ".log")).string();
-    pid_ = test_support::spawn_logged({HYSTLABD, "--config", (dir_ / "hystlab.json").string(), "--db", db(), "--port", "0"}, log);
-    port_ = test_support::served_port(log);
-    REQUIRE_MESSAGE(port_ != 0, test_support::read_log(log));
-  }
-  void stop(int signal) {
-    if (pid_ <= 0) return;
-    kill(pid_, signal);
-    int st = 0;
-    for (int k = 0; k < 300 && waitpid(pid_, &st, WNOHANG) == 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    if (waitpid(pid_, &st, WNOHANG) == 0) kill(pid_, SIGKILL), waitpid(pid_, &st, 0);
-    pid_ = -1;
-  }
-  std::string text(const std::string& path) {
-    httplib::Client c("127.0.0.1", port_);
-    const auto r = c.Get(path);
-    REQUIRE(r);
-    return r->body;
-  }
-  json get(const std::string& path) { return json::parse(text(path)); }
-  std::int64_t submit() {
-    httplib::Client c("127.0.0.1", port_);
-    const auto r = c.Post("/api/campaigns", json{{"plan", json::parse(kPlan)}}.dump(), "application/json");
-    REQUIRE(r);
-    REQUIRE_MESSAGE(r->status == 201, r->body);
-    return json::parse(r->body).at("id").get<std::int64_t>();
-  }
-  [[nodiscard]] std::string db() const { return (dir_ / "hystlab.db").string(); }
-  [[nodiscard]] const std::string& name() const { return name_; }
-
- private:
-  std::string name_;
-  TempDir dir_{"labd"};
-  pid_t pid_ = -1;
-  int port_ = 0, starts_ = 0;
-};
 
 std::string campaign_state(const std::string& db_path, std::int64_t id) {
   db::Database d(db_path, false);
@@ -108,7 +54,7 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   PostgresServer server;
   setenv("HYSTLAB_TEST_PG_PASSWORD", PostgresServer::kPassword, 1);
   setenv("HYSTLAB_TEST_PG_WRONG", "not-the-password", 1);
-  LabDaemon a("frame-pc-1", server, "HYSTLAB_TEST_PG_PASSWORD"), b("frame-pc-2", server, "HYSTLAB_TEST_PG_PASSWORD");
+  LabDaemon a(server, {.name = "frame-pc-1"}), b(server, {.name = "frame-pc-2"});
   const std::int64_t ca = a.submit(), cb = b.submit();
   REQUIRE(wait_until([&] { return a.get("/api/status")["lab"]["postgresql"]["samples"].get<std::int64_t>() > 1000; }, 60));
   CHECK(a.get("/api/status")["lab"]["postgresql"]["connected"] == true);
@@ -148,7 +94,7 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   CHECK(metrics.find("hystlab_replication_connected 1\n") != std::string::npos);
 
   // A wrong password: one clear error, and the daemon acquires anyway.
-  LabDaemon wrong("frame-pc-3", server, "HYSTLAB_TEST_PG_WRONG");
+  LabDaemon wrong(server, {.name = "frame-pc-3", .password_env = "HYSTLAB_TEST_PG_WRONG"});
   wrong.submit();
   REQUIRE(wait_until([&] { return !wrong.get("/api/status")["lab"]["postgresql"]["error"].is_null(); }, 30));
   const std::string why = wrong.get("/api/status")["lab"]["postgresql"]["error"];
@@ -156,4 +102,32 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   CHECK(why.find("not-the-password") == std::string::npos);
   CHECK(wait_until([&] { return acquired(wrong) > 500; }, 30));
   CHECK(daemon_id(pg, "frame-pc-3") == 0);
+
+  // The lab view over it (a lab section and no rigs): both daemons and their campaigns, a run's
+  // overview, read-only.
+  LabDaemon view(server, {.name = "", .view = true});
+  const json lab = view.get("/api/lab");
+  CHECK(lab["lab"] == "materials-lab");
+  REQUIRE(lab["daemons"].size() == 2);
+  CHECK(lab["daemons"][0]["url"] == "http://127.0.0.1:" + std::to_string(a.port()) + "/");
+  CHECK(lab["rigs"].size() == 2);
+  const json campaigns = view.get("/api/lab/campaigns");
+  REQUIRE(campaigns.size() == 2);
+  const json one = view.get("/api/lab/campaigns/frame-pc-2/" + std::to_string(cb));
+  CHECK(one["state"] == "completed");
+  REQUIRE(one["runs"].size() >= 1);
+  const json o = view.get("/api/lab/runs/frame-pc-2/" + std::to_string(one["runs"][0]["id"].get<std::int64_t>()) + "/overview?buckets=100");
+  CHECK(o["buckets"].get<int>() >= 50);
+  CHECK(o["max"]["force"].size() == o["buckets"].get<std::size_t>());
+  int status = 0;
+  (void)view.text("/api/lab/campaigns/frame-pc-9/1", &status);
+  CHECK(status == 404);
+  (void)view.text("/api/lab/campaigns?limit=0", &status);
+  CHECK(status == 400);
+  httplib::Client c("127.0.0.1", view.port());
+  const auto post = c.Post("/api/campaigns", R"({"plan": {}})", "application/json");
+  REQUIRE(post);
+  CHECK(post->status == 405);
+  CHECK(post->body.find("read-only") != std::string::npos);
+  CHECK(view.get("/api/status")["mode"] == "lab view");
 }

@@ -52,7 +52,7 @@ Filled fill(db::Store& s, int n, std::uint64_t seed) {
 }
 
 db::Replicator replicator(const PostgresServer& pg, const std::string& path, const std::string& daemon, std::size_t batch = 5000) {
-  return db::Replicator(path, {"materials-lab", daemon, "test"}, pg.url(), PostgresServer::kPassword, batch);
+  return db::Replicator(path, {"materials-lab", daemon, "test", ""}, pg.url(), PostgresServer::kPassword, batch);
 }
 int until_caught_up(db::Replicator& r) {
   for (int k = 0; k < 100; ++k)
@@ -197,7 +197,7 @@ TEST_CASE("replication: a wrong password, no server, a newer schema: one clear e
   const std::string path = (dir / "a.db").string();
   db::Store a(path);
   fill(a, 10, 6);
-  db::Replicator wrong(path, {"materials-lab", "frame-pc-1", "test"}, server.url(), "not-the-password");
+  db::Replicator wrong(path, {"materials-lab", "frame-pc-1", "test", ""}, server.url(), "not-the-password");
   try {
     wrong.connect();
     FAIL("connected with a wrong password");
@@ -206,7 +206,7 @@ TEST_CASE("replication: a wrong password, no server, a newer schema: one clear e
     CHECK(std::string(e.what()).find("not-the-password") == std::string::npos);
     CHECK(e.sqlstate == "28P01");
   }
-  db::Replicator nobody(path, {"materials-lab", "frame-pc-1", "test"}, "postgresql://hystlab@127.0.0.1:" + std::to_string(test_support::free_port()) + "/lab",
+  db::Replicator nobody(path, {"materials-lab", "frame-pc-1", "test", ""}, "postgresql://hystlab@127.0.0.1:" + std::to_string(test_support::free_port()) + "/lab",
                         PostgresServer::kPassword);
   try {
     nobody.connect();

@@ -41,6 +41,10 @@ double query_number(const httplib::Request& req, const char* name, double def, d
 // The body as a JSON object (parse_body); an empty body as {} when allow_empty.
 json body_object(const httplib::Request& req, bool allow_empty = false);
 
+// The page's folder: the configured one; else the installed one beside the executable
+// (<bindir>/../share/hystlab/web/<sub>); else the source tree's.
+std::string default_dir(const std::string& configured, const std::string& installed_sub, const char* source_tree);
+
 // This thread's read connection (WAL: never blocks the writer).
 db::Reads& reader(const std::string& db_path);
 

@@ -11,9 +11,6 @@
 #include "routes.hpp"
 
 namespace hystlab::web {
-namespace {
-// The configured folder; else the installed one beside the executable
-// (<bindir>/../share/hystlab/web/<sub>); else the source tree's.
 std::string default_dir(const std::string& configured, const std::string& installed_sub, const char* source_tree) {
   if (!configured.empty()) return configured;
   std::error_code ec;
@@ -22,7 +19,6 @@ std::string default_dir(const std::string& configured, const std::string& instal
   if (!ec && std::filesystem::exists(installed / (installed_sub.empty() ? "index.html" : "uPlot.iife.min.js"), ec)) return installed.string();
   return source_tree;
 }
-}  // namespace
 
 struct HttpApi::Impl {
   Impl(control::DaemonInterface& d, const control::HttpConfig& cfg, LabSource lab) : config(cfg), ctx(d, config, d.db_path()) { ctx.lab = std::move(lab); }

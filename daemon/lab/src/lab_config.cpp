@@ -125,6 +125,9 @@ LabConfig parse_lab_config(const json& j, const std::string& base_dir, const cha
       const std::string t = text(v, k);
       if (!valid_name(t)) fail(k, "'" + t + "' cannot be a topic level: up to 64 characters, none of '/', '+', '#'");
       (k == "name" ? c.name : c.daemon) = t;
+    } else if (k == "url") {
+      c.url = text(v, k);
+      if (c.url.rfind("http://", 0) != 0 && c.url.rfind("https://", 0) != 0) fail(k, "must be this daemon's page as an http:// or https:// address");
     } else if (k == "postgresql") {
       c.postgres.conninfo = text(v, k);
       refuse_inline_password(c.postgres.conninfo);
@@ -138,7 +141,7 @@ LabConfig parse_lab_config(const json& j, const std::string& base_dir, const cha
     } else if (k == "postgresql_password_file" || k == "postgresql_password_env") {
       if (!j.contains("postgresql")) fail(k, "is given without lab.postgresql");
     } else {
-      fail(k, "is not a known field (name, daemon, postgresql, postgresql_password_file, postgresql_password_env, replicate_every_s, mqtt)");
+      fail(k, "is not a known field (name, daemon, url, postgresql, postgresql_password_file, postgresql_password_env, replicate_every_s, mqtt)");
     }
   }
   if (c.name.empty()) fail("name", "is missing: the lab's name (e.g. \"materials-lab\") keys its topics and rows");

@@ -16,6 +16,11 @@ class MqttListener {
   virtual void on_connack(int rc) noexcept = 0;     // 0: accepted; else the broker's reason
   virtual void on_disconnect(int rc) noexcept = 0;  // 0: asked for; else lost
   virtual void on_published(int mid) noexcept = 0;  // QoS 0: written to the socket; QoS 1: PUBACK
+  // A message of a subscription (the lab view's watch; the publisher subscribes to nothing).
+  virtual void on_message(const std::string& topic, const std::string& payload) noexcept {
+    (void)topic;
+    (void)payload;
+  }
  protected:
   ~MqttListener() = default;
 };
@@ -23,9 +28,9 @@ class MqttListener {
 class MqttConnection {
  public:
   // The will (retained, QoS 1) is what the broker publishes when this client vanishes without a
-  // DISCONNECT (a crash, kill -9, a lost network). Throws std::runtime_error naming the config's
+  // DISCONNECT (a crash, kill -9, a lost network); an empty will_topic: none. Throws std::runtime_error naming the config's
   // field when libmosquitto refuses a setting (a TLS file it cannot read, say).
-  MqttConnection(const MqttSettings& s, const std::string& will_topic, const std::string& will_payload, MqttListener& listener);
+  MqttConnection(const MqttSettings& s, const std::string& will_topic, const std::string& will_payload, MqttListener& listener, bool clean = true);
   ~MqttConnection();
   MqttConnection(const MqttConnection&) = delete;
   MqttConnection& operator=(const MqttConnection&) = delete;
@@ -35,6 +40,7 @@ class MqttConnection {
   // Network I/O for up to timeout_ms; MOSQ_ERR_SUCCESS, or why the connection is gone.
   [[nodiscard]] int loop(int timeout_ms) noexcept;
   [[nodiscard]] int publish(const std::string& topic, const std::string& payload, int qos, bool retain, int* mid) noexcept;
+  [[nodiscard]] int subscribe(const std::string& pattern, int qos) noexcept;
   void disconnect() noexcept;
   // Bytes of packets libmosquitto still holds for the socket (0: all written).
   [[nodiscard]] bool wants_write() const noexcept;

@@ -73,6 +73,7 @@ std::string status_json(const LabConfig& lab, const std::string& state, const st
                         const std::vector<std::string>& rigs) {
   json j{{"state", state}, {"lab", lab.name}, {"daemon", lab.daemon}, {"version", HYSTLAB_VERSION}, {"started_at", started_at}, {"rigs", rigs}};
   if (!reason.empty()) j["reason"] = reason;
+  if (!lab.url.empty()) j["url"] = lab.url;  // where the lab view links to this daemon's own page
   return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

@@ -65,6 +65,7 @@ struct DaemonConfig {
   HttpConfig http;
   AcquisitionSettings acquisition;  // every rig's acquisition thread (and supervised simulator)
   lab::LabConfig lab;               // "lab": replication to PostgreSQL, rigs live over MQTT (docs/LAB.md)
+  bool lab_view = false;            // a lab section and no rigs: the read-only view of the lab, no rig, no store
 };
 
 // Throws ConfigError naming the field. A null json gives the embedded defaults.

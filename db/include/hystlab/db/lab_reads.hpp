@@ -14,7 +14,7 @@ namespace hystlab::db {
 
 struct LabDaemon {
   int id = 0;
-  std::string lab, name, software, first_seen, last_seen;
+  std::string lab, name, software, first_seen, last_seen, url;
 };
 struct LabRig {
   int daemon_id = 0;

@@ -41,6 +41,7 @@ void pg_migrate(PgConnection& c);
 
 struct ReplicaIdentity {
   std::string lab, daemon, software;
+  std::string url;  // the daemon's page ("" when not said)
 };
 
 struct PassResult {

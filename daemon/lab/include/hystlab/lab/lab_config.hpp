@@ -4,7 +4,7 @@
 // lab's MQTT broker. Both optional; without a "lab" section the daemon keeps everything to its
 // own SQLite file, as before.
 //
-//   "lab": {"name": "materials-lab", "daemon": "frame-pc-2",
+//   "lab": {"name": "materials-lab", "daemon": "frame-pc-2", "url": "http://frame-pc-2:8080/",
 //           "postgresql": "postgresql://hystlab@db.lab/hystlab?sslmode=verify-full",
 //           "postgresql_password_file": "/etc/hystlab/pg.pass",      (or _env: "HYSTLAB_PG_PASSWORD")
 //           "mqtt": {"host": "broker.lab", "port": 8883, "client_id": "...", "username": "...",
@@ -43,6 +43,7 @@ struct MqttSettings {
 struct LabConfig {
   bool enabled = false;  // a "lab" section was given
   std::string name, daemon;
+  std::string url;  // this daemon's page as the lab reaches it ("http://frame-pc-2:8080/"): the lab view links there
   bool has_postgres = false;
   PostgresTarget postgres;
   bool has_mqtt = false;

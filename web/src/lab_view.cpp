@@ -1,0 +1,160 @@
+#include "hystlab/web/lab_view.hpp"
+
+#include <httplib.h>
+#include <spdlog/spdlog.h>
+
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "api_support.hpp"
+#include "hystlab/db/lab_reads.hpp"
+#include "lab_view_json.hpp"
+#include "request_guard.hpp"
+
+namespace hystlab::web {
+using nlohmann::json;
+
+struct LabView::Impl {
+  Impl(const control::HttpConfig& h, const lab::LabConfig& l, LiveSource s) : http(h), lab(l), live(std::move(s)) {}
+  control::HttpConfig http;
+  lab::LabConfig lab;
+  LiveSource live;
+  httplib::Server server;
+  std::thread thread;
+  int port = 0;
+  // One connection to the lab's database for every request, in turn: the view is read by a few
+  // people, and libpq's connection is not to be shared between threads at once.
+  std::mutex pg_mu;
+  std::unique_ptr<db::PgConnection> pg;
+  std::string pg_error;
+
+  // f(reads) under the connection's lock, connecting first when needed; a lost server is a 503
+  // naming it, and the next request connects again.
+  void with_lab(httplib::Response& res, const std::function<void(db::LabReads&)>& f) {
+    const std::lock_guard lock(pg_mu);
+    try {
+      if (!pg || !pg->ok()) pg = std::make_unique<db::PgConnection>(lab.postgres.conninfo, lab.postgres.password);
+      db::LabReads reads(*pg);
+      f(reads);
+      pg_error.clear();
+    } catch (const db::PgError& e) {
+      pg_error = e.what();
+      if (pg && !pg->ok()) pg.reset();
+      send_error(res, 503, "lab database unavailable", e.what());
+    }
+  }
+  json pg_status() {
+    const std::lock_guard lock(pg_mu);
+    return {{"connected", pg && pg->ok()}, {"error", pg_error.empty() ? json(nullptr) : json(pg_error)}};
+  }
+};
+
+namespace {
+std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+db::LabFilter filter_of(const httplib::Request& req, const std::string& lab) {
+  return {lab, req.get_param_value("daemon"), req.get_param_value("specimen"), req.get_param_value("kind"),
+          static_cast<int>(query_number(req, "limit", 200, 1, 5000))};
+}
+
+void add_lab_routes(httplib::Server& s, LabView::Impl& m) {
+  s.Get("/api/status", guarded([&m](const httplib::Request&, httplib::Response& res) {
+    const json live = m.live ? m.live() : json::object();
+    send_json(res, {{"name", "hystlabd"},
+                    {"mode", "lab view"},
+                    {"version", HYSTLAB_VERSION},
+                    {"lab", {{"name", m.lab.name}, {"postgresql", m.pg_status()}, {"mqtt", mqtt_status(live)}}}});
+  }));
+  s.Get("/api/lab", guarded([&m](const httplib::Request&, httplib::Response& res) {
+    const json live = m.live ? m.live() : json::object();
+    m.with_lab(res, [&](db::LabReads& r) { send_json(res, lab_overview_json(m.lab.name, r.daemons(m.lab.name), r.rigs(m.lab.name), live)); });
+  }));
+  s.Get("/api/lab/campaigns", guarded([&m](const httplib::Request& req, httplib::Response& res) {
+    const db::LabFilter f = filter_of(req, m.lab.name);
+    m.with_lab(res, [&](db::LabReads& r) { send_json(res, campaigns_json(r.campaigns(f))); });
+  }));
+  s.Get(R"(/api/lab/campaigns/([^/]+)/(\d+))", guarded([&m](const httplib::Request& req, httplib::Response& res) {
+    const std::string daemon = req.matches[1].str();
+    const std::int64_t id = path_id(req, 2);
+    m.with_lab(res, [&](db::LabReads& r) {
+      const auto c = r.campaign(daemon, id);
+      if (!c || c->lab != m.lab.name) return send_error(res, 404, "not found", "no campaign " + std::to_string(id) + " of daemon '" + daemon + "' in lab " + m.lab.name);
+      db::LabFilter tables_of{m.lab.name, daemon, {}, {}, 500};
+      std::vector<db::LabTable> tables;
+      for (db::LabTable& t : r.tables(tables_of))
+        if (t.campaign == id) tables.push_back(std::move(t));
+      send_json(res, campaign_json(*c, r.runs(c->daemon_id, id), r.events(c->daemon_id, id), tables));
+    });
+  }));
+  s.Get(R"(/api/lab/runs/([^/]+)/(\d+)/overview)", guarded([&m](const httplib::Request& req, httplib::Response& res) {
+    const std::string daemon = req.matches[1].str();
+    const std::int64_t run = path_id(req, 2);
+    const int buckets = static_cast<int>(query_number(req, "buckets", 600, 10, 5000));
+    const bool shaker = req.get_param_value("shaker") == "1";
+    m.with_lab(res, [&](db::LabReads& r) {
+      for (const db::LabDaemon& d : r.daemons(m.lab.name))
+        if (d.name == daemon) return send_json(res, overview_json(r.overview(d.id, run, shaker, buckets)));
+      send_error(res, 404, "not found", "no daemon '" + daemon + "' in lab " + m.lab.name);
+    });
+  }));
+  s.Get("/api/lab/tables", guarded([&m](const httplib::Request& req, httplib::Response& res) {
+    const db::LabFilter f = filter_of(req, m.lab.name);
+    m.with_lab(res, [&](db::LabReads& r) { send_json(res, tables_json(r.tables(f))); });
+  }));
+}
+}  // namespace
+
+LabView::LabView(const control::HttpConfig& http, const lab::LabConfig& lab, LiveSource live) : impl_(std::make_unique<Impl>(http, lab, std::move(live))) {
+  Impl& m = *impl_;
+  httplib::Server& s = m.server;
+  s.set_tcp_nodelay(true);
+  s.set_default_headers({{"X-Content-Type-Options", "nosniff"},
+                         {"Content-Security-Policy", "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; frame-ancestors 'none'"},
+                         {"X-Frame-Options", "DENY"},
+                         {"Referrer-Policy", "no-referrer"}});
+  // Read-only by design: only GET (and HEAD); a host this view does not serve is refused, as on a
+  // rig's own daemon (a page of another site reaching it through DNS rebinding).
+  s.set_pre_routing_handler([&m](const httplib::Request& req, httplib::Response& res) {
+    if (!host_allowed(m.http, req.get_header_value("Host"))) {
+      send_error(res, 403, "unknown host", "Host '" + req.get_header_value("Host") + "' is not a name this view serves (add it to http.allowed_hosts)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (req.method != "GET" && req.method != "HEAD") {
+      send_error(res, 405, "read-only", "the lab view moves nothing: commands go to the rig's own daemon (its link on the page)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (res.body.empty() && res.status == 404) send_error(res, 404, "not found", "no such resource: " + req.method + " " + req.path);
+  });
+  add_lab_routes(s, m);
+  const std::string root = default_dir(http.web_root, "", HYSTLAB_WEB_ROOT), vendor = default_dir(http.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT);
+  s.set_mount_point("/vendor/uplot", vendor);
+  // The lab's page at "/", and only the files it uses (the rig page's own are not served here).
+  for (const char* f : {"/lab.js", "/style.css", "/fmt.js", "/favicon.svg"})
+    s.Get(f, [root, f](const httplib::Request&, httplib::Response& res) {
+      const std::string path = std::string(f);
+      const char* type = path.ends_with(".js") ? "text/javascript" : path.ends_with(".css") ? "text/css" : "image/svg+xml";
+      res.set_content(file_text(root + path), type);
+    });
+  s.Get("/", [root](const httplib::Request&, httplib::Response& res) { res.set_content(file_text(root + "/lab.html"), "text/html; charset=utf-8"); });
+  m.port = http.port == 0 ? s.bind_to_any_port(http.bind) : (s.bind_to_port(http.bind, http.port) ? http.port : -1);
+  if (m.port <= 0) throw std::runtime_error("http: cannot listen on " + http.bind + ":" + std::to_string(http.port) + " (in use, or not an address here)");
+  m.thread = std::thread([&s] { s.listen_after_bind(); });
+}
+
+LabView::~LabView() { stop(); }
+int LabView::port() const noexcept { return impl_->port; }
+void LabView::stop() {
+  impl_->server.stop();
+  if (impl_->thread.joinable()) impl_->thread.join();
+}
+
+}  // namespace hystlab::web
