@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -347,4 +348,15 @@ TEST_CASE("lab: one clear error each (no server, a refused password, a password 
   check_error(l.run(w, "runs export 1 " + l.pg()), "give --daemon NAME");
   check_error(l.run(w, "runs export 1 " + l.pg() + " --daemon frame-pc-1 --format h5 -o x.h5"), "HDF5 is exported from the daemon's own file");
   CHECK_FALSE(std::filesystem::exists(w / "x.h5"));
+}
+
+TEST_CASE("conninfo_has_password: what the CLI's --pg and the config's lab.postgresql both refuse") {
+  CHECK(db::conninfo_has_password("postgresql://hystlab:secret@127.0.0.1:5432/lab"));
+  CHECK(db::conninfo_has_password("postgres://u:p@host/db"));
+  CHECK(db::conninfo_has_password("postgresql://u@host/db?password=p"));
+  CHECK(db::conninfo_has_password("host=h dbname=lab password=p"));
+  CHECK_FALSE(db::conninfo_has_password("postgresql://hystlab@127.0.0.1:5432/lab"));
+  CHECK_FALSE(db::conninfo_has_password("postgresql://hystlab@[::1]:5432/lab"));
+  CHECK_FALSE(db::conninfo_has_password("postgresql://host:5432/lab"));
+  CHECK_FALSE(db::conninfo_has_password("host=h dbname=lab user=u"));
 }
