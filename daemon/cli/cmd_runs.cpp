@@ -5,18 +5,22 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
+#include "hystlab/db/lab_reads.hpp"
 #include "hystlab/db/run_csv.hpp"
 #include "hystlab/db/run_h5.hpp"
 #include "hystlab/db/store.hpp"
+#include "lab_access.hpp"
 
 namespace hystlab::cli {
 namespace {
 const char* kRunsUsage = R"(usage: hystlab runs export RUN_ID [--format csv|h5] [-o FILE] [--db hystlab.db]
        hystlab runs export --campaign ID --format h5 -o FILE [--db hystlab.db]
+       hystlab runs export RUN_ID --pg URL --daemon NAME [--lab NAME] [--format csv] [-o FILE] [--pg-password-file FILE]
 
 csv (the default) writes the run's samples, to FILE or stdout, as GET /api/runs/ID/samples.csv
 does (docs/FORMATS.md, "Runs as CSV"): a load frame's seq,t_s,command_mm,displacement_mm,force_N,
@@ -28,6 +32,10 @@ h5 writes an HDF5 file (docs/FORMATS.md, "Runs as HDF5"): the run's samples, one
 signal with its units, and its campaign's plan, rig, events, FOT nodes and tables. With
 --campaign, every run of that campaign. HDF5 is binary: -o must name a file.
 A failed export leaves no file behind.
+
+With --pg, the run is read from the lab database (docs/LAB.md) that daemon NAME replicates into
+(RUN_ID: its id on that daemon, as hystlab lab show lists it): the same CSV, byte for byte, as
+from that daemon's file, of the samples replicated so far. HDF5 comes from the daemon's file only.
 )";
 
 std::int64_t whole_number(const std::string& text, const std::string& what) {
@@ -50,12 +58,10 @@ void write_csv_rows(db::Reads& store, std::int64_t id, bool shaker, std::FILE* f
 }
 
 // To stdout, or to FILE.tmp renamed to FILE once complete (a failure leaves no half file).
-void export_csv(db::Reads& store, std::int64_t id, const std::string& path) {
-  const db::RunSamples where = db::run_samples(store, id);
-  if (where == db::RunSamples::none) throw CliError("no samples for run " + std::to_string(id));
-  const bool shaker = where == db::RunSamples::shaker;  // a shaker's run: its own columns
+// write(f, name): the rows to f, name the output's for its errors.
+void write_csv_output(const std::string& path, const std::function<void(std::FILE*, const std::string&)>& write) {
   if (path.empty() || path == "-") {
-    write_csv_rows(store, id, shaker, stdout, "to stdout");
+    write(stdout, "to stdout");
     if (std::fflush(stdout) != 0) throw CliError(std::string("cannot write to stdout: ") + std::strerror(errno));
     return;
   }
@@ -63,7 +69,7 @@ void export_csv(db::Reads& store, std::int64_t id, const std::string& path) {
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (f == nullptr) throw CliError("-o: cannot write '" + path + "': " + std::strerror(errno));
   try {
-    write_csv_rows(store, id, shaker, f, "'" + path + "'");
+    write(f, "'" + path + "'");
   } catch (...) {
     std::fclose(f);
     std::remove(tmp.c_str());
@@ -75,6 +81,43 @@ void export_csv(db::Reads& store, std::int64_t id, const std::string& path) {
     std::remove(tmp.c_str());
     throw CliError("-o: cannot write '" + path + "': " + why);
   }
+}
+
+void export_csv(db::Reads& store, std::int64_t id, const std::string& path) {
+  const db::RunSamples where = db::run_samples(store, id);
+  if (where == db::RunSamples::none) throw CliError("no samples for run " + std::to_string(id));
+  const bool shaker = where == db::RunSamples::shaker;  // a shaker's run: its own columns
+  write_csv_output(path, [&](std::FILE* f, const std::string& name) { write_csv_rows(store, id, shaker, f, name); });
+}
+
+// The run's CSV from the lab database: the rows as the daemon's store gives them
+// (LabReads::for_each_*_row), through run_csv.hpp's own row writer, flushed a window at a time.
+int export_lab_csv(const Options& opt, std::int64_t id) {
+  const auto pg = connect_lab(opt);
+  db::LabReads lab(*pg);
+  try {
+    const db::LabDaemon daemon = lab_daemon(lab, opt.require("daemon"), opt.get("lab"));
+    const auto run = lab.run(daemon.id, id);
+    const std::string where = "on daemon '" + daemon.name + "' in the lab database";
+    if (!run) throw CliError("no samples for run " + std::to_string(id) + ": there is no run " + std::to_string(id) + " " + where);
+    if (run->samples == 0) throw CliError("no samples for run " + std::to_string(id) + " " + where + " (none replicated yet)");
+    write_csv_output(opt.get("output"), [&](std::FILE* f, const std::string& name) {
+      std::string buf = db::run_csv_header(run->shaker);
+      const auto flush = [&](bool force) {
+        if (!force && buf.size() < (std::size_t{1} << 20)) return;
+        if (std::fwrite(buf.data(), 1, buf.size(), f) != buf.size()) throw CliError("cannot write " + name + ": " + std::strerror(errno));
+        buf.clear();
+      };
+      if (run->shaker)
+        lab.for_each_shaker_row(daemon.id, id, [&](const db::ShakerRow& r) { db::append_csv_row(buf, r), flush(false); });
+      else
+        lab.for_each_frame_row(daemon.id, id, [&](const db::SampleRow& r) { db::append_csv_row(buf, r), flush(false); });
+      flush(true);
+    });
+  } catch (const db::PgError& e) {
+    throw CliError("the lab database: " + one_line(e.what()));
+  }
+  return 0;
 }
 
 // HDF5 beside the target, then renamed: the export removes its own file when it fails.
@@ -103,9 +146,18 @@ int run_runs_cmd(const Args& args) {
     return 2;
   }
   const bool positional = args.size() > 1 && !args[1].starts_with("-");
-  const Options opt(Args(args.begin() + (positional ? 2 : 1), args.end()), {"db", "output", "format", "campaign"}, {});
+  const Options opt(Args(args.begin() + (positional ? 2 : 1), args.end()), {"db", "output", "format", "campaign", "pg", "pg-password-file", "daemon", "lab"},
+                    {});
   const std::string format = opt.get("format", "csv");
   if (format != "csv" && format != "h5") throw CliError("--format: '" + format + "' is not csv or h5");
+  if (opt.has("pg") || opt.has("daemon") || opt.has("lab") || opt.has("pg-password-file")) {  // from the lab database
+    if (opt.has("db")) throw CliError("--db and --pg name two sources: give one (the daemon's file, or the lab database)");
+    if (opt.has("campaign") || format == "h5")
+      throw CliError("--pg: HDF5 is exported from the daemon's own file (--db); from the lab database, a run's samples as CSV only");
+    if (!positional) throw CliError("give RUN_ID (see --help)");
+    if (!opt.has("daemon")) throw CliError("--pg: give --daemon NAME, the daemon whose run it is (hystlab lab campaigns lists them)");
+    return export_lab_csv(opt, whole_number(args[1], "RUN_ID"));
+  }
   if (positional == opt.has("campaign")) throw CliError("give one of RUN_ID or --campaign ID (see --help)");
   if (opt.has("campaign") && format != "h5") throw CliError("--campaign: a whole campaign is exported as HDF5 only (--format h5)");
   const std::int64_t id = positional ? whole_number(args[1], "RUN_ID") : whole_number(opt.get("campaign"), "--campaign");

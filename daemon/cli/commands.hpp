@@ -24,6 +24,7 @@ int run_rig_cmd(const Args& args);
 int run_report(const Args& args);
 int run_tables_cmd(const Args& args);
 int run_runs_cmd(const Args& args);
+int run_lab_cmd(const Args& args);
 int run_simulate(const Args& args);
 int run_export(const Args& args);
 // Writes a table or parameter document in an export format (hystlab export, tables export).

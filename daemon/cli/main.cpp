@@ -55,6 +55,12 @@ With hystlabd (commands over its HTTP API; records read from its database file):
              a run's samples as CSV or HDF5, or a whole campaign as HDF5 (--campaign ID)
   report ID -o FILE.html|FILE.pdf
              a campaign's report (HTML, or PDF through Chromium) from the running daemon
+
+A lab of many rigs (the lab database every daemon replicates into: --pg URL):
+  lab campaigns|tables|show|compare
+             every daemon's campaigns and tables; one campaign; one specimen's tables ranked across rigs
+  runs export RUN_ID --pg URL --daemon NAME
+             a run's samples from the lab, as CSV (the same bytes as from the daemon's file)
 )";
 
 // kUsage with the export formats filled in.
@@ -79,6 +85,7 @@ int dispatch(const std::string& verb, const Args& args) {
   if (verb == "rig") return run_rig_cmd(args);
   if (verb == "tables") return run_tables_cmd(args);
   if (verb == "runs") return run_runs_cmd(args);
+  if (verb == "lab") return run_lab_cmd(args);
   if (verb == "simulate") return run_simulate(args);
   if (verb == "export") return run_export(args);
   if (verb == "report") return run_report(args);

@@ -1,6 +1,7 @@
 #include "hystlab/db/lab_reads.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <iterator>
@@ -96,17 +97,29 @@ std::optional<LabCampaign> LabReads::campaign(const std::string& daemon, std::in
   return c;
 }
 
-std::vector<LabRun> LabReads::runs(int daemon_id, std::int64_t campaign) {
-  const std::string d = std::to_string(daemon_id), c = std::to_string(campaign);
-  const PgResult r = pg_.query(
+namespace {
+// The runs of a daemon that match `where` ($1 the daemon, $2 the campaign or the run).
+std::vector<LabRun> runs_where(PgConnection& pg, const std::string& where, int daemon_id, std::int64_t key) {
+  const std::string d = std::to_string(daemon_id), c = std::to_string(key);
+  const PgResult r = pg.query(
       "SELECT u.id, coalesce(u.role, ''), coalesce(u.state, ''), coalesce(u.started_at::text, ''), coalesce(u.ended_at::text, ''), "
-      "coalesce(m.mark + 1, 0), m.tbl = 'shaker_samples' FROM hystlab.runs u LEFT JOIN hystlab.marks m ON m.daemon_id = u.daemon_id "
-      "AND m.tbl IN ('samples', 'shaker_samples') AND m.key = u.id WHERE u.daemon_id = $1 AND u.campaign_id = $2 ORDER BY u.id",
+      "coalesce(m.mark + 1, 0), m.tbl = 'shaker_samples', coalesce(u.campaign_id, 0) FROM hystlab.runs u LEFT JOIN hystlab.marks m "
+      "ON m.daemon_id = u.daemon_id AND m.tbl IN ('samples', 'shaker_samples') AND m.key = u.id WHERE u.daemon_id = $1 AND " +
+          where + " ORDER BY u.id",
       {d.c_str(), c.c_str()});
   std::vector<LabRun> out;
   for (int k = 0; k < r.rows(); ++k)
-    out.push_back({r.integer(k, 0), r.integer(k, 5), r.text(k, 1), r.text(k, 2), r.text(k, 3), r.text(k, 4), opt(r, k, 6) == "t"});
+    out.push_back({r.integer(k, 0), r.integer(k, 5), r.text(k, 1), r.text(k, 2), r.text(k, 3), r.text(k, 4), opt(r, k, 6) == "t", r.integer(k, 7)});
   return out;
+}
+}  // namespace
+
+std::vector<LabRun> LabReads::runs(int daemon_id, std::int64_t campaign) { return runs_where(pg_, "u.campaign_id = $2", daemon_id, campaign); }
+
+std::optional<LabRun> LabReads::run(int daemon_id, std::int64_t id) {
+  auto found = runs_where(pg_, "u.id = $2", daemon_id, id);
+  if (found.empty()) return std::nullopt;
+  return std::move(found.front());
 }
 
 std::vector<LabEvent> LabReads::events(int daemon_id, std::int64_t campaign, int limit) {
@@ -187,6 +200,40 @@ void LabReads::for_each_sample(int daemon_id, std::int64_t run, bool shaker, con
       f(after, row);
     }
   }
+}
+
+namespace {
+// Every row of a run's samples in seq order, `cols` (after seq) NULL as 0, in chunks of 50000.
+void for_each_row(PgConnection& pg, const std::string& table, const std::string& cols, int daemon_id, std::int64_t run,
+                  const std::function<void(const PgResult&, int)>& f) {
+  const std::string d = std::to_string(daemon_id), u = std::to_string(run);
+  std::int64_t after = -1;
+  for (;;) {
+    const std::string a = std::to_string(after);
+    const PgResult r = pg.query("SELECT seq, " + cols + " FROM " + table + " WHERE daemon_id = $1 AND run_id = $2 AND seq > $3 ORDER BY seq LIMIT 50000",
+                                {d.c_str(), u.c_str(), a.c_str()});
+    if (r.rows() == 0) return;
+    for (int k = 0; k < r.rows(); ++k) f(r, k);
+    after = r.integer(r.rows() - 1, 0);
+  }
+}
+}  // namespace
+
+void LabReads::for_each_frame_row(int daemon_id, std::int64_t run, const std::function<void(const SampleRow&)>& f) {
+  for_each_row(pg_, "hystlab.samples", "t, coalesce(cmd, 0), coalesce(disp, 0), coalesce(force, 0), coalesce(status, 0)", daemon_id, run,
+               [&](const PgResult& r, int k) {
+                 f(SampleRow{run, r.integer(k, 0), num(r, k, 1), num(r, k, 2), num(r, k, 3), num(r, k, 4), r.integer(k, 5)});
+               });
+}
+
+void LabReads::for_each_shaker_row(int daemon_id, std::int64_t run, const std::function<void(const ShakerRow&)>& f) {
+  std::string cols = "t";
+  for (std::size_t c = 1; c < std::size(kShakerColumns); ++c) cols += ", coalesce(" + std::string(kShakerColumns[c]) + ", 0)";
+  for_each_row(pg_, "hystlab.shaker_samples", cols + ", coalesce(status, 0)", daemon_id, run, [&](const PgResult& r, int k) {
+    std::array<double, 6> v{};
+    for (int c = 0; c < 6; ++c) v[static_cast<std::size_t>(c)] = num(r, k, c + 2);
+    f(ShakerRow{run, r.integer(k, 0), num(r, k, 1), domain::shaker_sample(v), r.integer(k, 8)});
+  });
 }
 
 }  // namespace hystlab::db

@@ -26,6 +26,15 @@ std::string trimmed(const char* m) {
 }
 }  // namespace
 
+bool conninfo_has_password(std::string_view conninfo) noexcept {
+  const bool url = conninfo.starts_with("postgresql://") || conninfo.starts_with("postgres://");
+  if (!url) return conninfo.find("password") != std::string_view::npos;
+  const std::size_t start = conninfo.find("://") + 3;
+  const std::size_t at = conninfo.find('@', start), slash = conninfo.find('/', start), colon = conninfo.find(':', start);
+  if (at != std::string_view::npos && (slash == std::string_view::npos || at < slash) && colon < at) return true;
+  return conninfo.find("password=") != std::string_view::npos;
+}
+
 PgResult::~PgResult() { PQclear(r_); }
 int PgResult::rows() const noexcept { return PQntuples(r_); }
 bool PgResult::is_null(int row, int col) const noexcept { return PQgetisnull(r_, row, col) != 0; }

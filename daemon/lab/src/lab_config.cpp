@@ -1,5 +1,7 @@
 #include "hystlab/lab/lab_config.hpp"
 
+#include "hystlab/db/pg.hpp"
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -44,20 +46,11 @@ std::string secret(const json& section, const std::string& prefix, const std::st
 }
 
 // libpq takes a URL (postgresql://user:password@host/db) or key=value pairs (password=...): a
-// password in either would put it in the config's JSON, which is refused.
+// password in either would put it in the config's JSON, which is refused (db::conninfo_has_password,
+// which `hystlab lab --pg` asks too).
 void refuse_inline_password(const std::string& conninfo) {
-  const bool url = conninfo.rfind("postgresql://", 0) == 0 || conninfo.rfind("postgres://", 0) == 0;
-  if (url) {
-    const std::size_t start = conninfo.find("://") + 3;
-    const std::size_t at = conninfo.find('@', start), slash = conninfo.find('/', start);
-    const std::size_t colon = conninfo.find(':', start);
-    if (at != std::string::npos && (slash == std::string::npos || at < slash) && colon < at)
-      fail("postgresql", "holds a password: give it in lab.postgresql_password_file or lab.postgresql_password_env, never in the config");
-    if (conninfo.find("password=") != std::string::npos)
-      fail("postgresql", "holds a password: give it in lab.postgresql_password_file or lab.postgresql_password_env, never in the config");
-  } else if (conninfo.find("password") != std::string::npos) {
+  if (db::conninfo_has_password(conninfo))
     fail("postgresql", "holds a password: give it in lab.postgresql_password_file or lab.postgresql_password_env, never in the config");
-  }
 }
 
 MqttSettings parse_mqtt(const json& m, const std::string& base_dir, const char* (*env)(const char*)) {

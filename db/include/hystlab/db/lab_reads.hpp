@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hystlab/db/pg.hpp"
+#include "hystlab/db/store.hpp"
 
 namespace hystlab::db {
 
@@ -31,6 +32,7 @@ struct LabRun {
   std::int64_t id = 0, samples = 0;
   std::string role, state, started_at, ended_at;
   bool shaker = false;  // its samples are a shaker's
+  std::int64_t campaign = 0;
 };
 struct LabEvent {
   std::int64_t id = 0;
@@ -62,12 +64,19 @@ class LabReads {
   std::vector<LabCampaign> campaigns(const LabFilter& f);
   std::optional<LabCampaign> campaign(const std::string& daemon, std::int64_t id);
   std::vector<LabRun> runs(int daemon_id, std::int64_t campaign);
+  // One run of a daemon, or none (its campaign: campaign_of).
+  std::optional<LabRun> run(int daemon_id, std::int64_t id);
   std::vector<LabEvent> events(int daemon_id, std::int64_t campaign, int limit = 500);
   std::vector<LabTable> tables(const LabFilter& f);
   std::optional<std::string> table_document(const std::string& daemon, std::int64_t id);
   LabOverview overview(int daemon_id, std::int64_t run, bool shaker, int buckets);
   // Every sample of a run in seq order, columns as overview's; chunked reads (a run of any size).
   void for_each_sample(int daemon_id, std::int64_t run, bool shaker, const std::function<void(std::int64_t seq, const std::vector<double>&)>& f);
+  // Every sample of a run in seq order as the daemon's store gives it (status included, a NULL
+  // value 0 as SQLite reads one): an export from the lab writes the same bytes as one from the
+  // daemon's file (run_csv.hpp's append_csv_row). Chunked reads.
+  void for_each_frame_row(int daemon_id, std::int64_t run, const std::function<void(const SampleRow&)>& f);
+  void for_each_shaker_row(int daemon_id, std::int64_t run, const std::function<void(const ShakerRow&)>& f);
 
  private:
   PgConnection& pg_;

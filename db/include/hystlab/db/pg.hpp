@@ -70,6 +70,11 @@ class PgTransaction {
   bool done_ = false;
 };
 
+// True when conninfo (a URL or key=value pairs) holds a password: postgresql://user:secret@host/db,
+// ...?password=..., or password=... The config and the CLI refuse such a conninfo, each in its
+// own words: a password belongs in a file or the environment, never in a config or a command line.
+[[nodiscard]] bool conninfo_has_password(std::string_view conninfo) noexcept;
+
 // COPY's text format for one field: backslash, tab, newline and carriage return escaped.
 void append_copy_text(std::string& out, std::string_view field);
 // A double as the shortest text that reads back to the same bits (std::to_chars); NaN and the
