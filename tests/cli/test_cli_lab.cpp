@@ -122,7 +122,7 @@ struct Lab {
       shaker_samples(b, b.add_run(sweep, iso(40), 1.8e9, 0.0), 500, 4);
     }
     for (const auto& [path, daemon] : {std::pair{a_db, "frame-pc-1"}, std::pair{b_db, "frame-pc-2"}}) {
-      db::Replicator r(path, {"materials-lab", daemon, "test"}, server.url(), PostgresServer::kPassword);
+      db::Replicator r(path, {"materials-lab", daemon, "test", ""}, server.url(), PostgresServer::kPassword);
       bool done = false;
       for (int k = 0; k < 50 && !done; ++k) done = r.pass().caught_up;
       REQUIRE(done);
