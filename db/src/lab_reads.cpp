@@ -44,7 +44,8 @@ std::vector<LabDaemon> LabReads::daemons(const std::string& lab) {
       "WHERE $1 = '' OR lab = $1 ORDER BY lab, name",
       {lab.c_str()});
   std::vector<LabDaemon> out;
-  for (int k = 0; k < r.rows(); ++k) out.push_back({static_cast<int>(r.integer(k, 0)), r.text(k, 1), r.text(k, 2), r.text(k, 3), r.text(k, 4), r.text(k, 5), r.text(k, 6)});
+  for (int k = 0; k < r.rows(); ++k)
+    out.push_back({static_cast<int>(r.integer(k, 0)), r.text(k, 1), r.text(k, 2), r.text(k, 3), r.text(k, 4), r.text(k, 5), r.text(k, 6)});
   return out;
 }
 

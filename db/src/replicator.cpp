@@ -140,6 +140,11 @@ std::vector<std::int64_t> Replicator::pg_ids(const char* sql) {
 
 PassResult Replicator::pass(int max_batches) {
   if (!connected()) connect();
+  // The lab sees this daemon alive (hystlab.daemons.last_seen), at most every 10 s.
+  if (const auto now = std::chrono::steady_clock::now(); now - last_seen_ > std::chrono::seconds(10)) {
+    pg_->query("UPDATE hystlab.daemons SET last_seen = now() WHERE id = $1", {daemon_text_.c_str()});
+    last_seen_ = now;
+  }
   PassResult out;
   bool more = false;
   std::int64_t backlog = 0;

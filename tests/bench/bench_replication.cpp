@@ -19,10 +19,11 @@
 //    name each time: everything in SQLite is backlog), seconds and rows/s; and the bytes one
 //    sample row takes in PostgreSQL (table and primary key, pg_total_relation_size).
 // 3. Replication lag during a 1 kHz campaign (target p99 < 1 s) and the missed deadlines added
-//    by replication and MQTT together (target 0): three hystlabd processes one after the other,
+//    by replication and MQTT together (target 0): two hystlabd processes one after the other,
 //    a simulated load frame at time scale 1 each, the same 1 kHz FOT campaign for the same time;
-//    the first without a lab section (the baseline), then two with lab.postgresql and lab.mqtt:
-//    replicate_every_s at its default (1 s) and at --replicate-every-s (0.5 s). lag_s (GET
+//    the first without a lab section (the baseline), then one with lab.postgresql and lab.mqtt,
+//    replicate_every_s at its default (0.5 s; 1 s gave p99 1.07 s), and a third at
+//    --replicate-every-s P when asked. lag_s (GET
 //    /api/status, lab.postgresql) is the age of the newest instant at which everything SQLite
 //    held was in PostgreSQL (the start of the newest pass that left nothing behind), sampled
 //    every 100 ms. PostgreSQL and mosquitto stand for the lab's servers on other machines: as
@@ -79,8 +80,8 @@ const char* met(bool ok) { return ok ? "met" : "NOT met"; }
 struct Options {
   std::int64_t samples = 1'000'000;
   int runs = 4, reps = 3;
-  std::size_t batch = 20000;                        // the replication thread's default (lab_config.hpp)
-  double campaign_s = 20, replicate_every_s = 0.5;  // the second lab daemon's (the first: the default, 1 s)
+  std::size_t batch = 20000;                      // the replication thread's default (lab_config.hpp)
+  double campaign_s = 20, replicate_every_s = 0;  // > 0: a third daemon at this period (the second: the default)
 };
 
 // A load frame's campaign: a slow triangle with noise, so every double is a full-precision one.
@@ -359,8 +360,10 @@ int main(int argc, char** argv) {
     std::printf("   without a lab section (the baseline): %llu missed deadlines (%llu samples, %llu late wake-ups)\n",
                 static_cast<unsigned long long>(base.missed), static_cast<unsigned long long>(base.samples), static_cast<unsigned long long>(base.late));
     long long added = 0;
-    // replicate_every_s: the default (the section without it), then the period asked for.
-    for (const double period : {0.0, o.replicate_every_s}) {
+    // replicate_every_s: the default (the section without it), then the period asked for, if any.
+    std::vector<double> periods{0.0};
+    if (o.replicate_every_s > 0) periods.push_back(o.replicate_every_s);
+    for (const double period : periods) {
       const std::string name = "bench-pc-" + std::to_string(period == 0 ? 1 : 2);  // a daemon's own marks: one name a database
       nlohmann::json section{{"name", "bench-lab"},
                              {"daemon", name},

@@ -19,7 +19,7 @@ inline const char* kFotPlan = R"({"kind": "fot", "range_mm": [0, 4], "subdivisio
                                   "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 400, "rate_mm_s": 50}})";
 
 struct LabDaemonOptions {
-  std::string name;                // lab.daemon; empty with view: the lab view
+  std::string name;  // lab.daemon; empty with view: the lab view
   std::string password_env = "HYSTLAB_TEST_PG_PASSWORD";
   int mqtt_port = 0;               // 0: no lab.mqtt
   bool view = false;               // no rigs: the lab view

@@ -149,6 +149,11 @@ TEST_CASE("replication: every row once, samples equal to the bit, changes follow
   });
   CHECK(n == 23456 + 777);
   CHECK(ordered);
+  // docs/LAB.md's example query, as written there.
+  const db::PgResult held = pg.query(
+      "SELECT daemon, table_id, method, n, (accuracy::jsonb #>> '{held_out,overall,rms_N}')::float8 AS held_out_rms_N\n"
+      "      FROM hystlab.lab_tables WHERE specimen LIKE 'SMA spring%' ORDER BY 5;");
+  CHECK(held.rows() == 1);
 }
 
 TEST_CASE("replication: PostgreSQL stopped mid-campaign and started again, or a batch cut off: caught up, nothing lost or doubled") {
@@ -206,8 +211,8 @@ TEST_CASE("replication: a wrong password, no server, a newer schema: one clear e
     CHECK(std::string(e.what()).find("not-the-password") == std::string::npos);
     CHECK(e.sqlstate == "28P01");
   }
-  db::Replicator nobody(path, {"materials-lab", "frame-pc-1", "test", ""}, "postgresql://hystlab@127.0.0.1:" + std::to_string(test_support::free_port()) + "/lab",
-                        PostgresServer::kPassword);
+  db::Replicator nobody(path, {"materials-lab", "frame-pc-1", "test", ""},
+                        "postgresql://hystlab@127.0.0.1:" + std::to_string(test_support::free_port()) + "/lab", PostgresServer::kPassword);
   try {
     nobody.connect();
     FAIL("connected to no server");

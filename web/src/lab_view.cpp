@@ -65,48 +65,49 @@ db::LabFilter filter_of(const httplib::Request& req, const std::string& lab) {
 
 void add_lab_routes(httplib::Server& s, LabView::Impl& m) {
   s.Get("/api/status", guarded([&m](const httplib::Request&, httplib::Response& res) {
-    const json live = m.live ? m.live() : json::object();
-    send_json(res, {{"name", "hystlabd"},
-                    {"mode", "lab view"},
-                    {"version", HYSTLAB_VERSION},
-                    {"lab", {{"name", m.lab.name}, {"postgresql", m.pg_status()}, {"mqtt", mqtt_status(live)}}}});
-  }));
+          const json live = m.live ? m.live() : json::object();
+          send_json(res, {{"name", "hystlabd"},
+                          {"mode", "lab view"},
+                          {"version", HYSTLAB_VERSION},
+                          {"lab", {{"name", m.lab.name}, {"postgresql", m.pg_status()}, {"mqtt", mqtt_status(live)}}}});
+        }));
   s.Get("/api/lab", guarded([&m](const httplib::Request&, httplib::Response& res) {
-    const json live = m.live ? m.live() : json::object();
-    m.with_lab(res, [&](db::LabReads& r) { send_json(res, lab_overview_json(m.lab.name, r.daemons(m.lab.name), r.rigs(m.lab.name), live)); });
-  }));
+          const json live = m.live ? m.live() : json::object();
+          m.with_lab(res, [&](db::LabReads& r) { send_json(res, lab_overview_json(m.lab.name, r.daemons(m.lab.name), r.rigs(m.lab.name), live)); });
+        }));
   s.Get("/api/lab/campaigns", guarded([&m](const httplib::Request& req, httplib::Response& res) {
-    const db::LabFilter f = filter_of(req, m.lab.name);
-    m.with_lab(res, [&](db::LabReads& r) { send_json(res, campaigns_json(r.campaigns(f))); });
-  }));
+          const db::LabFilter f = filter_of(req, m.lab.name);
+          m.with_lab(res, [&](db::LabReads& r) { send_json(res, campaigns_json(r.campaigns(f))); });
+        }));
   s.Get(R"(/api/lab/campaigns/([^/]+)/(\d+))", guarded([&m](const httplib::Request& req, httplib::Response& res) {
-    const std::string daemon = req.matches[1].str();
-    const std::int64_t id = path_id(req, 2);
-    m.with_lab(res, [&](db::LabReads& r) {
-      const auto c = r.campaign(daemon, id);
-      if (!c || c->lab != m.lab.name) return send_error(res, 404, "not found", "no campaign " + std::to_string(id) + " of daemon '" + daemon + "' in lab " + m.lab.name);
-      db::LabFilter tables_of{m.lab.name, daemon, {}, {}, 500};
-      std::vector<db::LabTable> tables;
-      for (db::LabTable& t : r.tables(tables_of))
-        if (t.campaign == id) tables.push_back(std::move(t));
-      send_json(res, campaign_json(*c, r.runs(c->daemon_id, id), r.events(c->daemon_id, id), tables));
-    });
-  }));
+          const std::string daemon = req.matches[1].str();
+          const std::int64_t id = path_id(req, 2);
+          m.with_lab(res, [&](db::LabReads& r) {
+            const auto c = r.campaign(daemon, id);
+            if (!c || c->lab != m.lab.name)
+              return send_error(res, 404, "not found", "no campaign " + std::to_string(id) + " of daemon '" + daemon + "' in lab " + m.lab.name);
+            db::LabFilter tables_of{m.lab.name, daemon, {}, {}, 500};
+            std::vector<db::LabTable> tables;
+            for (db::LabTable& t : r.tables(tables_of))
+              if (t.campaign == id) tables.push_back(std::move(t));
+            send_json(res, campaign_json(*c, r.runs(c->daemon_id, id), r.events(c->daemon_id, id), tables));
+          });
+        }));
   s.Get(R"(/api/lab/runs/([^/]+)/(\d+)/overview)", guarded([&m](const httplib::Request& req, httplib::Response& res) {
-    const std::string daemon = req.matches[1].str();
-    const std::int64_t run = path_id(req, 2);
-    const int buckets = static_cast<int>(query_number(req, "buckets", 600, 10, 5000));
-    const bool shaker = req.get_param_value("shaker") == "1";
-    m.with_lab(res, [&](db::LabReads& r) {
-      for (const db::LabDaemon& d : r.daemons(m.lab.name))
-        if (d.name == daemon) return send_json(res, overview_json(r.overview(d.id, run, shaker, buckets)));
-      send_error(res, 404, "not found", "no daemon '" + daemon + "' in lab " + m.lab.name);
-    });
-  }));
+          const std::string daemon = req.matches[1].str();
+          const std::int64_t run = path_id(req, 2);
+          const int buckets = static_cast<int>(query_number(req, "buckets", 600, 10, 5000));
+          const bool shaker = req.get_param_value("shaker") == "1";
+          m.with_lab(res, [&](db::LabReads& r) {
+            for (const db::LabDaemon& d : r.daemons(m.lab.name))
+              if (d.name == daemon) return send_json(res, overview_json(r.overview(d.id, run, shaker, buckets)));
+            send_error(res, 404, "not found", "no daemon '" + daemon + "' in lab " + m.lab.name);
+          });
+        }));
   s.Get("/api/lab/tables", guarded([&m](const httplib::Request& req, httplib::Response& res) {
-    const db::LabFilter f = filter_of(req, m.lab.name);
-    m.with_lab(res, [&](db::LabReads& r) { send_json(res, tables_json(r.tables(f))); });
-  }));
+          const db::LabFilter f = filter_of(req, m.lab.name);
+          m.with_lab(res, [&](db::LabReads& r) { send_json(res, tables_json(r.tables(f))); });
+        }));
 }
 }  // namespace
 

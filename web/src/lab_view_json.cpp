@@ -90,7 +90,8 @@ json campaigns_json(const std::vector<db::LabCampaign>& campaigns) {
   return out;
 }
 
-json campaign_json(const db::LabCampaign& c, const std::vector<db::LabRun>& runs, const std::vector<db::LabEvent>& events, const std::vector<db::LabTable>& tables) {
+json campaign_json(const db::LabCampaign& c, const std::vector<db::LabRun>& runs, const std::vector<db::LabEvent>& events,
+                   const std::vector<db::LabTable>& tables) {
   json j = campaign_row(c);
   j["plan"] = parsed(c.plan);
   json rs = json::array(), es = json::array(), ts = json::array();
@@ -103,7 +104,8 @@ json campaign_json(const db::LabCampaign& c, const std::vector<db::LabRun>& runs
                   {"samples", r.samples},
                   {"signals", r.shaker ? "shaker" : "load_frame"}});
   for (const db::LabEvent& e : events)
-    es.push_back({{"id", e.id}, {"at", e.at}, {"kind", e.kind}, {"from", text_or_null(e.from_state)}, {"to", text_or_null(e.to_state)}, {"detail", parsed(e.detail)}});
+    es.push_back(
+        {{"id", e.id}, {"at", e.at}, {"kind", e.kind}, {"from", text_or_null(e.from_state)}, {"to", text_or_null(e.to_state)}, {"detail", parsed(e.detail)}});
   for (const db::LabTable& t : tables) ts.push_back(table_row(t));
   j["runs"] = rs;
   j["events"] = es;

@@ -132,6 +132,11 @@ async function showCampaign(daemon, id) {
   }
 }
 
+// The plot follows the page's width (a window resized, a phone turned).
+window.addEventListener('resize', () => {
+  if (plot) plot.setSize({ width: Math.max(320, $('lab-plot').clientWidth), height: 260 });
+});
+
 $('lab-filter').addEventListener('submit', (ev) => {
   ev.preventDefault();
   refreshCampaigns();

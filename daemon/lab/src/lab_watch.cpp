@@ -3,14 +3,14 @@
 #include <mosquitto.h>
 
 #include <algorithm>
-#include <cctype>
-#include <string>
-#include <vector>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "mqtt_connection.hpp"
 #include "mqtt_payloads.hpp"
@@ -99,7 +99,8 @@ struct LabWatch::Impl final : detail::MqttListener {
   // One connection's life: connect, subscribe once accepted, loop until lost or stopped.
   void session(detail::MqttConnection& c) {
     const std::string prefix = "hystlab/" + config.name + "/";
-    if (const int rc = c.connect(); rc != MOSQ_ERR_SUCCESS) return fail("cannot reach the broker at " + settings.host + ":" + std::to_string(settings.port) + ": " + c.error_text(rc));
+    if (const int rc = c.connect(); rc != MOSQ_ERR_SUCCESS)
+      return fail("cannot reach the broker at " + settings.host + ":" + std::to_string(settings.port) + ": " + c.error_text(rc));
     while (!stop_asked()) {
       if (const int rc = c.loop(100); rc != MOSQ_ERR_SUCCESS) return fail("the broker's connection: " + c.error_text(rc));
       bool sub = false;

@@ -50,7 +50,7 @@ MqttConnection::MqttConnection(const MqttSettings& s, const std::string& will_to
     mosquitto_message_callback_set(m_, on_message);
     if (!will_topic.empty())
       check(mosquitto_will_set(m_, will_topic.c_str(), static_cast<int>(will_payload.size()), will_payload.data(), 1, true), "client_id",
-          "the will on '" + will_topic + "'");
+            "the will on '" + will_topic + "'");
     if (!s.username.empty()) check(mosquitto_username_pw_set(m_, s.username.c_str(), or_null(s.password)), "username", "refused");
     if (!s.ca_file.empty())
       check(mosquitto_tls_set(m_, s.ca_file.c_str(), nullptr, or_null(s.cert_file), or_null(s.key_file), nullptr), "ca_file",

@@ -21,6 +21,7 @@ class MqttListener {
     (void)topic;
     (void)payload;
   }
+
  protected:
   ~MqttListener() = default;
 };

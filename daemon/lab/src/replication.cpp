@@ -71,8 +71,8 @@ void ReplicationThread::run() noexcept {
     bool again = false;
     try {
       if (!rep)
-        rep = std::make_unique<db::Replicator>(daemon_.db_path(), db::ReplicaIdentity{config_.name, config_.daemon, software_, config_.url}, config_.postgres.conninfo,
-                                               config_.postgres.password, config_.postgres.batch_rows);
+        rep = std::make_unique<db::Replicator>(daemon_.db_path(), db::ReplicaIdentity{config_.name, config_.daemon, software_, config_.url},
+                                               config_.postgres.conninfo, config_.postgres.password, config_.postgres.batch_rows);
       const double began = mono_s();
       const db::PassResult r = rep->pass(10);
       again = !r.caught_up;

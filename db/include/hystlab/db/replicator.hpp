@@ -88,6 +88,7 @@ class Replicator {
   std::string daemon_text_;
   std::map<std::pair<std::string, std::int64_t>, std::int64_t> marks_;  // (table, key) -> mark, as committed
   std::int64_t backlog_samples_ = 0;
+  std::chrono::steady_clock::time_point last_seen_{};
   std::set<std::string> temp_tables_;  // created on this connection
   std::string buf_;                    // COPY text, reused
 };

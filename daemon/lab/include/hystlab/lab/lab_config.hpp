@@ -25,7 +25,7 @@ struct LabConfigError : std::invalid_argument {
 struct PostgresTarget {
   std::string conninfo;            // a libpq URL or key=value string, without a password
   std::string password;            // from the file or the environment; empty: libpq's own (~/.pgpass, PGPASSWORD)
-  double period_s = 0.5;  // a pass this often when idle: p99 lag 0.55 s during a 1 kHz campaign (bench_replication; 1 s: 1.07 s)
+  double period_s = 0.5;           // a pass this often when idle: p99 lag 0.55 s during a 1 kHz campaign (bench_replication; 1 s: 1.07 s)
   std::size_t batch_rows = 20000;  // samples per transaction (each with its high-water mark)
 };
 
