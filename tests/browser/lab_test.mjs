@@ -76,6 +76,13 @@ try {
   await page.screenshot({ path: path.join(outDir, 'lab-800.png'), fullPage: true });
   const post = await fetch(base + '/api/campaigns', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: '{"plan": {}}' });
   check(post.status === 405, `read-only: a POST is refused (${post.status})`);
+  // A rig's own page (the card's link): its daemon's replication and broker in its header.
+  const own = await browser.newPage({ viewport: { width: 800, height: 700 } });
+  await own.goto(links[0]);
+  check(await wait(own, () => /^lab db lag \d+\.\d s.* · broker up$/.test(document.getElementById('lab-status').textContent), null, 'the lab status on the rig page'),
+        `the rig's own page says its lab link: "${await own.textContent('#lab-status')}"`);
+  await own.screenshot({ path: path.join(outDir, 'rig-page-lab-800.png') });
+  await own.close();
   // A daemon dies: the broker publishes its will, and the view says so.
   world.stdin.write('kill frame-pc-2\n');
   await said(/done: kill frame-pc-2/, 30000);

@@ -386,7 +386,22 @@ function setOnline(on) {
 async function refreshStatus() {
   const s = await api('/api/status');
   $('daemon').textContent = `hystlabd ${s.version}`;
+  showLab(s.lab);
   if (!rigPanel.rigs().length) planForm.setRigs(s.rigs);
+}
+
+// What this daemon shares with its lab (docs/LAB.md), when its config has a lab section: the
+// replication's lag and backlog, the broker's link; the reason of a failure on hover.
+function showLab(lab) {
+  const el = $('lab-status');
+  if (!lab) { el.hidden = true; return; }
+  const pg = lab.postgresql, mq = lab.mqtt, parts = [];
+  if (pg) parts.push(pg.connected ? `lab db lag ${pg.lag_s.toFixed(1)} s${pg.backlog_samples > 0 ? `, ${pg.backlog_samples} behind` : ''}` : 'lab db down');
+  if (mq) parts.push(mq.connected ? 'broker up' : 'broker down');
+  el.hidden = false;
+  el.className = 'link ' + ((!pg || pg.connected) && (!mq || mq.connected) ? 'up' : 'down');
+  el.textContent = parts.join(' · ');
+  el.title = [pg && pg.error, mq && mq.error].filter(Boolean).join('\n') || `lab ${lab.name}, as ${lab.daemon}`;
 }
 
 function onSamples(m) {
@@ -486,4 +501,5 @@ connect();
 setInterval(() => {
   const d = S.detail;
   if (S.online && d && !d.final) serial(refreshDetail)();
+  if (S.online && !$('lab-status').hidden) api('/api/status').then(s => showLab(s.lab), () => {});
 }, 5000);
