@@ -83,13 +83,13 @@ std::vector<LabCampaign> LabReads::campaigns(const LabFilter& f) {
   return out;
 }
 
-std::optional<LabCampaign> LabReads::campaign(const std::string& daemon, std::int64_t id) {
+std::optional<LabCampaign> LabReads::campaign(const std::string& daemon, std::int64_t id, const std::string& lab) {
   const std::string ids = std::to_string(id);
   const PgResult r = pg_.query(
       "SELECT v.daemon_id, v.lab, v.daemon, coalesce(v.rig, ''), v.campaign, v.kind, v.state, coalesce(v.specimen, ''), v.created_at::text, "
       "v.updated_at::text, c.plan::text FROM hystlab.lab_campaigns v JOIN hystlab.campaigns c ON c.daemon_id = v.daemon_id AND c.id = v.campaign "
-      "WHERE v.daemon = $1 AND v.campaign = $2",
-      {daemon.c_str(), ids.c_str()});
+      "WHERE v.daemon = $1 AND v.campaign = $2 AND ($3 = '' OR v.lab = $3)",
+      {daemon.c_str(), ids.c_str(), lab.c_str()});
   if (r.rows() == 0) return std::nullopt;
   LabCampaign c;
   c.daemon_id = static_cast<int>(r.integer(0, 0)), c.lab = r.text(0, 1), c.daemon = r.text(0, 2), c.rig = r.text(0, 3);
@@ -134,14 +134,11 @@ std::vector<LabEvent> LabReads::events(int daemon_id, std::int64_t campaign, int
   return out;
 }
 
-std::vector<LabTable> LabReads::tables(const LabFilter& f) {
-  std::vector<const char*> params;
-  const std::string limit = std::to_string(f.limit > 0 ? f.limit : 200);
-  const PgResult r = pg_.query(filtered("SELECT daemon_id, daemon, coalesce(specimen, ''), coalesce(method, ''), coalesce(created_at::text, ''), "
-                                        "coalesce(accuracy, ''), table_id, coalesce(campaign, 0), coalesce(n, 0), range_lo, range_hi FROM hystlab.lab_tables",
-                                        LabFilter{f.lab, f.daemon, f.specimen, {}, f.limit}, params) +
-                                   " ORDER BY specimen, created_at LIMIT " + limit,
-                               params);
+namespace {
+constexpr const char* kTableColumns =
+    "SELECT daemon_id, daemon, coalesce(specimen, ''), coalesce(method, ''), coalesce(created_at::text, ''), coalesce(accuracy, ''), table_id, "
+    "coalesce(campaign, 0), coalesce(n, 0), range_lo, range_hi FROM hystlab.lab_tables";
+std::vector<LabTable> tables_in(const PgResult& r) {
   std::vector<LabTable> out;
   for (int k = 0; k < r.rows(); ++k) {
     LabTable t;
@@ -151,6 +148,19 @@ std::vector<LabTable> LabReads::tables(const LabFilter& f) {
     out.push_back(std::move(t));
   }
   return out;
+}
+}  // namespace
+
+std::vector<LabTable> LabReads::tables(const LabFilter& f) {
+  std::vector<const char*> params;
+  const std::string limit = std::to_string(f.limit > 0 ? f.limit : 200);
+  return tables_in(
+      pg_.query(filtered(kTableColumns, LabFilter{f.lab, f.daemon, f.specimen, {}, f.limit}, params) + " ORDER BY specimen, created_at LIMIT " + limit, params));
+}
+
+std::vector<LabTable> LabReads::campaign_tables(int daemon_id, std::int64_t campaign) {
+  const std::string d = std::to_string(daemon_id), c = std::to_string(campaign);
+  return tables_in(pg_.query(std::string(kTableColumns) + " WHERE daemon_id = $1 AND campaign = $2 ORDER BY table_id", {d.c_str(), c.c_str()}));
 }
 
 std::optional<std::string> LabReads::table_document(const std::string& daemon, std::int64_t id) {

@@ -51,8 +51,11 @@ PgConnection::PgConnection(const std::string& conninfo, const std::string& passw
   const std::string timeout = std::to_string(connect_timeout_s);
   // dbname holding the whole conninfo with expand_dbname: a URL or key=value pairs, and the
   // keywords after it (a password, the timeout, the application's name) added to it.
-  const char* keys[] = {"dbname", "connect_timeout", "application_name", password.empty() ? nullptr : "password", nullptr};
-  const char* values[] = {conninfo.c_str(), timeout.c_str(), "hystlabd", password.empty() ? nullptr : password.c_str(), nullptr};
+  // TCP keep-alives and a user timeout before the conninfo (which overrides them): a server host
+  // gone mid-COPY fails the call within about 30 s, not the kernel's 15 min of retransmissions.
+  const char* keys[] = {"keepalives_idle", "keepalives_interval", "keepalives_count", "tcp_user_timeout", "dbname",
+                        "connect_timeout", "application_name", password.empty() ? nullptr : "password", nullptr};
+  const char* values[] = {"10", "5", "3", "30000", conninfo.c_str(), timeout.c_str(), "hystlabd", password.empty() ? nullptr : password.c_str(), nullptr};
   c_ = PQconnectdbParams(keys, values, 1);
   if (c_ == nullptr) throw PgError("PostgreSQL: out of memory", "");
   if (PQstatus(c_) != CONNECTION_OK) {

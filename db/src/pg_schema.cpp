@@ -23,7 +23,7 @@ std::string migration(int k) {
   if (k == 0)
     return R"sql(
 CREATE TABLE hystlab.daemons(
-  id serial PRIMARY KEY, lab text NOT NULL, name text NOT NULL, software text, url text,
+  id serial PRIMARY KEY, lab text NOT NULL, name text NOT NULL, software text, url text, store text,
   first_seen timestamptz NOT NULL DEFAULT now(), last_seen timestamptz NOT NULL DEFAULT now(), UNIQUE(lab, name));
 CREATE TABLE hystlab.marks(
   daemon_id integer NOT NULL, tbl text NOT NULL, key bigint NOT NULL, mark bigint NOT NULL, PRIMARY KEY(daemon_id, tbl, key));

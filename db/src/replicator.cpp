@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <functional>
 #include <set>
 #include <utility>
 
@@ -76,6 +77,19 @@ std::string json_ids(const std::vector<std::int64_t>& ids) {
   return s + "]";
 }
 
+// f(), a PostgreSQL error naming the table it was copying (one row refused stops replication
+// until it is mended: the status must say where).
+template <class F>
+std::int64_t naming(const char* table, F f) {
+  try {
+    return f();
+  } catch (const PgSchemaError&) {
+    throw;
+  } catch (const PgError& e) {
+    throw PgError(std::string(e.what()) + " (replicating " + table + ")", e.sqlstate);
+  }
+}
+
 std::string upsert_set(const char* columns, const char* key) {
   std::string set, col;
   const std::string cols = std::string(columns) + ",";
@@ -102,19 +116,33 @@ void Replicator::disconnect() noexcept { pg_.reset(); }
 void Replicator::connect() {
   pg_.reset();
   temp_tables_.clear();  // a session's temporary tables went with it
+  if (!lite_) lite_ = std::make_unique<Database>(sqlite_path_, false);
+  std::string store;
+  {
+    Statement st(*lite_, "SELECT id FROM store_identity");
+    if (!st.step()) throw DbError("the daemon's database '" + sqlite_path_ + "' has no identity (store_identity): not migrated", 0);
+    store = st.column_text(0);
+  }
   auto pg = std::make_unique<PgConnection>(conninfo_, password_);
   pg_migrate(*pg);
+  // This daemon's id in the lab, claimed by this SQLite file: another file under the same name
+  // (a second daemon given the same lab.daemon, or a new file) would start its ids again under
+  // the first one's marks and overwrite its rows; it is refused, naming the field.
   const PgResult d = pg->query(
-      "INSERT INTO hystlab.daemons(lab, name, software, url) VALUES($1, $2, $3, nullif($4, '')) "
-      "ON CONFLICT(lab, name) DO UPDATE SET software = excluded.software, url = excluded.url, last_seen = now() RETURNING id",
-      {id_.lab.c_str(), id_.daemon.c_str(), id_.software.c_str(), id_.url.c_str()});
+      "INSERT INTO hystlab.daemons(lab, name, software, url, store) VALUES($1, $2, $3, nullif($4, ''), $5) "
+      "ON CONFLICT(lab, name) DO UPDATE SET software = excluded.software, url = excluded.url, last_seen = now(), "
+      "store = coalesce(hystlab.daemons.store, excluded.store) RETURNING id, store",
+      {id_.lab.c_str(), id_.daemon.c_str(), id_.software.c_str(), id_.url.c_str(), store.c_str()});
+  if (d.text(0, 1) != store)
+    throw PgSchemaError("PostgreSQL: lab.daemon '" + id_.daemon + "' of lab '" + id_.lab + "' is replicated from another SQLite file (store " + d.text(0, 1) +
+                            "; this one is " + store + "): give this daemon a name of its own in lab.daemon",
+                        "");
   daemon_id_ = static_cast<int>(d.integer(0, 0));
   daemon_text_ = std::to_string(daemon_id_);
   // The marks as PostgreSQL committed them: after any failure, the truth is there, never here.
   marks_.clear();
   const PgResult m = pg->query("SELECT tbl, key, mark FROM hystlab.marks WHERE daemon_id = $1", {daemon_text_.c_str()});
   for (int r = 0; r < m.rows(); ++r) marks_[{m.text(r, 0), m.integer(r, 1)}] = m.integer(r, 2);
-  if (!lite_) lite_ = std::make_unique<Database>(sqlite_path_, false);
   pg_ = std::move(pg);
 }
 
@@ -148,11 +176,11 @@ PassResult Replicator::pass(int max_batches) {
   PassResult out;
   bool more = false;
   std::int64_t backlog = 0;
-  for (const Spec& s : kSamples) out.samples += copy_samples(s, max_batches, more, backlog);
+  for (const Spec& s : kSamples) out.samples += naming(s.name, [&] { return copy_samples(s, max_batches, more, backlog); });
   backlog_samples_ = backlog;
   out.rows += out.samples;
-  for (const Spec& s : kAppended) out.rows += copy_appended(s);
-  out.rows += copy_changing();
+  for (const Spec& s : kAppended) out.rows += naming(s.name, [&] { return copy_appended(s); });
+  out.rows += naming("campaigns, runs, sweep points, loops and rigs", [&] { return copy_changing(); });
   out.caught_up = !more;
   return out;
 }
@@ -170,8 +198,12 @@ std::int64_t Replicator::copy_samples(const Spec& s, int max_batches, bool& more
   for (const std::int64_t run : runs) {
     newest.reset();
     newest.bind(1, run);
-    if (!newest.step() || newest.column_is_null(0)) continue;
+    if (!newest.step() || newest.column_is_null(0)) {
+      newest.reset();
+      continue;
+    }
     const std::int64_t upto = newest.column_int(0);
+    newest.reset();  // no read transaction left open across the COPYs below
     std::int64_t from = mark(s.name, run);
     while (from < upto) {
       if (batches >= max_batches) {
@@ -190,18 +222,20 @@ std::int64_t Replicator::copy_samples(const Spec& s, int max_batches, bool& more
 }
 
 std::int64_t Replicator::copy_run_samples(const Spec& s, std::int64_t run, std::int64_t from) {
-  Statement st(*lite_, std::string("SELECT ") + s.columns + " FROM " + s.name + " WHERE run_id = ? AND seq > ? ORDER BY seq LIMIT ?");
-  st.bind(1, run).bind(2, from).bind(3, static_cast<std::int64_t>(batch_rows_));
   const int columns = column_count(s.columns);
   buf_.clear();
   std::int64_t n = 0, last = from;
-  while (st.step()) {
-    buf_ += daemon_text_;
-    buf_ += '\t';
-    append_int(buf_, run);
-    encode_row(st, columns, buf_);
-    last = st.column_int(0);
-    ++n;
+  {  // the statement finalized (its read ended) before PostgreSQL is called
+    Statement st(*lite_, std::string("SELECT ") + s.columns + " FROM " + s.name + " WHERE run_id = ? AND seq > ? ORDER BY seq LIMIT ?");
+    st.bind(1, run).bind(2, from).bind(3, static_cast<std::int64_t>(batch_rows_));
+    while (st.step()) {
+      buf_ += daemon_text_;
+      buf_ += '\t';
+      append_int(buf_, run);
+      encode_row(st, columns, buf_);
+      last = st.column_int(0);
+      ++n;
+    }
   }
   if (n == 0) return 0;
   PgTransaction tx(*pg_);
@@ -217,15 +251,17 @@ std::int64_t Replicator::copy_appended(const Spec& s) {
   std::int64_t total = 0;
   const int columns = column_count(s.columns);
   for (;;) {
-    Statement st(*lite_, std::string("SELECT ") + s.columns + " FROM " + s.name + " WHERE id > ? ORDER BY id LIMIT ?");
-    st.bind(1, mark(s.name, 0)).bind(2, static_cast<std::int64_t>(batch_rows_));
     buf_.clear();
     std::int64_t n = 0, last = 0;
-    while (st.step()) {
-      buf_ += daemon_text_;
-      encode_row(st, columns, buf_);
-      last = st.column_int(0);
-      ++n;
+    {  // finalized before PostgreSQL is called
+      Statement st(*lite_, std::string("SELECT ") + s.columns + " FROM " + s.name + " WHERE id > ? ORDER BY id LIMIT ?");
+      st.bind(1, mark(s.name, 0)).bind(2, static_cast<std::int64_t>(batch_rows_));
+      while (st.step()) {
+        buf_ += daemon_text_;
+        encode_row(st, columns, buf_);
+        last = st.column_int(0);
+        ++n;
+      }
     }
     if (n == 0) return total;
     PgTransaction tx(*pg_);
@@ -238,60 +274,81 @@ std::int64_t Replicator::copy_appended(const Spec& s) {
   }
 }
 
-// Rows selected by `where` (?1: a JSON list of ids), upserted; with_mark: the table's mark (key
-// 0) moved to the largest first column. Returns the first column of every row.
-std::vector<std::int64_t> Replicator::upsert(const Spec& s, const std::string& where, const std::string& ids, bool with_mark) {
+// Rows selected by `where` (?1: a JSON list of ids) as COPY text, with their first column (an id).
+Replicator::Rows Replicator::read_rows(const Spec& s, const std::string& where, const std::string& ids) {
+  Rows out;
   Statement st(*lite_, std::string("SELECT ") + s.columns + " FROM " + s.name + " WHERE " + where);
   if (where.find("?1") != std::string::npos) st.bind(1, std::string_view(ids));
   const int columns = column_count(s.columns);
-  buf_.clear();
-  std::vector<std::int64_t> seen;
   while (st.step()) {
-    buf_ += daemon_text_;
-    encode_row(st, columns, buf_);
-    seen.push_back(st.column_int(0));
+    out.text += daemon_text_;
+    encode_row(st, columns, out.text);
+    out.ids.push_back(st.column_int(0));
   }
-  if (seen.empty()) return seen;
-  const std::string temp = std::string("up_") + s.name;
-  if (temp_tables_.insert(temp).second) pg_->exec("CREATE TEMP TABLE IF NOT EXISTS " + temp + " (LIKE hystlab." + s.name + ") ON COMMIT DELETE ROWS");
-  PgTransaction tx(*pg_);
-  pg_->copy_in("COPY " + temp + "(daemon_id, " + s.columns + ") FROM STDIN", buf_);
-  pg_->exec("INSERT INTO hystlab." + std::string(s.name) + " SELECT * FROM " + temp + " ON CONFLICT (daemon_id, " + s.key + ") DO UPDATE SET " +
-            upsert_set(s.columns, s.key));
-  if (with_mark) save_mark(s.name, 0, std::max(mark(s.name, 0), *std::max_element(seen.begin(), seen.end())));
-  tx.commit();
-  if (with_mark) marks_[{s.name, 0}] = std::max(mark(s.name, 0), *std::max_element(seen.begin(), seen.end()));
-  return seen;
+  return out;
 }
 
-// Rows that change, read from one SQLite snapshot: a run's sweep points and loop figures before
-// the run itself, so that PostgreSQL never holds a run as ended without its last children (the
-// next pass reads a run's children again as long as PostgreSQL holds it open).
+// The rows upserted in one transaction, with the table's mark (key 0) moved to `new_mark` when >=
+// 0 and `also` (more statements of the same transaction) before the commit. An unchanged row is
+// not written again (no dead row for a campaign or rig read again every pass).
+void Replicator::write_upsert(const Spec& s, const Rows& rows, std::int64_t new_mark, const std::function<void()>& also) {
+  if (rows.ids.empty() && !also) return;
+  const std::string temp = std::string("up_") + s.name;
+  if (!rows.ids.empty() && temp_tables_.insert(temp).second)
+    pg_->exec("CREATE TEMP TABLE IF NOT EXISTS " + temp + " (LIKE hystlab." + s.name + ") ON COMMIT DELETE ROWS");
+  PgTransaction tx(*pg_);
+  if (!rows.ids.empty()) {
+    pg_->copy_in("COPY " + temp + "(daemon_id, " + s.columns + ") FROM STDIN", rows.text);
+    pg_->exec("INSERT INTO hystlab." + std::string(s.name) + " AS t SELECT * FROM " + temp + " ON CONFLICT (daemon_id, " + s.key + ") DO UPDATE SET " +
+              upsert_set(s.columns, s.key) + " WHERE (t.*) IS DISTINCT FROM (excluded.*)");
+  }
+  if (also) also();
+  if (new_mark >= 0) save_mark(s.name, 0, new_mark);
+  tx.commit();
+  if (new_mark >= 0) marks_[{s.name, 0}] = new_mark;
+}
+
+// Rows that change, read from one SQLite snapshot (a run's sweep points and loop figures with the
+// run itself, so that PostgreSQL never holds a run as ended without its last children: the next
+// pass reads a run's children again as long as PostgreSQL holds it open), then written, the
+// snapshot ended first (a PostgreSQL slow or gone never holds the SQLite file's WAL).
 std::int64_t Replicator::copy_changing() {
   const std::vector<std::int64_t> open_runs = pg_ids(kOpenRuns), open_campaigns = pg_ids(kOpenCampaigns);
   const std::string runs_ids = json_ids(open_runs), campaign_ids = json_ids(open_campaigns);
-  const std::string newer_runs = std::to_string(mark("runs", 0)), newer_campaigns = std::to_string(mark("campaigns", 0));
-  const std::string run_open = "(run_id IN (SELECT value FROM json_each(?1)) OR run_id > " + newer_runs + ")";
-  Transaction snapshot(*lite_, false);  // a read transaction: one snapshot for every read below
-  std::int64_t rows = 0;
-  rows += static_cast<std::int64_t>(
-      upsert(kSweepPoints, "id > " + std::to_string(mark(kSweepPoints.name, 0)) + " OR " + run_open + " ORDER BY id", runs_ids, true).size());
-  rows += static_cast<std::int64_t>(upsert(kLoops, run_open + " ORDER BY run_id, k", runs_ids, false).size());
-  const std::vector<std::int64_t> runs = upsert(kRuns, "id > " + newer_runs + " OR id IN (SELECT value FROM json_each(?1)) ORDER BY id", runs_ids, true);
-  rows += static_cast<std::int64_t>(runs.size());
+  const std::int64_t runs_mark = mark("runs", 0);
+  const std::string run_open = "(run_id IN (SELECT value FROM json_each(?1)) OR run_id > " + std::to_string(runs_mark) + ")";
+  Rows points, loops, runs, campaigns, rigs;
+  {
+    Transaction snapshot(*lite_, false);  // a read transaction: one snapshot for every read here
+    points = read_rows(kSweepPoints, "id > " + std::to_string(mark(kSweepPoints.name, 0)) + " OR " + run_open + " ORDER BY id", runs_ids);
+    loops = read_rows(kLoops, run_open + " ORDER BY run_id, k", runs_ids);
+    runs = read_rows(kRuns, "id > " + std::to_string(runs_mark) + " OR id IN (SELECT value FROM json_each(?1)) ORDER BY id", runs_ids);
+    campaigns = read_rows(kCampaigns, "id > " + std::to_string(mark("campaigns", 0)) + " OR id IN (SELECT value FROM json_each(?1)) ORDER BY id", campaign_ids);
+    rigs = read_rows(kRigs, "1 ORDER BY id", {});
+  }
+  const auto newest = [this](const Spec& s, const Rows& r) {
+    return r.ids.empty() ? -1 : std::max(mark(s.name, 0), *std::max_element(r.ids.begin(), r.ids.end()));
+  };
+  write_upsert(kSweepPoints, points, newest(kSweepPoints, points), {});
+  write_upsert(kLoops, loops, -1, {});
   // A run PostgreSQL holds open that SQLite no longer has (a validation run that never started
-  // is removed with its campaign's end): removed here too.
+  // is removed with its campaign's end) is removed there too, and the runs' mark goes back below
+  // it: SQLite gives a removed newest id to the next run, which must be copied as new.
   std::vector<std::int64_t> gone;
   for (const std::int64_t r : open_runs)
-    if (std::find(runs.begin(), runs.end(), r) == runs.end()) gone.push_back(r);
-  if (!gone.empty()) {
+    if (std::find(runs.ids.begin(), runs.ids.end(), r) == runs.ids.end()) gone.push_back(r);
+  std::int64_t new_runs_mark = newest(kRuns, runs);
+  if (!gone.empty()) new_runs_mark = std::min(new_runs_mark < 0 ? runs_mark : new_runs_mark, *std::min_element(gone.begin(), gone.end()) - 1);
+  write_upsert(kRuns, runs, new_runs_mark, gone.empty() ? std::function<void()>() : [&] {
     const std::string list = "{" + json_ids(gone).substr(1, json_ids(gone).size() - 2) + "}";
     pg_->query("DELETE FROM hystlab.runs WHERE daemon_id = $1 AND id = ANY($2::bigint[])", {daemon_text_.c_str(), list.c_str()});
-  }
-  rows += static_cast<std::int64_t>(
-      upsert(kCampaigns, "id > " + newer_campaigns + " OR id IN (SELECT value FROM json_each(?1)) ORDER BY id", campaign_ids, true).size());
-  rows += static_cast<std::int64_t>(upsert(kRigs, "1 ORDER BY id", {}, false).size());
-  return rows;
+    pg_->query("DELETE FROM hystlab.marks WHERE daemon_id = $1 AND tbl IN ('samples', 'shaker_samples') AND key = ANY($2::bigint[])",
+               {daemon_text_.c_str(), list.c_str()});
+  });
+  for (const std::int64_t g : gone) marks_.erase({"samples", g}), marks_.erase({"shaker_samples", g});
+  write_upsert(kCampaigns, campaigns, newest(kCampaigns, campaigns), {});
+  write_upsert(kRigs, rigs, -1, {});
+  return static_cast<std::int64_t>(points.ids.size() + loops.ids.size() + runs.ids.size() + campaigns.ids.size() + rigs.ids.size());
 }
 
 }  // namespace hystlab::db

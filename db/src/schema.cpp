@@ -80,6 +80,13 @@ ALTER TABLE transmissibility ADD COLUMN detail TEXT;
 ALTER TABLE transmissibility ADD COLUMN predicted_ratio REAL;
 ALTER TABLE transmissibility ADD COLUMN predicted_phase_rad REAL;
 )sql",
+    // 6: the file's own identity, random, made once: the lab database (docs/LAB.md) keys a
+    // daemon's rows by its name and checks that they keep coming from the same file (a new file
+    // under an old name would start its ids again under the old high-water marks).
+    R"sql(
+CREATE TABLE store_identity(id TEXT NOT NULL);
+INSERT INTO store_identity VALUES(lower(hex(randomblob(16))));
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof kMigrations / sizeof kMigrations[0]);
 static_assert(kMigrationCount == kSchemaVersion);

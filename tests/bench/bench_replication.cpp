@@ -284,7 +284,7 @@ int main(int argc, char** argv) {
             if (n != rows) throw std::runtime_error("bare read " + std::to_string(n) + " rows");
             bare_rate.push_back(static_cast<double>(rows) / s);
           } else {
-            hystlab::db::Replicator r(path, {"bench-lab", "bench-rep-" + std::to_string(rep), "bench"}, server->url(), PostgresServer::kPassword, o.batch);
+            hystlab::db::Replicator r(path, {"bench-lab", "bench-rep-" + std::to_string(rep), "bench", ""}, server->url(), PostgresServer::kPassword, o.batch);
             r.connect();
             daemon_id = r.daemon_id();
             int passes = 0;

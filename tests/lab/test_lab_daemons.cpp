@@ -72,8 +72,10 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   CHECK(acquired(a) > before);  // acquisition went on
   server.start();
 
-  // Killed while catching up, restarted on the same files: it resumes from PostgreSQL's marks.
-  REQUIRE(wait_until([&] { return a.get("/api/status")["lab"]["postgresql"]["connected"] == true; }, 30));
+  // Killed while catching up (after its first pass back: 10 batches of 20,000 samples, of a
+  // backlog of about 3·10^5), restarted on the same files: it resumes from PostgreSQL's marks.
+  const std::int64_t copied = a.get("/api/status")["lab"]["postgresql"]["samples"].get<std::int64_t>();
+  REQUIRE(wait_until([&] { return a.get("/api/status")["lab"]["postgresql"]["samples"].get<std::int64_t>() > copied; }, 60));
   a.stop(SIGKILL);
   a.start();
   db::PgConnection pg(server.url(), PostgresServer::kPassword);

@@ -180,7 +180,9 @@ TEST_CASE("a broker stopped and started again: drops counted, reconnected, state
   REQUIRE(wait_until([&] { return pub.status().dropped > 0; }, 10));
   const auto t0 = std::chrono::steady_clock::now();
   const lab::MqttStatus down = pub.status();
-  CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(100));  // status() never waits on the broker
+  // status() never waits on the broker (a wait would be its connect's seconds; 1 s leaves room
+  // for a frozen shared machine and ThreadSanitizer)
+  CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(1));
   CHECK(down.queued <= 10);
   CHECK(!down.last_error.empty());
   INFO("last error: " << down.last_error);
@@ -196,7 +198,7 @@ TEST_CASE("a broker stopped and started again: drops counted, reconnected, state
   CHECK(last_json(fresh.on(kFrame + "/state"))["latched"] == true);
   CHECK(wait_until([&] { return !fresh.on(kPrefix + "/shaker/state").empty(); }, 5));
   // The publisher read the live ring at its pace all along (20 a second), and lost nothing of it.
-  CHECK(fake.max_read_gap_s() < 0.5);
+  CHECK(fake.max_read_gap_s() < 2.0);  // 0.05 s a batch; a blocked reader would show the broker's whole outage
   CHECK(pub.status().lost_samples == 0);
   CHECK(pub.status().connect_attempts >= 2);
 }

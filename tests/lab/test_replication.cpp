@@ -6,7 +6,9 @@
 
 #include <cmath>
 #include <cstring>
+#include <atomic>
 #include <random>
+#include <thread>
 
 #include "../support/postgres_server.hpp"
 #include "hystlab/db/lab_reads.hpp"
@@ -179,20 +181,50 @@ TEST_CASE("replication: PostgreSQL stopped mid-campaign and started again, or a 
   const std::string id = std::to_string(r.daemon_id());
   CHECK(pg.query("SELECT state FROM hystlab.campaigns WHERE daemon_id = $1", {id.c_str()}).text(0, 0) == "completed");
 
+  // The replicator's own connection killed in the middle of its passes (as a daemon killed
+  // mid-COPY is, from the server's side): the batch in flight is rolled back with its mark, and
+  // the next session copies it whole, once.
+  add_samples(a, f, 60000, rng);
+  {
+    auto busy = replicator(server, path, "frame-pc-1", 500);
+    busy.connect();
+    std::atomic<bool> done{false};
+    std::thread killer([&] {
+      db::PgConnection admin(server.url(), PostgresServer::kPassword);
+      while (!done)
+        if (admin.query("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE application_name = 'hystlabd' AND state = 'active' AND pid <> pg_backend_pid()").rows() > 0) return;
+    });
+    bool cut = false;
+    try {
+      for (int k = 0; k < 200 && !busy.pass(4).caught_up; ++k) {
+      }
+    } catch (const db::PgError&) {
+      cut = true;
+    }
+    done = true;
+    killer.join();
+    CHECK(cut);  // the kill landed while it was copying
+  }
+  auto resumed = replicator(server, path, "frame-pc-1", 1000);
+  until_caught_up(resumed);
+  CHECK(pg_samples(pg, r.daemon_id()).rows == 9321 + 60000);
+  CHECK(pg_samples(pg, r.daemon_id()).h == lite_samples(a.database()).h);
+
   // A batch cut off before its commit (the daemon killed mid-COPY): neither its rows nor its mark
   // are there, and a new replicator (the daemon restarted) copies it whole, once.
   add_samples(a, f, 2500, rng);
   {
     db::PgConnection cut(server.url(), PostgresServer::kPassword);
     cut.exec("BEGIN");
-    cut.copy_in("COPY hystlab.samples(daemon_id, run_id, seq, t) FROM STDIN", id + "\t" + std::to_string(f.run) + "\t9321\t9.321\n");
-    cut.exec("INSERT INTO hystlab.marks VALUES(" + id + ", 'samples', " + std::to_string(f.run) +
-             ", 9321) ON CONFLICT (daemon_id, tbl, key) DO UPDATE SET mark = 9321");
+    const std::string next = std::to_string(9321 + 60000);  // the next sample's seq
+    cut.copy_in("COPY hystlab.samples(daemon_id, run_id, seq, t) FROM STDIN", id + "\t" + std::to_string(f.run) + "\t" + next + "\t9.321\n");
+    cut.exec("INSERT INTO hystlab.marks VALUES(" + id + ", 'samples', " + std::to_string(f.run) + ", " + next +
+             ") ON CONFLICT (daemon_id, tbl, key) DO UPDATE SET mark = " + next);
   }  // the connection closes without COMMIT, as a killed process's does
   auto again = replicator(server, path, "frame-pc-1", 1000);
   until_caught_up(again);
   CHECK(again.daemon_id() == r.daemon_id());
-  CHECK(pg_samples(pg, r.daemon_id()).rows == 9321 + 2500);
+  CHECK(pg_samples(pg, r.daemon_id()).rows == 9321 + 60000 + 2500);
   CHECK(pg_samples(pg, r.daemon_id()).h == lite_samples(a.database()).h);
 }
 
@@ -231,4 +263,47 @@ TEST_CASE("replication: a wrong password, no server, a newer schema: one clear e
     CHECK(std::string(e.what()).find("schema version 99, newer than this hystlabd's (1)") != std::string::npos);
   }
   CHECK(pg.query("SELECT count(*) FROM hystlab.daemons").integer(0, 0) == 0);
+}
+
+TEST_CASE("replication: a run id SQLite gives again after removing a run is copied as the new run; a second file under one name is refused") {
+  PostgresServer server;
+  TempDir dir("replica");
+  const std::string path = (dir / "a.db").string();
+  db::Store a(path);
+  Filled f = fill(a, 100, 7);
+  const auto [run, validation] = a.add_runs(f.campaign, iso(10), 1.8e9, 20.0, true);
+  auto r = replicator(server, path, "frame-pc-1");
+  until_caught_up(r);
+  // The validation run never started: the campaign's end removes it (store_lifecycle.cpp), and
+  // SQLite gives its id, the newest, to the next run.
+  a.database().exec("DELETE FROM runs WHERE id = " + std::to_string(validation));
+  until_caught_up(r);
+  const auto c2 = a.create_campaign(f.rig, domain::CampaignKind::fot, R"({"kind":"fot","specimen":"SMA spring 9"})", iso(20));
+  const std::int64_t again = a.add_run(c2, iso(21), 1.8e9, 30.0);
+  REQUIRE(again == validation);
+  Filled g{f.rig, c2, again, 0};
+  std::mt19937_64 rng(8);
+  add_samples(a, g, 500, rng);
+  until_caught_up(r);
+  db::PgConnection pg(server.url(), PostgresServer::kPassword);
+  const std::string id = std::to_string(r.daemon_id()), run_id = std::to_string(again);
+  const db::PgResult row = pg.query("SELECT campaign_id FROM hystlab.runs WHERE daemon_id = $1 AND id = $2", {id.c_str(), run_id.c_str()});
+  REQUIRE(row.rows() == 1);
+  CHECK(row.integer(0, 0) == c2);
+  CHECK(pg_samples(pg, r.daemon_id()).h == lite_samples(a.database()).h);
+  CHECK(pg_count(pg, "runs", r.daemon_id()) == lite_count(a.database(), "runs"));
+  (void)run;
+
+  // Another SQLite file under the same lab.daemon: its ids would start again under the first
+  // file's marks; refused, naming the field, nothing written.
+  db::Store b((dir / "b.db").string());
+  fill(b, 10, 9);
+  auto other = replicator(server, (dir / "b.db").string(), "frame-pc-1");
+  try {
+    other.connect();
+    FAIL("a second file replicated under one daemon's name");
+  } catch (const db::PgError& e) {
+    CHECK(std::string(e.what()).find("lab.daemon 'frame-pc-1' of lab 'materials-lab' is replicated from another SQLite file") != std::string::npos);
+  }
+  CHECK(pg_count(pg, "campaigns", r.daemon_id()) == 2);
 }

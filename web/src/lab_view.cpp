@@ -35,7 +35,12 @@ struct LabView::Impl {
   void with_lab(httplib::Response& res, const std::function<void(db::LabReads&)>& f) {
     const std::lock_guard lock(pg_mu);
     try {
-      if (!pg || !pg->ok()) pg = std::make_unique<db::PgConnection>(lab.postgres.conninfo, lab.postgres.password);
+      if (!pg || !pg->ok()) {
+        pg = std::make_unique<db::PgConnection>(lab.postgres.conninfo, lab.postgres.password);
+        // A view only reads, and a slow query never holds the others (one connection) for long.
+        pg->exec("SET default_transaction_read_only = on");
+        pg->exec("SET statement_timeout = '20s'");
+      }
       db::LabReads reads(*pg);
       f(reads);
       pg_error.clear();
@@ -83,14 +88,10 @@ void add_lab_routes(httplib::Server& s, LabView::Impl& m) {
           const std::string daemon = req.matches[1].str();
           const std::int64_t id = path_id(req, 2);
           m.with_lab(res, [&](db::LabReads& r) {
-            const auto c = r.campaign(daemon, id);
+            const auto c = r.campaign(daemon, id, m.lab.name);
             if (!c || c->lab != m.lab.name)
               return send_error(res, 404, "not found", "no campaign " + std::to_string(id) + " of daemon '" + daemon + "' in lab " + m.lab.name);
-            db::LabFilter tables_of{m.lab.name, daemon, {}, {}, 500};
-            std::vector<db::LabTable> tables;
-            for (db::LabTable& t : r.tables(tables_of))
-              if (t.campaign == id) tables.push_back(std::move(t));
-            send_json(res, campaign_json(*c, r.runs(c->daemon_id, id), r.events(c->daemon_id, id), tables));
+            send_json(res, campaign_json(*c, r.runs(c->daemon_id, id), r.events(c->daemon_id, id), r.campaign_tables(c->daemon_id, id)));
           });
         }));
   s.Get(R"(/api/lab/runs/([^/]+)/(\d+)/overview)", guarded([&m](const httplib::Request& req, httplib::Response& res) {
@@ -130,7 +131,7 @@ LabView::LabView(const control::HttpConfig& http, const lab::LabConfig& lab, Liv
       send_error(res, 405, "read-only", "the lab view moves nothing: commands go to the rig's own daemon (its link on the page)");
       return httplib::Server::HandlerResponse::Handled;
     }
-    return httplib::Server::HandlerResponse::Unhandled;
+    return check_read(m.http, req, res);  // http.read_token, as a rig's own daemon
   });
   s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (res.body.empty() && res.status == 404) send_error(res, 404, "not found", "no such resource: " + req.method + " " + req.path);

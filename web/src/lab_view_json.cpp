@@ -14,6 +14,16 @@ json parsed(const std::string& s) {
   json j = json::parse(s, nullptr, false);
   return j.is_discarded() ? json(s) : j;
 }
+// A text field of a document from the broker (anyone who may publish there wrote it): its text,
+// or def when missing or not text. Never throws.
+std::string text_of(const json& doc, const char* key, const std::string& def = {}) {
+  if (!doc.is_object()) return def;
+  const auto it = doc.find(key);
+  return it != doc.end() && it->is_string() ? it->get<std::string>() : def;
+}
+// Only an http(s) address is a link (a javascript: one from the broker never is).
+json link_or_null(const std::string& url) { return url.rfind("http://", 0) == 0 || url.rfind("https://", 0) == 0 ? json(url) : json(nullptr); }
+
 json campaign_row(const db::LabCampaign& c) {
   return {{"daemon", c.daemon},
           {"rig", c.rig},
@@ -38,8 +48,10 @@ json table_row(const db::LabTable& t) {
 }  // namespace
 
 json mqtt_status(const json& live) {
-  if (!live.is_object() || !live.value("configured", false)) return nullptr;
-  return {{"connected", live.value("connected", false)}, {"error", live.value("error", json(nullptr))}};
+  if (!live.is_object() || !live.contains("configured") || live["configured"] != true) return nullptr;
+  const auto connected = live.find("connected");
+  const std::string error = text_of(live, "error");
+  return {{"connected", connected != live.end() && connected->is_boolean() && connected->get<bool>()}, {"error", text_or_null(error)}};
 }
 
 json lab_overview_json(const std::string& lab, const std::vector<db::LabDaemon>& daemons, const std::vector<db::LabRig>& rigs, const json& live) {
@@ -53,24 +65,24 @@ json lab_overview_json(const std::string& lab, const std::vector<db::LabDaemon>&
     const json status = seen_daemons.contains(d.name) ? seen_daemons[d.name] : json(nullptr);
     ds.push_back({{"name", d.name},
                   {"software", d.software},
-                  {"url", text_or_null(status.is_object() && status.contains("url") ? status["url"].get<std::string>() : d.url)},
+                  {"url", link_or_null(text_of(status, "url", d.url))},
                   {"first_seen", d.first_seen},
                   {"last_seen", d.last_seen},
-                  {"online", status.is_object() ? json(status.value("state", "") == "online") : json(nullptr)},
+                  {"online", status.is_object() ? json(text_of(status, "state") == "online") : json(nullptr)},
                   {"status", status}});
   }
   for (const auto& [name, status] : seen_daemons.items())
     if (!daemon_names.contains(name))
       ds.push_back({{"name", name},
-                    {"software", status.value("version", "")},
-                    {"url", status.value("url", json(nullptr))},
+                    {"software", text_of(status, "version")},
+                    {"url", link_or_null(text_of(status, "url"))},
                     {"first_seen", nullptr},
                     {"last_seen", nullptr},
-                    {"online", status.value("state", "") == "online"},
+                    {"online", text_of(status, "state") == "online"},
                     {"status", status}});
   for (const db::LabRig& g : rigs) {
     rig_names.insert({g.daemon, g.name});
-    const json state = seen_rigs.contains(g.daemon) && seen_rigs[g.daemon].contains(g.name) ? seen_rigs[g.daemon][g.name] : json(nullptr);
+    const json state = seen_rigs.contains(g.daemon) && seen_rigs[g.daemon].is_object() && seen_rigs[g.daemon].contains(g.name) ? seen_rigs[g.daemon][g.name] : json(nullptr);
     rs.push_back({{"daemon", g.daemon},
                   {"rig", g.name},
                   {"last_campaign", g.last_campaign == 0 ? json(nullptr) : json(g.last_campaign)},
@@ -78,7 +90,8 @@ json lab_overview_json(const std::string& lab, const std::vector<db::LabDaemon>&
                   {"live", state}});
   }
   for (const auto& [daemon, by_rig] : seen_rigs.items())
-    for (const auto& [rig, state] : by_rig.items())
+    if (by_rig.is_object())
+      for (const auto& [rig, state] : by_rig.items())
       if (!rig_names.contains({daemon, rig}))
         rs.push_back({{"daemon", daemon}, {"rig", rig}, {"last_campaign", nullptr}, {"last_campaign_state", nullptr}, {"live", state}});
   return {{"lab", lab}, {"mqtt", mqtt_status(live)}, {"daemons", ds}, {"rigs", rs}};

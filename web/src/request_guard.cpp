@@ -99,15 +99,6 @@ HR dispatch_bodiless(ApiContext& c, const httplib::Request& req, httplib::Respon
   return refuse(res, 404, "not found", "no such resource: POST " + req.path);
 }
 
-HR check_read(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
-  const bool data = req.path.rfind("/api/", 0) == 0 || req.path == "/metrics";
-  if (c.config.read_token.empty() || !data) return HR::Unhandled;
-  const std::string given = given_token(req);
-  if (same_secret(given, c.config.read_token) || (!c.config.token.empty() && same_secret(given, c.config.token))) return HR::Unhandled;
-  res.set_header("WWW-Authenticate", "Bearer realm=\"hystlabd\"");
-  return refuse(res, 401, "unauthorized", "this daemon's data needs its read token (http.read_token): Authorization: Bearer ...");
-}
-
 HR check_write(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   if (req.has_header("Origin")) {
     const std::string origin = req.get_header_value("Origin"), host = req.get_header_value("Host");
@@ -177,12 +168,22 @@ HR guard_request(ApiContext& c, const httplib::Request& req, httplib::Response& 
   // port as "same origin"; its Host header still says attacker.example.
   if (!host_allowed(c.config, req.get_header_value("Host")))
     return refuse(res, 403, "unknown host", "Host '" + req.get_header_value("Host") + "' is not a name this daemon serves (add it to http.allowed_hosts)");
-  return changes_state(req.method) ? check_write(c, req, res) : check_read(c, req, res);
+  return changes_state(req.method) ? check_write(c, req, res) : check_read(c.config, req, res);
 }
 
 void post_route(httplib::Server& s, ApiContext& c, const std::string& pattern, httplib::Server::Handler h) {
   c.post_routes.emplace_back(std::regex(pattern), h);
   s.Post(pattern, std::move(h));
+}
+
+httplib::Server::HandlerResponse check_read(const control::HttpConfig& config, const httplib::Request& req, httplib::Response& res) {
+  using HR = httplib::Server::HandlerResponse;
+  const bool data = req.path.rfind("/api/", 0) == 0 || req.path == "/metrics";
+  if (config.read_token.empty() || !data) return HR::Unhandled;
+  const std::string given = given_token(req);
+  if (same_secret(given, config.read_token) || (!config.token.empty() && same_secret(given, config.token))) return HR::Unhandled;
+  res.set_header("WWW-Authenticate", "Bearer realm=\"hystlabd\"");
+  return refuse(res, 401, "unauthorized", "this daemon's data needs its read token (http.read_token): Authorization: Bearer ...");
 }
 
 }  // namespace hystlab::web

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "mqtt_connection.hpp"
+#include "hystlab/lab/mqtt_publisher.hpp"
 #include "mqtt_payloads.hpp"
 
 namespace hystlab::lab {
@@ -96,35 +97,47 @@ struct LabWatch::Impl final : detail::MqttListener {
     error = why;
   }
 
-  // One connection's life: connect, subscribe once accepted, loop until lost or stopped.
-  void session(detail::MqttConnection& c) {
-    const std::string prefix = "hystlab/" + config.name + "/";
-    if (const int rc = c.connect(); rc != MOSQ_ERR_SUCCESS)
-      return fail("cannot reach the broker at " + settings.host + ":" + std::to_string(settings.port) + ": " + c.error_text(rc));
+  // One connection's life: connect, subscribe once accepted, loop until lost or stopped. True
+  // when the broker accepted it.
+  bool session(detail::MqttConnection& c) {
+    bool accepted = false;
+    const std::string prefix = "hystlab/" + topic_level(config.name) + "/";  // escaped as the daemons publish it
+    if (const int rc = c.connect(); rc != MOSQ_ERR_SUCCESS) {
+      fail("cannot reach the broker at " + settings.host + ":" + std::to_string(settings.port) + ": " + c.error_text(rc));
+      return false;
+    }
     while (!stop_asked()) {
-      if (const int rc = c.loop(100); rc != MOSQ_ERR_SUCCESS) return fail("the broker's connection: " + c.error_text(rc));
+      if (const int rc = c.loop(100); rc != MOSQ_ERR_SUCCESS) {
+        fail("the broker's connection: " + c.error_text(rc));
+        return accepted;
+      }
       bool sub = false;
       {
         const std::lock_guard lock(mu);
         std::swap(sub, subscribe_now);
+        accepted = accepted || connected;
       }
-      if (sub && (c.subscribe(prefix + "+/status", 1) != MOSQ_ERR_SUCCESS || c.subscribe(prefix + "+/+/state", 1) != MOSQ_ERR_SUCCESS))
-        return fail("cannot subscribe to " + prefix + "#");
+      if (sub && (c.subscribe(prefix + "+/status", 1) != MOSQ_ERR_SUCCESS || c.subscribe(prefix + "+/+/state", 1) != MOSQ_ERR_SUCCESS)) {
+        fail("cannot subscribe to " + prefix + "#");
+        return accepted;
+      }
     }
     c.disconnect();
+    return accepted;
   }
 
   void run() noexcept {
     double backoff = 0.5;
     while (!stop_asked()) {
+      bool was_connected = false;
       try {
         detail::MqttConnection c(settings, "", "", *this);
-        session(c);
+        was_connected = session(c);
       } catch (const std::exception& e) {
         fail(e.what());
       }
+      backoff = was_connected ? 0.5 : std::min(backoff * 2, 30.0);  // a broker that was up: try again soon
       if (!wait(backoff)) return;
-      backoff = std::min(backoff * 2, 30.0);
     }
   }
 };

@@ -62,12 +62,14 @@ class LabReads {
   std::vector<LabDaemon> daemons(const std::string& lab = {});
   std::vector<LabRig> rigs(const std::string& lab = {});
   std::vector<LabCampaign> campaigns(const LabFilter& f);
-  std::optional<LabCampaign> campaign(const std::string& daemon, std::int64_t id);
+  // lab: empty for any (a daemon's name is unique in its lab only).
+  std::optional<LabCampaign> campaign(const std::string& daemon, std::int64_t id, const std::string& lab = {});
   std::vector<LabRun> runs(int daemon_id, std::int64_t campaign);
   // One run of a daemon, or none (its campaign: campaign_of).
   std::optional<LabRun> run(int daemon_id, std::int64_t id);
   std::vector<LabEvent> events(int daemon_id, std::int64_t campaign, int limit = 500);
   std::vector<LabTable> tables(const LabFilter& f);
+  std::vector<LabTable> campaign_tables(int daemon_id, std::int64_t campaign);
   std::optional<std::string> table_document(const std::string& daemon, std::int64_t id);
   LabOverview overview(int daemon_id, std::int64_t run, bool shaker, int buckets);
   // Every sample of a run in seq order, columns as overview's; chunked reads (a run of any size).

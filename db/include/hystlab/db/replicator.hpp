@@ -15,6 +15,7 @@
 // the link) or DbError (SQLite).
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -73,7 +74,12 @@ class Replicator {
   std::int64_t copy_run_samples(const Spec& s, std::int64_t run, std::int64_t from);
   std::int64_t copy_appended(const Spec& s);
   std::int64_t copy_changing();
-  std::vector<std::int64_t> upsert(const Spec& s, const std::string& where, const std::string& ids, bool with_mark);
+  struct Rows {
+    std::string text;               // COPY text
+    std::vector<std::int64_t> ids;  // each row's first column
+  };
+  Rows read_rows(const Spec& s, const std::string& where, const std::string& ids);
+  void write_upsert(const Spec& s, const Rows& rows, std::int64_t new_mark, const std::function<void()>& also);
   std::vector<std::int64_t> pg_ids(const char* sql);
   [[nodiscard]] std::int64_t mark(const char* table, std::int64_t key) const;
   void save_mark(const char* table, std::int64_t key, std::int64_t value);

@@ -4,7 +4,7 @@
 
 namespace hystlab::db {
 
-inline constexpr int kSchemaVersion = 5;
+inline constexpr int kSchemaVersion = 6;
 
 // Brings the file to kSchemaVersion in one transaction per step. Throws DbError for a file
 // newer than this program (refusing to guess), or when a migration fails (rolled back).
