@@ -154,8 +154,8 @@ std::vector<LabTable> tables_in(const PgResult& r) {
 std::vector<LabTable> LabReads::tables(const LabFilter& f) {
   std::vector<const char*> params;
   const std::string limit = std::to_string(f.limit > 0 ? f.limit : 200);
-  return tables_in(
-      pg_.query(filtered(kTableColumns, LabFilter{f.lab, f.daemon, f.specimen, {}, f.limit}, params) + " ORDER BY specimen, created_at LIMIT " + limit, params));
+  return tables_in(pg_.query(
+      filtered(kTableColumns, LabFilter{f.lab, f.daemon, f.specimen, {}, f.limit}, params) + " ORDER BY specimen, created_at LIMIT " + limit, params));
 }
 
 std::vector<LabTable> LabReads::campaign_tables(int daemon_id, std::int64_t campaign) {

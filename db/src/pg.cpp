@@ -53,8 +53,15 @@ PgConnection::PgConnection(const std::string& conninfo, const std::string& passw
   // keywords after it (a password, the timeout, the application's name) added to it.
   // TCP keep-alives and a user timeout before the conninfo (which overrides them): a server host
   // gone mid-COPY fails the call within about 30 s, not the kernel's 15 min of retransmissions.
-  const char* keys[] = {"keepalives_idle", "keepalives_interval", "keepalives_count", "tcp_user_timeout", "dbname",
-                        "connect_timeout", "application_name", password.empty() ? nullptr : "password", nullptr};
+  const char* keys[] = {"keepalives_idle",
+                        "keepalives_interval",
+                        "keepalives_count",
+                        "tcp_user_timeout",
+                        "dbname",
+                        "connect_timeout",
+                        "application_name",
+                        password.empty() ? nullptr : "password",
+                        nullptr};
   const char* values[] = {"10", "5", "3", "30000", conninfo.c_str(), timeout.c_str(), "hystlabd", password.empty() ? nullptr : password.c_str(), nullptr};
   c_ = PQconnectdbParams(keys, values, 1);
   if (c_ == nullptr) throw PgError("PostgreSQL: out of memory", "");

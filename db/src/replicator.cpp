@@ -339,12 +339,13 @@ std::int64_t Replicator::copy_changing() {
     if (std::find(runs.ids.begin(), runs.ids.end(), r) == runs.ids.end()) gone.push_back(r);
   std::int64_t new_runs_mark = newest(kRuns, runs);
   if (!gone.empty()) new_runs_mark = std::min(new_runs_mark < 0 ? runs_mark : new_runs_mark, *std::min_element(gone.begin(), gone.end()) - 1);
-  write_upsert(kRuns, runs, new_runs_mark, gone.empty() ? std::function<void()>() : [&] {
-    const std::string list = "{" + json_ids(gone).substr(1, json_ids(gone).size() - 2) + "}";
-    pg_->query("DELETE FROM hystlab.runs WHERE daemon_id = $1 AND id = ANY($2::bigint[])", {daemon_text_.c_str(), list.c_str()});
-    pg_->query("DELETE FROM hystlab.marks WHERE daemon_id = $1 AND tbl IN ('samples', 'shaker_samples') AND key = ANY($2::bigint[])",
-               {daemon_text_.c_str(), list.c_str()});
-  });
+  write_upsert(
+      kRuns, runs, new_runs_mark, gone.empty() ? std::function<void()>() : [&] {
+        const std::string list = "{" + json_ids(gone).substr(1, json_ids(gone).size() - 2) + "}";
+        pg_->query("DELETE FROM hystlab.runs WHERE daemon_id = $1 AND id = ANY($2::bigint[])", {daemon_text_.c_str(), list.c_str()});
+        pg_->query("DELETE FROM hystlab.marks WHERE daemon_id = $1 AND tbl IN ('samples', 'shaker_samples') AND key = ANY($2::bigint[])",
+                   {daemon_text_.c_str(), list.c_str()});
+      });
   for (const std::int64_t g : gone) marks_.erase({"samples", g}), marks_.erase({"shaker_samples", g});
   write_upsert(kCampaigns, campaigns, newest(kCampaigns, campaigns), {});
   write_upsert(kRigs, rigs, -1, {});

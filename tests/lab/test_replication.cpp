@@ -4,9 +4,9 @@
 // schema.
 #include <doctest/doctest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
-#include <atomic>
 #include <random>
 #include <thread>
 
@@ -192,7 +192,11 @@ TEST_CASE("replication: PostgreSQL stopped mid-campaign and started again, or a 
     std::thread killer([&] {
       db::PgConnection admin(server.url(), PostgresServer::kPassword);
       while (!done)
-        if (admin.query("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE application_name = 'hystlabd' AND state = 'active' AND pid <> pg_backend_pid()").rows() > 0) return;
+        if (admin
+                .query("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE application_name = 'hystlabd' AND state = 'active' AND pid <> "
+                       "pg_backend_pid()")
+                .rows() > 0)
+          return;
     });
     bool cut = false;
     try {

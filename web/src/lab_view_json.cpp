@@ -82,7 +82,8 @@ json lab_overview_json(const std::string& lab, const std::vector<db::LabDaemon>&
                     {"status", status}});
   for (const db::LabRig& g : rigs) {
     rig_names.insert({g.daemon, g.name});
-    const json state = seen_rigs.contains(g.daemon) && seen_rigs[g.daemon].is_object() && seen_rigs[g.daemon].contains(g.name) ? seen_rigs[g.daemon][g.name] : json(nullptr);
+    const json state =
+        seen_rigs.contains(g.daemon) && seen_rigs[g.daemon].is_object() && seen_rigs[g.daemon].contains(g.name) ? seen_rigs[g.daemon][g.name] : json(nullptr);
     rs.push_back({{"daemon", g.daemon},
                   {"rig", g.name},
                   {"last_campaign", g.last_campaign == 0 ? json(nullptr) : json(g.last_campaign)},
@@ -92,8 +93,8 @@ json lab_overview_json(const std::string& lab, const std::vector<db::LabDaemon>&
   for (const auto& [daemon, by_rig] : seen_rigs.items())
     if (by_rig.is_object())
       for (const auto& [rig, state] : by_rig.items())
-      if (!rig_names.contains({daemon, rig}))
-        rs.push_back({{"daemon", daemon}, {"rig", rig}, {"last_campaign", nullptr}, {"last_campaign_state", nullptr}, {"live", state}});
+        if (!rig_names.contains({daemon, rig}))
+          rs.push_back({{"daemon", daemon}, {"rig", rig}, {"last_campaign", nullptr}, {"last_campaign_state", nullptr}, {"live", state}});
   return {{"lab", lab}, {"mqtt", mqtt_status(live)}, {"daemons", ds}, {"rigs", rs}};
 }
 

@@ -12,8 +12,8 @@
 #include <thread>
 #include <vector>
 
-#include "mqtt_connection.hpp"
 #include "hystlab/lab/mqtt_publisher.hpp"
+#include "mqtt_connection.hpp"
 #include "mqtt_payloads.hpp"
 
 namespace hystlab::lab {
