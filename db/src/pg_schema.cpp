@@ -76,19 +76,32 @@ CREATE VIEW hystlab.lab_rigs AS
   FROM hystlab.rigs r JOIN hystlab.daemons d ON d.id = r.daemon_id;
 CREATE VIEW hystlab.lab_tables AS
   SELECT d.lab, d.name AS daemon, t.id AS table_id, t.campaign_id AS campaign, c.plan->>'specimen' AS specimen, t.method, t.n,
-         t.range_lo, t.range_hi, t.created_at, t.accuracy, t.daemon_id
+         t.range_lo, t.range_hi, t.created_at, t.accuracy,
+         (CASE WHEN t.accuracy LIKE '{%' THEN (t.accuracy::jsonb #>> '{held_out,overall,rms_N}')::float8 END) AS held_out_rms_n,
+         t.daemon_id
   FROM hystlab.tables t JOIN hystlab.daemons d ON d.id = t.daemon_id
   LEFT JOIN hystlab.campaigns c ON c.daemon_id = t.daemon_id AND c.id = t.campaign_id;
--- Per run: samples replicated (the run's mark), its rig-time span and mean sample rate, read
--- through the primary key (two index probes a run, never a scan of the samples).
+-- Per run: samples replicated (the run's mark), its rig-time span through the primary key (two
+-- index probes, never a scan of the samples), and the run's data quality as the daemon measured
+-- it (its "quality" event: rate, missed deadlines, gaps, losses). The CASE keeps the JSON cast off
+-- events of other kinds (a command's detail is plain text).
 CREATE VIEW hystlab.run_quality AS
   SELECT d.lab, d.name AS daemon, u.id AS run, u.campaign_id AS campaign, u.role, u.state, u.started_at, u.ended_at,
          m.mark + 1 AS samples,
          (SELECT s.t FROM hystlab.samples s WHERE s.daemon_id = u.daemon_id AND s.run_id = u.id ORDER BY s.seq DESC LIMIT 1) -
          (SELECT s.t FROM hystlab.samples s WHERE s.daemon_id = u.daemon_id AND s.run_id = u.id ORDER BY s.seq LIMIT 1) AS span_s,
+         (q.q->>'rate_hz')::float8 AS rate_hz, (q.q->>'requested_rate_hz')::float8 AS requested_rate_hz,
+         (q.q->>'missed_deadlines')::bigint AS missed_deadlines, (q.q->>'gaps')::bigint AS gaps,
+         (q.q->>'longest_gap_s')::float8 AS longest_gap_s, (q.q->>'dropped')::bigint AS dropped,
+         (q.q->>'lost_samples')::bigint AS lost_samples, (q.q->>'io_errors')::bigint AS io_errors,
          u.daemon_id
   FROM hystlab.runs u JOIN hystlab.daemons d ON d.id = u.daemon_id
-  LEFT JOIN hystlab.marks m ON m.daemon_id = u.daemon_id AND m.tbl IN ('samples', 'shaker_samples') AND m.key = u.id;
+  LEFT JOIN hystlab.marks m ON m.daemon_id = u.daemon_id AND m.tbl IN ('samples', 'shaker_samples') AND m.key = u.id
+  LEFT JOIN LATERAL (
+    SELECT CASE WHEN e.kind = 'quality' THEN e.detail::jsonb END AS q FROM hystlab.events e
+    WHERE e.daemon_id = u.daemon_id AND e.campaign_id = u.campaign_id AND e.kind = 'quality'
+      AND (CASE WHEN e.kind = 'quality' THEN (e.detail::jsonb->>'run')::bigint END) = u.id
+    ORDER BY e.id DESC LIMIT 1) q ON true;
 )sql";
   return {};
 }

@@ -81,6 +81,14 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   db::PgConnection pg(server.url(), PostgresServer::kPassword);
   REQUIRE(wait_until([&] { return campaign_state(b.db(), cb) == "completed"; }, 120));
   CHECK(wait_until([&] { return same(pg, b); }, 30));
+  // The dashboard's views: the run's data quality as the daemon measured it, the tables' held-out score.
+  const db::PgResult q = pg.query("SELECT rate_hz, missed_deadlines, samples FROM hystlab.run_quality WHERE daemon = 'frame-pc-2' AND role = 'campaign'");
+  REQUIRE(q.rows() == 1);
+  CHECK(std::strtod(q.text(0, 0).c_str(), nullptr) > 10);  // samples a wall second (500 a rig second asked, 20 times real time: 25)
+  CHECK_FALSE(q.is_null(0, 1));
+  CHECK(q.integer(0, 2) > 1000);
+  const db::PgResult t = pg.query("SELECT held_out_rms_n FROM hystlab.lab_tables WHERE daemon = 'frame-pc-2' AND held_out_rms_n IS NOT NULL");
+  CHECK(t.rows() >= 1);
   // Daemon a's campaign was interrupted by the kill: it is final there, and so here.
   CHECK(wait_until([&] { return same(pg, a); }, 30));
   const std::string ida = std::to_string(daemon_id(pg, "frame-pc-1"));
