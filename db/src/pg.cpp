@@ -99,29 +99,49 @@ PgResult PgConnection::query(std::string_view sql, const std::vector<const char*
 }
 
 std::int64_t PgConnection::copy_in(std::string_view copy_sql, std::string_view rows) {
-  PGresult* r = PQexec(c_, std::string(copy_sql).c_str());
-  if (PQresultStatus(r) != PGRES_COPY_IN) fail_result(c_, r, copy_sql.substr(0, 60));
+  PgCopy copy(*this, copy_sql);
+  copy.put(rows);
+  return copy.finish();
+}
+
+PgCopy::PgCopy(PgConnection& c, std::string_view copy_sql) : c_(c) {
+  PGresult* r = PQexec(c_.handle(), std::string(copy_sql).c_str());
+  if (PQresultStatus(r) != PGRES_COPY_IN) {
+    open_ = false;
+    fail_result(c_.handle(), r, copy_sql.substr(0, 60));
+  }
   PQclear(r);
+}
+
+PgCopy::~PgCopy() {
+  if (!open_) return;
+  PQputCopyEnd(c_.handle(), "the copy was abandoned");  // the server rolls the COPY back
+  while (PGresult* x = PQgetResult(c_.handle())) PQclear(x);
+}
+
+void PgCopy::put(std::string_view rows) {
   // In pieces under 1 GiB (libpq's int length); blocking connection: each call sends or fails.
   constexpr std::size_t kPiece = 1U << 20;
   for (std::size_t at = 0; at < rows.size(); at += kPiece) {
     const std::string_view piece = rows.substr(at, kPiece);
-    if (PQputCopyData(c_, piece.data(), static_cast<int>(piece.size())) != 1) {
-      PQputCopyEnd(c_, "send failed");
-      while (PGresult* x = PQgetResult(c_)) PQclear(x);
-      throw PgError("PostgreSQL: COPY: " + trimmed(PQerrorMessage(c_)), "08006");
-    }
+    if (PQputCopyData(c_.handle(), piece.data(), static_cast<int>(piece.size())) != 1)
+      throw PgError("PostgreSQL: COPY: " + trimmed(PQerrorMessage(c_.handle())), "08006");
   }
-  if (PQputCopyEnd(c_, nullptr) != 1) throw PgError("PostgreSQL: COPY: " + trimmed(PQerrorMessage(c_)), "08006");
-  r = PQgetResult(c_);
+}
+
+std::int64_t PgCopy::finish() {
+  open_ = false;
+  PGconn* c = c_.handle();
+  if (PQputCopyEnd(c, nullptr) != 1) throw PgError("PostgreSQL: COPY: " + trimmed(PQerrorMessage(c)), "08006");
+  PGresult* r = PQgetResult(c);
   if (PQresultStatus(r) != PGRES_COMMAND_OK) {
-    while (PGresult* x = PQgetResult(c_)) PQclear(x);
-    fail_result(c_, r, copy_sql.substr(0, 60));
+    while (PGresult* x = PQgetResult(c)) PQclear(x);
+    fail_result(c, r, "COPY");
   }
   const char* n = PQcmdTuples(r);
   const std::int64_t count = n && *n ? std::stoll(n) : 0;
   PQclear(r);
-  while (PGresult* x = PQgetResult(c_)) PQclear(x);
+  while (PGresult* x = PQgetResult(c)) PQclear(x);
   return count;
 }
 

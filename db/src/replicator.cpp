@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <functional>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -221,25 +222,33 @@ std::int64_t Replicator::copy_samples(const Spec& s, int max_batches, bool& more
   return copied;
 }
 
+// One batch of a run's samples, streamed: each piece of COPY text goes to the server while the next
+// is read and encoded (the server parses as SQLite reads). The batch's read stays open for the
+// batch alone (at most batch_rows_ samples; the connection's user timeout bounds a server gone).
 std::int64_t Replicator::copy_run_samples(const Spec& s, std::int64_t run, std::int64_t from) {
+  constexpr std::size_t kPiece = 64 * 1024;
   const int columns = column_count(s.columns);
-  buf_.clear();
   std::int64_t n = 0, last = from;
-  {  // the statement finalized (its read ended) before PostgreSQL is called
+  PgTransaction tx(*pg_);
+  {
     Statement st(*lite_, std::string("SELECT ") + s.columns + " FROM " + s.name + " WHERE run_id = ? AND seq > ? ORDER BY seq LIMIT ?");
     st.bind(1, run).bind(2, from).bind(3, static_cast<std::int64_t>(batch_rows_));
+    std::optional<PgCopy> copy;
+    buf_.clear();
     while (st.step()) {
+      if (!copy) copy.emplace(*pg_, std::string("COPY hystlab.") + s.name + "(daemon_id, run_id, " + s.columns + ") FROM STDIN");
       buf_ += daemon_text_;
       buf_ += '\t';
       append_int(buf_, run);
       encode_row(st, columns, buf_);
       last = st.column_int(0);
       ++n;
+      if (buf_.size() >= kPiece) copy->put(buf_), buf_.clear();
     }
+    if (!copy) return 0;  // nothing past the mark (the transaction rolls back, empty)
+    copy->put(buf_);
+    copy->finish();
   }
-  if (n == 0) return 0;
-  PgTransaction tx(*pg_);
-  pg_->copy_in(std::string("COPY hystlab.") + s.name + "(daemon_id, run_id, " + s.columns + ") FROM STDIN", buf_);
   save_mark(s.name, run, last);
   tx.commit();
   marks_[{s.name, run}] = last;

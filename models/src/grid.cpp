@@ -68,11 +68,7 @@ int Grid::cell_of(double x, double& fraction) const noexcept {
     fraction = u - static_cast<double>(i - 1);
     return i;
   }
-  const auto& p = *positions;
-  int i = static_cast<int>(std::upper_bound(p.begin(), p.end(), x) - p.begin());
-  i = std::clamp(i, 1, n);
-  fraction = (x - p[static_cast<std::size_t>(i - 1)]) / (p[static_cast<std::size_t>(i)] - p[static_cast<std::size_t>(i - 1)]);
-  return i;
+  return cell_among(positions->data(), n, x, fraction);
 }
 
 std::vector<double> Grid::nodes() const {

@@ -81,7 +81,7 @@ struct Options {
   std::int64_t samples = 1'000'000;
   int runs = 4, reps = 3;
   std::size_t batch = 20000;                      // the replication thread's default (lab_config.hpp)
-  double campaign_s = 20, replicate_every_s = 0;  // > 0: a third daemon at this period (the second: the default)
+  double campaign_s = 12, replicate_every_s = 0;  // > 0: a third daemon at this period (the second: the default)
 };
 
 // A load frame's campaign: a slow triangle with noise, so every double is a full-precision one.

@@ -67,8 +67,8 @@ class EverettTable {
   // [δ_{j-1}, δ_j], and the local coordinates s, t in [0, 1] (t <= s in a triangle).
   [[gnu::always_inline]] void cell_of(double a, double b, int& i, int& j, double& s, double& t) const noexcept {
     if (nodes_) {  // a grid of its own: the cells by binary search, s and t in each cell's own width
-      i = node_cell(a, s);
-      j = node_cell(b, t);
+      i = Grid::cell_among(nodes_, grid_.n, a, s);
+      j = Grid::cell_among(nodes_, grid_.n, b, t);
       if (j > i) j = i, t = s;
       return;
     }
@@ -81,15 +81,6 @@ class EverettTable {
     j = j > i ? i : j;
     s = u - static_cast<double>(i - 1);
     t = w - static_cast<double>(j - 1);
-  }
-
-  // Grid::cell_of inlined, on x in the range: called out of line it held the step on a refined grid
-  // at 0.79-0.93 of the bare loop's (bench_preisach).
-  [[gnu::always_inline]] int node_cell(double x, double& fraction) const noexcept {
-    const int k = static_cast<int>(std::upper_bound(nodes_, nodes_ + grid_.n + 1, x) - nodes_);
-    const int i = k < 1 ? 1 : k > grid_.n ? grid_.n : k;
-    fraction = (x - nodes_[i - 1]) / (nodes_[i] - nodes_[i - 1]);
-    return i;
   }
 
   Grid grid_;
