@@ -152,8 +152,8 @@ TEST_CASE("replication: every row once, samples equal to the bit, changes follow
   CHECK(n == 23456 + 777);
   CHECK(ordered);
   // docs/LAB.md's example query, as written there.
-  const db::PgResult held = pg.query(
-      "SELECT daemon, table_id, method, n, held_out_rms_n FROM hystlab.lab_tables WHERE specimen LIKE 'SMA spring%' ORDER BY 5;");
+  const db::PgResult held =
+      pg.query("SELECT daemon, table_id, method, n, held_out_rms_n FROM hystlab.lab_tables WHERE specimen LIKE 'SMA spring%' ORDER BY 5;");
   CHECK(held.rows() == 1);
 }
 
