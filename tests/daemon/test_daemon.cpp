@@ -77,7 +77,15 @@ std::string daemon_at(const fs::path& log) {
 std::string state_of(const std::string& db, std::int64_t id) { return domain::to_string(db::Store(db).campaign(id)->state); }
 // The daemon is up once its rig is registered: after it held what was queued before it started
 // (a campaign submitted when only the file exists may be held as left over from a restart).
-bool daemon_ready(const std::string& db) { return fs::exists(db) && db::Store(db).rig_names().size() == 1; }
+// The daemon has made its file and its rig. A file still being made (the daemon migrating it)
+// can be locked for a moment (CI, stop 35: "database is locked" from this very poll): not yet.
+bool daemon_ready(const std::string& db) {
+  try {
+    return fs::exists(db) && db::Store(db).rig_names().size() == 1;
+  } catch (const db::DbError&) {
+    return false;
+  }
+}
 // Whether any event of campaign id has text in its detail.
 bool has_event(const std::string& db, std::int64_t id, const std::string& text) {
   for (const auto& e : db::Store(db).events(id))
