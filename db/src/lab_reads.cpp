@@ -194,27 +194,8 @@ LabOverview LabReads::overview(int daemon_id, std::int64_t run, bool shaker, int
   return o;
 }
 
-void LabReads::for_each_sample(int daemon_id, std::int64_t run, bool shaker, const std::function<void(std::int64_t, const std::vector<double>&)>& f) {
-  const std::vector<std::string> cols = columns_of(shaker);
-  const std::string d = std::to_string(daemon_id), u = std::to_string(run), table = shaker ? "hystlab.shaker_samples" : "hystlab.samples";
-  std::int64_t after = -1;
-  std::vector<double> row(cols.size());
-  for (;;) {
-    const std::string a = std::to_string(after);
-    const PgResult r =
-        pg_.query("SELECT seq, " + joined(cols) + " FROM " + table + " WHERE daemon_id = $1 AND run_id = $2 AND seq > $3 ORDER BY seq LIMIT 50000",
-                  {d.c_str(), u.c_str(), a.c_str()});
-    if (r.rows() == 0) return;
-    for (int k = 0; k < r.rows(); ++k) {
-      for (std::size_t c = 0; c < cols.size(); ++c) row[c] = num(r, k, static_cast<int>(c) + 1);
-      after = r.integer(k, 0);
-      f(after, row);
-    }
-  }
-}
-
 namespace {
-// Every row of a run's samples in seq order, `cols` (after seq) NULL as 0, in chunks of 50000.
+// Every row of a run's samples in seq order, `cols` after seq, in chunks of 50000.
 void for_each_row(PgConnection& pg, const std::string& table, const std::string& cols, int daemon_id, std::int64_t run,
                   const std::function<void(const PgResult&, int)>& f) {
   const std::string d = std::to_string(daemon_id), u = std::to_string(run);
@@ -229,6 +210,15 @@ void for_each_row(PgConnection& pg, const std::string& table, const std::string&
   }
 }
 }  // namespace
+
+void LabReads::for_each_sample(int daemon_id, std::int64_t run, bool shaker, const std::function<void(std::int64_t, const std::vector<double>&)>& f) {
+  const std::vector<std::string> cols = columns_of(shaker);
+  std::vector<double> row(cols.size());
+  for_each_row(pg_, shaker ? "hystlab.shaker_samples" : "hystlab.samples", joined(cols), daemon_id, run, [&](const PgResult& r, int k) {
+    for (std::size_t c = 0; c < cols.size(); ++c) row[c] = num(r, k, static_cast<int>(c) + 1);
+    f(r.integer(k, 0), row);
+  });
+}
 
 void LabReads::for_each_frame_row(int daemon_id, std::int64_t run, const std::function<void(const SampleRow&)>& f) {
   for_each_row(pg_, "hystlab.samples", "t, coalesce(cmd, 0), coalesce(disp, 0), coalesce(force, 0), coalesce(status, 0)", daemon_id, run,
