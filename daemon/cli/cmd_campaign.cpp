@@ -132,7 +132,7 @@ std::string heldout_line(const std::string& json_text) {
 }
 
 // hystlab tables list: one row a table, the columns aligned, and what its marks mean below it.
-void list_tables(db::Reads& store) {
+void list_tables(db::ReadSource& store) {
   const std::vector<Column> columns{{"id", true},
                                     {"campaign", true},
                                     {"method"},
@@ -180,7 +180,7 @@ int print_preview(const nlohmann::json& p) {
 }
 
 // A sine campaign's points and its resonance table (measured, and predicted where it was).
-void print_sweep(db::Reads& store, const db::CampaignRow& row) {
+void print_sweep(db::ReadSource& store, const db::CampaignRow& row) {
   const auto rows = store.transmissibility(row.id);
   if (rows.empty()) return;
   double threshold = 0.10, worst = 0;
@@ -216,7 +216,7 @@ void print_sweep(db::Reads& store, const db::CampaignRow& row) {
   }
 }
 
-void show_json(db::Reads& store, const db::CampaignRow& row) {
+void show_json(db::ReadSource& store, const db::CampaignRow& row) {
   const auto plan = nlohmann::json::parse(row.plan, nullptr, false);
   const std::string why = store.state_reason(row.id, row.state);
   nlohmann::json j{{"id", row.id},
@@ -251,7 +251,7 @@ void show_json(db::Reads& store, const db::CampaignRow& row) {
 
 // The campaign's first lines: what, where, its state and why, when; the specimen and the notes
 // the lab recorded with it (with the plan, or changed since: db/campaign_record.hpp).
-void print_heading(db::Reads& store, const db::CampaignRow& row) {
+void print_heading(db::ReadSource& store, const db::CampaignRow& row) {
   const std::string why = store.state_reason(row.id, row.state);
   std::cout << "campaign " << row.id << ": " << domain::to_string(row.kind) << " on " << store.rig_name(row.rig_id) << ", " << domain::to_string(row.state)
             << (why.empty() ? "" : ": " + why) << "\n"
@@ -267,7 +267,7 @@ void print_heading(db::Reads& store, const db::CampaignRow& row) {
 }
 
 // Every event, a sentence each, under the date it happened (UTC).
-void print_events(db::Reads& store, const db::CampaignRow& row) {
+void print_events(db::ReadSource& store, const db::CampaignRow& row) {
   std::cout << "  events (oldest first; times in UTC):\n";
   auto events = store.events(row.id);
   std::erase_if(events, [](const db::EventRow& e) { return e.kind == "gap"; });  // one per hole: the "gaps" summary says it in one line
@@ -280,7 +280,7 @@ void print_events(db::Reads& store, const db::CampaignRow& row) {
   }
 }
 
-int show_campaign(db::Reads& store, const db::CampaignRow& row, bool as_json) {
+int show_campaign(db::ReadSource& store, const db::CampaignRow& row, bool as_json) {
   if (as_json) {
     show_json(store, row);
     return 0;

@@ -11,6 +11,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "hystlab/db/lab_reads.hpp"
+#include "hystlab/db/pg_reads.hpp"
 #include "hystlab/db/run_csv.hpp"
 #include "hystlab/db/run_h5.hpp"
 #include "hystlab/db/store.hpp"
@@ -20,7 +21,8 @@ namespace hystlab::cli {
 namespace {
 const char* kRunsUsage = R"(usage: hystlab runs export RUN_ID [--format csv|h5] [-o FILE] [--db hystlab.db]
        hystlab runs export --campaign ID --format h5 -o FILE [--db hystlab.db]
-       hystlab runs export RUN_ID --pg URL --daemon NAME [--lab NAME] [--format csv] [-o FILE] [--pg-password-file FILE]
+       hystlab runs export RUN_ID --pg URL --daemon NAME [--lab NAME] [--format csv|h5] [-o FILE] [--pg-password-file FILE]
+       hystlab runs export --campaign ID --pg URL --daemon NAME [--lab NAME] --format h5 -o FILE
 
 csv (the default) writes the run's samples, to FILE or stdout, as GET /api/runs/ID/samples.csv
 does (docs/FORMATS.md, "Runs as CSV"): a load frame's seq,t_s,command_mm,displacement_mm,force_N,
@@ -34,8 +36,8 @@ signal with its units, and its campaign's plan, rig, events, FOT nodes and table
 A failed export leaves no file behind.
 
 With --pg, the run is read from the lab database (docs/LAB.md) that daemon NAME replicates into
-(RUN_ID: its id on that daemon, as hystlab lab show lists it): the same CSV, byte for byte, as
-from that daemon's file, of the samples replicated so far. HDF5 comes from the daemon's file only.
+(RUN_ID: its id on that daemon, as hystlab lab show lists it): the same CSV, byte for byte, and
+the same HDF5 layout as from that daemon's file, of what is replicated so far.
 )";
 
 std::int64_t whole_number(const std::string& text, const std::string& what) {
@@ -47,7 +49,7 @@ std::int64_t whole_number(const std::string& text, const std::string& what) {
 
 // The run's CSV (db/run_csv.hpp: the API's layout and bytes), written a window of samples at a
 // time: bounded memory at any length.
-void write_csv_rows(db::Reads& store, std::int64_t id, bool shaker, std::FILE* f, const std::string& name) {
+void write_csv_rows(db::ReadSource& store, std::int64_t id, bool shaker, std::FILE* f, const std::string& name) {
   std::string buf = db::run_csv_header(shaker);
   const std::int64_t last = db::last_seq(store, id, shaker);
   for (std::int64_t seq0 = 0; seq0 <= last; seq0 += db::kRunCsvWindow) {
@@ -83,45 +85,15 @@ void write_csv_output(const std::string& path, const std::function<void(std::FIL
   }
 }
 
-void export_csv(db::Reads& store, std::int64_t id, const std::string& path) {
+void export_csv(db::ReadSource& store, std::int64_t id, const std::string& path) {
   const db::RunSamples where = db::run_samples(store, id);
   if (where == db::RunSamples::none) throw CliError("no samples for run " + std::to_string(id));
   const bool shaker = where == db::RunSamples::shaker;  // a shaker's run: its own columns
   write_csv_output(path, [&](std::FILE* f, const std::string& name) { write_csv_rows(store, id, shaker, f, name); });
 }
 
-// The run's CSV from the lab database: the rows as the daemon's store gives them
-// (LabReads::for_each_*_row), through run_csv.hpp's own row writer, flushed a window at a time.
-int export_lab_csv(const Options& opt, std::int64_t id) {
-  const auto pg = connect_lab(opt);
-  db::LabReads lab(*pg);
-  try {
-    const db::LabDaemon daemon = lab_daemon(lab, opt.require("daemon"), opt.get("lab"));
-    const auto run = lab.run(daemon.id, id);
-    const std::string where = "on daemon '" + daemon.name + "' in the lab database";
-    if (!run) throw CliError("no samples for run " + std::to_string(id) + ": there is no run " + std::to_string(id) + " " + where);
-    if (run->samples == 0) throw CliError("no samples for run " + std::to_string(id) + " " + where + " (none replicated yet)");
-    write_csv_output(opt.get("output"), [&](std::FILE* f, const std::string& name) {
-      std::string buf = db::run_csv_header(run->shaker);
-      const auto flush = [&](bool force) {
-        if (!force && buf.size() < (std::size_t{1} << 20)) return;
-        if (std::fwrite(buf.data(), 1, buf.size(), f) != buf.size()) throw CliError("cannot write " + name + ": " + std::strerror(errno));
-        buf.clear();
-      };
-      if (run->shaker)
-        lab.for_each_shaker_row(daemon.id, id, [&](const db::ShakerRow& r) { db::append_csv_row(buf, r), flush(false); });
-      else
-        lab.for_each_frame_row(daemon.id, id, [&](const db::SampleRow& r) { db::append_csv_row(buf, r), flush(false); });
-      flush(true);
-    });
-  } catch (const db::PgError& e) {
-    throw CliError("the lab database: " + one_line(e.what()));
-  }
-  return 0;
-}
-
 // HDF5 beside the target, then renamed: the export removes its own file when it fails.
-void export_h5(db::Reads& store, std::int64_t id, bool campaign, const std::string& path) {
+void export_h5(db::ReadSource& store, std::int64_t id, bool campaign, const std::string& path) {
   if (path.empty() || path == "-") throw CliError("-o: HDF5 is a binary file: give its name (-o run.h5); it is not written to stdout");
   const std::string tmp = path + ".tmp";
   try {
@@ -137,6 +109,31 @@ void export_h5(db::Reads& store, std::int64_t id, bool campaign, const std::stri
     throw CliError("-o: cannot write '" + path + "' (" + e.what() + ")");
   }
 }
+
+// From the lab database: the daemon's rows there as a ReadSource (db/pg_reads.hpp), through the
+// same writers as from its file: the same CSV bytes and HDF5 layout, of what is replicated so far.
+int export_from_lab(const Options& opt, const std::string& format, bool campaign, std::int64_t id) {
+  const auto pg = connect_lab(opt);
+  db::LabReads lab(*pg);
+  try {
+    const db::LabDaemon daemon = lab_daemon(lab, opt.require("daemon"), opt.get("lab"));
+    db::PgReads store(*pg, daemon.id);
+    const std::string where = " on daemon '" + daemon.name + "' in the lab database";
+    if (campaign && !store.campaign(id)) throw CliError("no campaign " + std::to_string(id) + where);
+    if (!campaign) {
+      const auto run = store.run(id);
+      if (!run) throw CliError("no samples for run " + std::to_string(id) + ": there is no run " + std::to_string(id) + where);
+      if (run->samples == 0) throw CliError("no samples for run " + std::to_string(id) + where + " (none replicated yet)");
+    }
+    if (format == "csv")
+      export_csv(store, id, opt.get("output"));
+    else
+      export_h5(store, id, campaign, opt.get("output"));
+  } catch (const db::PgError& e) {
+    throw CliError("the lab database: " + one_line(e.what()));
+  }
+  return 0;
+}
 }  // namespace
 
 int run_runs_cmd(const Args& args) {
@@ -150,17 +147,15 @@ int run_runs_cmd(const Args& args) {
                     {});
   const std::string format = opt.get("format", "csv");
   if (format != "csv" && format != "h5") throw CliError("--format: '" + format + "' is not csv or h5");
-  if (opt.has("pg") || opt.has("daemon") || opt.has("lab") || opt.has("pg-password-file")) {  // from the lab database
-    if (opt.has("db")) throw CliError("--db and --pg name two sources: give one (the daemon's file, or the lab database)");
-    if (opt.has("campaign") || format == "h5")
-      throw CliError("--pg: HDF5 is exported from the daemon's own file (--db); from the lab database, a run's samples as CSV only");
-    if (!positional) throw CliError("give RUN_ID (see --help)");
-    if (!opt.has("daemon")) throw CliError("--pg: give --daemon NAME, the daemon whose run it is (hystlab lab campaigns lists them)");
-    return export_lab_csv(opt, whole_number(args[1], "RUN_ID"));
-  }
+  const bool lab = opt.has("pg") || opt.has("daemon") || opt.has("lab") || opt.has("pg-password-file");
+  if (lab && opt.has("db")) throw CliError("--db and --pg name two sources: give one (the daemon's file, or the lab database)");
   if (positional == opt.has("campaign")) throw CliError("give one of RUN_ID or --campaign ID (see --help)");
   if (opt.has("campaign") && format != "h5") throw CliError("--campaign: a whole campaign is exported as HDF5 only (--format h5)");
   const std::int64_t id = positional ? whole_number(args[1], "RUN_ID") : whole_number(opt.get("campaign"), "--campaign");
+  if (lab) {
+    if (!opt.has("daemon")) throw CliError("--pg: give --daemon NAME, the daemon whose run it is (hystlab lab campaigns lists them)");
+    return export_from_lab(opt, format, !positional, id);
+  }
   db::Store store = open_store(opt);
   if (positional && !store.run(id)) throw CliError("no samples for run " + std::to_string(id) + ": there is no run " + std::to_string(id));
   if (format == "csv")

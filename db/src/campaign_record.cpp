@@ -11,7 +11,7 @@ std::string text_of(const json& j, const char* key) {
 }
 }  // namespace
 
-CampaignRecord campaign_record(Reads& store, const CampaignRow& row) {
+CampaignRecord campaign_record(ReadSource& store, const CampaignRow& row) {
   CampaignRecord r;
   const json plan = json::parse(row.plan, nullptr, false);
   r.specimen = text_of(plan, "specimen");

@@ -20,7 +20,7 @@ using h5::Handle;
 // The envelope the campaign ran under: its newest "envelope" event (the rig's envelope as the
 // daemon had it when it started the campaign: the rig's row holds only today's config, rewritten
 // at every start of hystlabd), else the envelope the rig's stored config names; "null" when neither.
-std::string envelope_in_force(Reads& store, std::int64_t campaign, const std::string& config) {
+std::string envelope_in_force(ReadSource& store, std::int64_t campaign, const std::string& config) {
   if (const auto recorded = store.event_details(campaign, "envelope"); !recorded.empty()) {
     const auto e = nlohmann::json::parse(recorded.back(), nullptr, false);
     if (e.is_object()) return e.dump();
@@ -29,7 +29,7 @@ std::string envelope_in_force(Reads& store, std::int64_t campaign, const std::st
   return j.is_object() && j.contains("envelope") && j["envelope"].is_object() ? j["envelope"].dump() : "null";
 }
 
-void write_campaign_group(Reads& store, hid_t file, const CampaignRow& c) {
+void write_campaign_group(ReadSource& store, hid_t file, const CampaignRow& c) {
   const Handle g = h5::create_group(file, "campaign");
   h5::attr_int(g.get(), "id", c.id);
   h5::attr_text(g.get(), "kind", to_string(c.kind));
@@ -50,7 +50,7 @@ void write_campaign_group(Reads& store, hid_t file, const CampaignRow& c) {
   h5::dataset_text(g.get(), "limits", limits.empty() ? "null" : limits.back());
 }
 
-void write_events(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
+void write_events(ReadSource& store, hid_t file, std::int64_t campaign, int deflate_level) {
   const Handle g = h5::create_group(file, "events");
   std::vector<std::int64_t> id;
   std::vector<std::string> at, kind, from, to, detail;
@@ -66,7 +66,7 @@ void write_events(Reads& store, hid_t file, std::int64_t campaign, int deflate_l
   h5::dataset_texts(g.get(), "detail", detail, deflate_level);
 }
 
-void write_nodes(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
+void write_nodes(ReadSource& store, hid_t file, std::int64_t campaign, int deflate_level) {
   const Handle g = h5::create_group(file, "fot_nodes");
   std::vector<std::int64_t> id, run;
   std::vector<double> alpha, beta, fa, fab, t;
@@ -87,7 +87,7 @@ void write_nodes(Reads& store, hid_t file, std::int64_t campaign, int deflate_le
 // A sine campaign's points, one row per step measured, as GET /api/campaigns/ID/sweep.csv has
 // them: with each step's equivalent damping from its hysteresis loop (models/sweep_analysis.hpp),
 // measured and predicted (NaN without a prediction). None for a campaign without points.
-void write_sweep(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
+void write_sweep(ReadSource& store, hid_t file, std::int64_t campaign, int deflate_level) {
   const auto rows = store.transmissibility(campaign);
   if (rows.empty()) return;
   const Handle g = h5::create_group(file, "sweep");
@@ -120,7 +120,7 @@ void write_sweep(Reads& store, hid_t file, std::int64_t campaign, int deflate_le
 }
 }  // namespace
 
-std::int64_t write_campaign(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
+std::int64_t write_campaign(ReadSource& store, hid_t file, std::int64_t campaign, int deflate_level) {
   const auto c = store.campaign(campaign);
   if (!c) throw H5ExportError(H5ExportError::Kind::not_found, "no campaign " + std::to_string(campaign));
   write_campaign_group(store, file, *c);

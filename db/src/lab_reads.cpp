@@ -1,5 +1,7 @@
 #include "hystlab/db/lab_reads.hpp"
 
+#include "pg_values.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -8,9 +10,6 @@
 
 namespace hystlab::db {
 namespace {
-std::string opt(const PgResult& r, int row, int col) { return r.is_null(row, col) ? std::string() : r.text(row, col); }
-std::int64_t opt_int(const PgResult& r, int row, int col) { return r.is_null(row, col) ? 0 : r.integer(row, col); }
-double num(const PgResult& r, int row, int col) { return r.is_null(row, col) ? std::nan("") : std::strtod(r.text(row, col).c_str(), nullptr); }
 
 constexpr const char* kFrameColumns[] = {"t", "cmd", "disp", "force"};
 constexpr const char* kShakerColumns[] = {
@@ -58,7 +57,7 @@ std::vector<LabRig> LabReads::rigs(const std::string& lab) {
   for (int k = 0; k < r.rows(); ++k) {
     LabRig g;
     g.daemon_id = static_cast<int>(r.integer(k, 0)), g.daemon = r.text(k, 1), g.name = r.text(k, 2), g.id = r.integer(k, 3);
-    g.last_campaign = opt_int(r, k, 4), g.last_campaign_state = opt(r, k, 5);
+    g.last_campaign = pg_opt_int(r, k, 4), g.last_campaign_state = pg_opt(r, k, 5);
     out.push_back(std::move(g));
   }
   return out;
@@ -76,8 +75,8 @@ std::vector<LabCampaign> LabReads::campaigns(const LabFilter& f) {
   for (int k = 0; k < r.rows(); ++k) {
     LabCampaign c;
     c.daemon_id = static_cast<int>(r.integer(k, 0)), c.lab = r.text(k, 1), c.daemon = r.text(k, 2), c.rig = r.text(k, 3);
-    c.id = r.integer(k, 4), c.kind = opt(r, k, 5), c.state = opt(r, k, 6), c.specimen = r.text(k, 7);
-    c.created_at = opt(r, k, 8), c.updated_at = opt(r, k, 9);
+    c.id = r.integer(k, 4), c.kind = pg_opt(r, k, 5), c.state = pg_opt(r, k, 6), c.specimen = r.text(k, 7);
+    c.created_at = pg_opt(r, k, 8), c.updated_at = pg_opt(r, k, 9);
     out.push_back(std::move(c));
   }
   return out;
@@ -93,8 +92,8 @@ std::optional<LabCampaign> LabReads::campaign(const std::string& daemon, std::in
   if (r.rows() == 0) return std::nullopt;
   LabCampaign c;
   c.daemon_id = static_cast<int>(r.integer(0, 0)), c.lab = r.text(0, 1), c.daemon = r.text(0, 2), c.rig = r.text(0, 3);
-  c.id = r.integer(0, 4), c.kind = opt(r, 0, 5), c.state = opt(r, 0, 6), c.specimen = r.text(0, 7);
-  c.created_at = opt(r, 0, 8), c.updated_at = opt(r, 0, 9), c.plan = opt(r, 0, 10);
+  c.id = r.integer(0, 4), c.kind = pg_opt(r, 0, 5), c.state = pg_opt(r, 0, 6), c.specimen = r.text(0, 7);
+  c.created_at = pg_opt(r, 0, 8), c.updated_at = pg_opt(r, 0, 9), c.plan = pg_opt(r, 0, 10);
   return c;
 }
 
@@ -110,7 +109,7 @@ std::vector<LabRun> runs_where(PgConnection& pg, const std::string& where, int d
       {d.c_str(), c.c_str()});
   std::vector<LabRun> out;
   for (int k = 0; k < r.rows(); ++k)
-    out.push_back({r.integer(k, 0), r.integer(k, 5), r.text(k, 1), r.text(k, 2), r.text(k, 3), r.text(k, 4), opt(r, k, 6) == "t", r.integer(k, 7)});
+    out.push_back({r.integer(k, 0), r.integer(k, 5), r.text(k, 1), r.text(k, 2), r.text(k, 3), r.text(k, 4), pg_opt(r, k, 6) == "t", r.integer(k, 7)});
   return out;
 }
 }  // namespace
@@ -144,7 +143,7 @@ std::vector<LabTable> tables_in(const PgResult& r) {
     LabTable t;
     t.daemon_id = static_cast<int>(r.integer(k, 0)), t.daemon = r.text(k, 1), t.specimen = r.text(k, 2), t.method = r.text(k, 3);
     t.created_at = r.text(k, 4), t.accuracy = r.text(k, 5), t.id = r.integer(k, 6), t.campaign = r.integer(k, 7);
-    t.n = static_cast<int>(r.integer(k, 8)), t.range_lo = num(r, k, 9), t.range_hi = num(r, k, 10);
+    t.n = static_cast<int>(r.integer(k, 8)), t.range_lo = pg_num(r, k, 9), t.range_hi = pg_num(r, k, 10);
     out.push_back(std::move(t));
   }
   return out;
@@ -188,8 +187,8 @@ LabOverview LabReads::overview(int daemon_id, std::int64_t run, bool shaker, int
   const int nc = static_cast<int>(o.columns.size());
   for (int k = 0; k < r.rows(); ++k)
     for (int c = 0; c < nc; ++c) {
-      o.min[static_cast<std::size_t>(c)].push_back(num(r, k, 1 + c));
-      o.max[static_cast<std::size_t>(c)].push_back(num(r, k, 1 + nc + c));
+      o.min[static_cast<std::size_t>(c)].push_back(pg_num(r, k, 1 + c));
+      o.max[static_cast<std::size_t>(c)].push_back(pg_num(r, k, 1 + nc + c));
     }
   return o;
 }
@@ -215,25 +214,8 @@ void LabReads::for_each_sample(int daemon_id, std::int64_t run, bool shaker, con
   const std::vector<std::string> cols = columns_of(shaker);
   std::vector<double> row(cols.size());
   for_each_row(pg_, shaker ? "hystlab.shaker_samples" : "hystlab.samples", joined(cols), daemon_id, run, [&](const PgResult& r, int k) {
-    for (std::size_t c = 0; c < cols.size(); ++c) row[c] = num(r, k, static_cast<int>(c) + 1);
+    for (std::size_t c = 0; c < cols.size(); ++c) row[c] = pg_num(r, k, static_cast<int>(c) + 1);
     f(r.integer(k, 0), row);
-  });
-}
-
-void LabReads::for_each_frame_row(int daemon_id, std::int64_t run, const std::function<void(const SampleRow&)>& f) {
-  for_each_row(pg_, "hystlab.samples", "t, coalesce(cmd, 0), coalesce(disp, 0), coalesce(force, 0), coalesce(status, 0)", daemon_id, run,
-               [&](const PgResult& r, int k) {
-                 f(SampleRow{run, r.integer(k, 0), num(r, k, 1), num(r, k, 2), num(r, k, 3), num(r, k, 4), r.integer(k, 5)});
-               });
-}
-
-void LabReads::for_each_shaker_row(int daemon_id, std::int64_t run, const std::function<void(const ShakerRow&)>& f) {
-  std::string cols = "t";
-  for (std::size_t c = 1; c < std::size(kShakerColumns); ++c) cols += ", coalesce(" + std::string(kShakerColumns[c]) + ", 0)";
-  for_each_row(pg_, "hystlab.shaker_samples", cols + ", coalesce(status, 0)", daemon_id, run, [&](const PgResult& r, int k) {
-    std::array<double, 6> v{};
-    for (int c = 0; c < 6; ++c) v[static_cast<std::size_t>(c)] = num(r, k, c + 2);
-    f(ShakerRow{run, r.integer(k, 0), num(r, k, 1), domain::shaker_sample(v), r.integer(k, 8)});
   });
 }
 

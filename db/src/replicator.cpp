@@ -125,6 +125,9 @@ void Replicator::connect() {
     store = st.column_text(0);
   }
   auto pg = std::make_unique<PgConnection>(conninfo_, password_);
+  // Which daemon this session is, for whoever reads pg_stat_activity (a DBA; the kill -9 test).
+  const std::string app = "hystlabd " + id_.daemon;
+  (void)pg->query("SELECT set_config('application_name', $1, false)", {app.c_str()});
   pg_migrate(*pg);
   // This daemon's id in the lab, claimed by this SQLite file: another file under the same name
   // (a second daemon given the same lab.daemon, or a new file) would start its ids again under

@@ -6,7 +6,7 @@
 
 namespace hystlab::db {
 
-RunSamples run_samples(Reads& store, std::int64_t run) {
+RunSamples run_samples(ReadSource& store, std::int64_t run) {
   if (store.max_seq(run) >= 0) return RunSamples::frame;
   return store.max_shaker_seq(run) >= 0 ? RunSamples::shaker : RunSamples::none;
 }
@@ -37,7 +37,7 @@ void append_csv_row(std::string& out, const ShakerRow& r) {
   out.push_back('\n');
 }
 
-std::int64_t append_csv_rows(Reads& store, std::int64_t run, bool shaker, std::int64_t seq0, std::int64_t seq1, std::string& out) {
+std::int64_t append_csv_rows(ReadSource& store, std::int64_t run, bool shaker, std::int64_t seq0, std::int64_t seq1, std::string& out) {
   std::int64_t rows = 0;
   if (shaker)
     store.for_each_shaker_sample(run, seq0, seq1, [&](const ShakerRow& r) { append_csv_row(out, r), ++rows; });
@@ -46,6 +46,6 @@ std::int64_t append_csv_rows(Reads& store, std::int64_t run, bool shaker, std::i
   return rows;
 }
 
-std::int64_t last_seq(Reads& store, std::int64_t run, bool shaker) { return shaker ? store.max_shaker_seq(run) : store.max_seq(run); }
+std::int64_t last_seq(ReadSource& store, std::int64_t run, bool shaker) { return shaker ? store.max_shaker_seq(run) : store.max_seq(run); }
 
 }  // namespace hystlab::db

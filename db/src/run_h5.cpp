@@ -32,7 +32,7 @@ std::string unit_of(const char* label) {
 
 // Where a run's samples are: a load frame's table or a shaker's (none: no samples).
 enum class RigKind { none, frame, shaker };
-RigKind rig_kind_of(Reads& store, std::int64_t run) {
+RigKind rig_kind_of(ReadSource& store, std::int64_t run) {
   if (store.max_seq(run) >= 0) return RigKind::frame;
   return store.max_shaker_seq(run) >= 0 ? RigKind::shaker : RigKind::none;
 }
@@ -71,7 +71,7 @@ SampleColumns make_columns(hid_t group, const std::array<domain::SignalName, N>&
 }
 
 // Every sample of the run, in seq order; returns how many.
-std::int64_t write_samples(Reads& store, hid_t group, const RunInfo& run, RigKind kind, const H5ExportOptions& opt) {
+std::int64_t write_samples(ReadSource& store, hid_t group, const RunInfo& run, RigKind kind, const H5ExportOptions& opt) {
   const std::int64_t last = kind == RigKind::frame ? store.max_seq(run.id) : store.max_shaker_seq(run.id), step = opt.rows_per_read;
   SampleColumns c = kind == RigKind::frame ? make_columns(group, domain::kFrameSignals, run.wall_anchor_unix, opt)
                                            : make_columns(group, domain::kShakerSignals, run.wall_anchor_unix, opt);
@@ -95,7 +95,7 @@ std::int64_t write_samples(Reads& store, hid_t group, const RunInfo& run, RigKin
   return n;
 }
 
-std::int64_t write_run(Reads& store, hid_t runs, const RunInfo& run, RigKind kind, const H5ExportOptions& opt) {
+std::int64_t write_run(ReadSource& store, hid_t runs, const RunInfo& run, RigKind kind, const H5ExportOptions& opt) {
   const Handle g = h5::create_group(runs, "run_" + std::to_string(run.id));
   h5::attr_int(g.get(), "id", run.id);
   h5::attr_int(g.get(), "campaign", run.campaign);
@@ -138,7 +138,7 @@ H5ExportStats write_file(const std::string& path, F body) {
   }
 }
 
-H5ExportStats write_runs(Reads& store, hid_t file, const char* scope, std::int64_t campaign, const std::vector<std::pair<RunInfo, RigKind>>& runs,
+H5ExportStats write_runs(ReadSource& store, hid_t file, const char* scope, std::int64_t campaign, const std::vector<std::pair<RunInfo, RigKind>>& runs,
                          const H5ExportOptions& opt) {
   write_root(file, scope, campaign);
   H5ExportStats stats;
@@ -156,7 +156,7 @@ void check_options(const H5ExportOptions& opt) {
 }
 }  // namespace
 
-H5ExportStats export_run_h5(Reads& store, std::int64_t run_id, const std::string& path, const H5ExportOptions& opt) {
+H5ExportStats export_run_h5(ReadSource& store, std::int64_t run_id, const std::string& path, const H5ExportOptions& opt) {
   check_options(opt);
   const auto run = store.run(run_id);
   if (!run) throw H5ExportError(H5ExportError::Kind::not_found, "no run " + std::to_string(run_id));
@@ -165,7 +165,7 @@ H5ExportStats export_run_h5(Reads& store, std::int64_t run_id, const std::string
   return write_file(path, [&](hid_t f) { return write_runs(store, f, "run", run->campaign, {{*run, kind}}, opt); });
 }
 
-H5ExportStats export_campaign_h5(Reads& store, std::int64_t campaign_id, const std::string& path, const H5ExportOptions& opt) {
+H5ExportStats export_campaign_h5(ReadSource& store, std::int64_t campaign_id, const std::string& path, const H5ExportOptions& opt) {
   check_options(opt);
   if (!store.campaign(campaign_id)) throw H5ExportError(H5ExportError::Kind::not_found, "no campaign " + std::to_string(campaign_id));
   std::vector<std::pair<RunInfo, RigKind>> runs;

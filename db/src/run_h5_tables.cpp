@@ -27,7 +27,7 @@ void write_table_numbers(hid_t g, const models::EverettTable& t) {
   h5::attr_text(h5::dataset_scalar(g, "force_offset_N", t.force_offset()).get(), "units", "N");
 }
 
-void write_table(Reads& store, hid_t tables, const TableInfo& info) {
+void write_table(ReadSource& store, hid_t tables, const TableInfo& info) {
   const h5::Handle g = h5::create_group(tables, "table_" + std::to_string(info.id));
   h5::attr_int(g.get(), "id", info.id);
   h5::attr_int(g.get(), "campaign", info.campaign.value_or(0));
@@ -52,7 +52,7 @@ void write_table(Reads& store, hid_t tables, const TableInfo& info) {
 }
 }  // namespace
 
-std::int64_t write_tables(Reads& store, hid_t file, std::int64_t campaign, int deflate_level) {
+std::int64_t write_tables(ReadSource& store, hid_t file, std::int64_t campaign, int deflate_level) {
   (void)deflate_level;  // tables are small: stored whole, uncompressed
   const h5::Handle g = h5::create_group(file, "tables");
   std::int64_t n = 0;

@@ -29,6 +29,39 @@ world.on('exit', code => { if (code) console.log(`the lab world exited with ${co
 const base = (await said(/lab view: (http:\S+)\//, 240000))[1];
 console.log(`lab view at ${base}`);
 
+// A campaign on its rig's own page, read-only, from the lab database (/daemons/NAME/): the loop
+// with the identified table's force, the Preisach triangle, the held-out score, downloads from
+// the lab; no form, no commands. Screenshots at 1280 and 800 px.
+async function archivePage(browser, base, href) {
+  check(/^\/daemons\/frame-pc-2\/#campaign\/1$/.test(href || ''), `the view links the campaign to its rig's page: ${href}`);
+  const p = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+  const errs = [];
+  p.on('pageerror', e => errs.push(String(e)));
+  await p.goto(base + href);
+  const shown = await wait(p, () => window.hystlab && window.hystlab.state() === 'completed' && window.hystlab.loopPoints() > 100 &&
+    window.hystlab.modelPoints() > 100 && window.hystlab.heatmapIdentified() > 0, null, 'the archived campaign\'s plots');
+  check(shown, `its loop, the table's force and the triangle: ${await p.evaluate(() => JSON.stringify({ s: window.hystlab.state(),
+    loop: window.hystlab.loopPoints(), model: window.hystlab.modelPoints(), nodes: window.hystlab.heatmapIdentified() }))}`);
+  check(await p.evaluate(() => window.hystlab.archive() && window.hystlab.heatmapIdentified() === window.hystlab.heatmapRequired()),
+    'every node of the triangle, as the daemon identified it');
+  check(/Campaign #1: fot on sim frame · SMA spring 8/.test(await p.textContent('#title')), `its title: ${await p.textContent('#title')}`);
+  check(!(await p.isVisible('#plan-form')) && !(await p.isVisible('#pause')) && !(await p.isVisible('#abort')) && !(await p.isVisible('.edit-record')),
+    'no form, no commands, no editing of the record (read-only)');
+  check(/frame-pc-2 \(read-only, from the lab database\)/.test(await p.textContent('#daemon')), `it says where it reads: ${await p.textContent('#daemon')}`);
+  check((await p.$$eval('#accuracy .heldout', es => es.map(e => e.textContent))).length > 0, 'the held-out score beside the table');
+  const exports = await p.$$eval('#downloads a', as => as.map(a => a.getAttribute('href')));
+  check(exports.length > 0 && exports.every(h => h.startsWith('/daemons/frame-pc-2/api/tables/')), `downloads from the lab database: ${exports}`);
+  const table = await fetch(base + exports.find(h => h.endsWith('format=json')));
+  check(table.status === 200 && (await table.json()).format !== undefined, `a table's document downloads (${table.status})`);
+  await p.screenshot({ path: path.join(outDir, 'lab-archive-1280.png'), fullPage: true });
+  await p.setViewportSize({ width: 800, height: 900 });
+  await p.waitForTimeout(300);
+  check(await p.evaluate(() => document.documentElement.scrollWidth <= 800), 'the archived page fits 800 px');
+  await p.screenshot({ path: path.join(outDir, 'lab-archive-800.png'), fullPage: true });
+  check(errs.length === 0, `no script error on the archived page: ${errs.join('; ')}`);
+  await p.close();
+}
+
 const browser = await chromium.launch({ executablePath: chromiumPath, headless: true,
   args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking', '--no-first-run', '--disable-sync'] });
 const wait = (page, fn, arg, what, timeout = 30000) =>
@@ -74,6 +107,7 @@ try {
   check(await page.evaluate(() => document.documentElement.scrollWidth <= 800), `nothing wider than 800 px (${await page.evaluate(() => document.documentElement.scrollWidth)})`);
   check(await page.evaluate(() => document.querySelector('#lab-plot canvas').getBoundingClientRect().right <= 800), 'the plot follows the width');
   await page.screenshot({ path: path.join(outDir, 'lab-800.png'), fullPage: true });
+  await archivePage(browser, base, await page.getAttribute('#lab-campaign-open', 'href'));
   const post = await fetch(base + '/api/campaigns', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: '{"plan": {}}' });
   check(post.status === 405, `read-only: a POST is refused (${post.status})`);
   // A rig's own page (the card's link): its daemon's replication and broker in its header.

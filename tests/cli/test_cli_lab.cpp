@@ -78,6 +78,24 @@ void shaker_samples(db::Store& s, std::int64_t run, int n, std::uint64_t seed) {
   tx.commit();
 }
 
+// A table document as hystlab writes one (models/formats.cpp): n subdivisions of [0, hi] mm.
+std::string table_doc(int n, double hi) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int i = 0; i <= n; ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int j = 0; j <= i; ++j) row.push_back(2.5 * (i - j) * (i - j) / n);
+    rows.push_back(row);
+  }
+  return nlohmann::json{{"format", "hystlab-everett-table"},
+                        {"version", 1},
+                        {"range_mm", {0, hi}},
+                        {"subdivisions", n},
+                        {"force_offset_N", 0.25},
+                        {"rows", rows},
+                        {"provenance", {{"source", "test"}, {"method", "fot"}, {"n", n}}}}
+      .dump();
+}
+
 // Daemon frame-pc-1: campaign 1 (the specimen, rig "frame A") with a run and a validation run,
 // two tables (held-out RMS 0.8 and 0.5, the second recommended), a few events.
 // Daemon frame-pc-2: campaign 1 (the specimen, rig "frame B"), tables with held-out RMS 0.3
@@ -101,8 +119,8 @@ struct Lab {
       a.end_run(run, domain::CampaignState::completed, iso(10));
       a.end_run(validation, domain::CampaignState::completed, iso(11));
       a.add_raw_event(c, "note", R"({"text":"grips re-tightened"})", iso(12));
-      a.add_table(c, run, "fot", 12, 0, 4, iso(13), accuracy(0.6, 0.8, false), R"({"n":12})");
-      a.add_table(c, run, "least-squares", 12, 0, 4, iso(14), accuracy(0.4, 0.5, true), R"({"n":12})");
+      a.add_table(c, run, "fot", 12, 0, 4, iso(13), accuracy(0.6, 0.8, false), table_doc(12, 4));
+      a.add_table(c, run, "least-squares", 12, 0, 4, iso(14), accuracy(0.4, 0.5, true), table_doc(12, 4));
       a.transition(c, domain::CampaignState::completed, "done", iso(15));
     }
     {
@@ -112,11 +130,11 @@ struct Lab {
       b.transition(c, domain::CampaignState::running, "armed", iso(21));
       const auto run = b.add_run(c, iso(21), 1.8e9, 3.0);
       frame_samples(b, run, 1500, 3);
-      b.add_table(c, run, "fot", 10, 0, 4, iso(22), accuracy(0.35, 0.3, true), R"({"n":10})");
-      b.add_table(c, run, "fot", 8, 0, 4, iso(23), accuracy(0.2, -1, false), R"({"n":8})");
+      b.add_table(c, run, "fot", 10, 0, 4, iso(22), accuracy(0.35, 0.3, true), table_doc(10, 4));
+      b.add_table(c, run, "fot", 8, 0, 4, iso(23), accuracy(0.2, -1, false), table_doc(8, 4));
       b.transition(c, domain::CampaignState::completed, "done", iso(24));
       const auto other = b.create_campaign(rig, domain::CampaignKind::waveform, R"({"kind":"waveform","specimen":"rubber mount"})", iso(30));
-      b.add_table(other, std::nullopt, "fot", 6, 0, 2, iso(31), accuracy(0.1, 0.05, true), R"({"n":6})");
+      b.add_table(other, std::nullopt, "fot", 6, 0, 2, iso(31), accuracy(0.1, 0.05, true), table_doc(6, 2));
       const auto shaker = b.upsert_rig("shaker B", R"({"kind":"shaker"})", iso(0));
       const auto sweep = b.create_campaign(shaker, domain::CampaignKind::sine, R"({"kind":"sine","specimen":"isolator 3"})", iso(40));
       shaker_samples(b, b.add_run(sweep, iso(40), 1.8e9, 0.0), 500, 4);
@@ -318,6 +336,64 @@ TEST_CASE("runs export --pg: a run's CSV from the lab equal byte for byte to the
   CHECK(lines_of(slurp(w / "lab.csv")).size() == 501);
 }
 
+// Two HDF5 exports hold the same: every group, dataset and attribute, values equal (NaN equal to
+// NaN; text that is JSON compared as JSON: the lab database keeps JSON as jsonb, its keys in its
+// own order), but the file's "created" time. Run by Debian's h5py; prints "same" or the differences.
+constexpr const char* kSameH5 = R"(import sys, json, h5py, numpy as np
+a, b = h5py.File(sys.argv[1], 'r'), h5py.File(sys.argv[2], 'r')
+def plain(v):
+    if isinstance(v, bytes): v = v.decode()
+    if isinstance(v, str):
+        try: return json.loads(v)
+        except ValueError: return v
+    return v.tolist() if isinstance(v, np.ndarray) else v
+def same(x, y):
+    if isinstance(x, np.ndarray) and x.dtype.kind == 'f': return x.shape == y.shape and np.array_equal(x, y, equal_nan=True)
+    if isinstance(x, np.ndarray) and x.dtype.kind in 'OSU': return [plain(v) for v in x.ravel()] == [plain(v) for v in y.ravel()]
+    if isinstance(x, np.ndarray): return x.dtype == y.dtype and np.array_equal(x, y)
+    return plain(x) == plain(y)
+diff, seen = [], 0
+def attrs(name, x, y):
+    for k in set(x.attrs) | set(y.attrs):
+        if name == '/' and k == 'created': continue
+        if k not in x.attrs or k not in y.attrs or not same(x.attrs[k], y.attrs[k]): diff.append(name + '@' + k)
+def visit(name, obj):
+    global seen
+    seen += 1
+    other = b.get(name)
+    if other is None or type(other) != type(obj): return diff.append('only in the first: ' + name)
+    attrs(name, obj, other)
+    if isinstance(obj, h5py.Dataset) and not same(obj[()], other[()]): diff.append('values of ' + name)
+a.visititems(visit)
+b.visititems(lambda name, obj: None if name in a else diff.append('only in the second: ' + name))
+attrs('/', a, b)
+print('same' if not diff else 'differ: ' + ', '.join(diff[:20]), seen)
+)";
+
+TEST_CASE("runs export --pg --format h5: a run and a campaign as HDF5 from the lab, as from the daemon's file") {
+  Lab& l = lab();
+  Workdir w;
+  w.write("same_h5.py", kSameH5);
+  for (const auto& [what, db, daemon] :
+       {std::tuple{"1", l.a_db, "frame-pc-1"}, std::tuple{"--campaign 1", l.b_db, "frame-pc-2"}, std::tuple{"2", l.b_db, "frame-pc-2"}}) {
+    CAPTURE(std::string(what));
+    CAPTURE(std::string(daemon));
+    const Result file = w.run("runs export " + std::string(what) + " --format h5 -o file.h5 --db " + db);
+    CAPTURE(file.err);
+    REQUIRE(file.code == 0);
+    const Result pg = l.run(w, "runs export " + std::string(what) + " " + l.pg() + " --daemon " + daemon + " --format h5 -o lab.h5");
+    CAPTURE(pg.err);
+    REQUIRE(pg.code == 0);
+    // "wrote NAME: N run(s), M samples, K table(s)"
+    CHECK(pg.err.substr(pg.err.find(": ")) == file.err.substr(file.err.find(": ")));
+    const Result cmp = w.run_raw("/usr/bin/python3 same_h5.py file.h5 lab.h5");  // Debian's, with its h5py
+    CAPTURE(cmp.err);
+    CHECK(cmp.out.rfind("same ", 0) == 0);
+    CHECK(cmp.out.find("same 1\n") == std::string::npos);  // more than the root compared
+    CAPTURE(cmp.out);
+  }
+}
+
 TEST_CASE("lab: one clear error each (no server, a refused password, a password in the URL, unknown names), exit 2") {
   Lab& l = lab();
   Workdir w;
@@ -346,7 +422,9 @@ TEST_CASE("lab: one clear error each (no server, a refused password, a password 
   check_error(l.run(w, "runs export 9 " + l.pg() + " --daemon frame-pc-1"), "there is no run 9 on daemon 'frame-pc-1' in the lab database");
   check_error(l.run(w, "runs export 1 " + l.pg() + " --daemon nobody"), "no daemon 'nobody'");
   check_error(l.run(w, "runs export 1 " + l.pg()), "give --daemon NAME");
-  check_error(l.run(w, "runs export 1 " + l.pg() + " --daemon frame-pc-1 --format h5 -o x.h5"), "HDF5 is exported from the daemon's own file");
+  check_error(l.run(w, "runs export --campaign 9 " + l.pg() + " --daemon frame-pc-1 --format h5 -o x.h5"),
+              "no campaign 9 on daemon 'frame-pc-1' in the lab database");
+  check_error(l.run(w, "runs export --campaign 1 " + l.pg() + " --daemon frame-pc-1"), "a whole campaign is exported as HDF5 only");
   CHECK_FALSE(std::filesystem::exists(w / "x.h5"));
 }
 

@@ -1,6 +1,6 @@
 // Two hystlabd processes with simulated load frames replicate into one PostgreSQL of the test's
 // own: the lab database is stopped for 30 s mid-campaign (the daemons keep acquiring, the
-// campaigns end while it is down), one daemon is killed with SIGKILL while catching up and
+// campaigns end while it is down), one daemon is killed with SIGKILL mid-batch while catching up and
 // restarted; in the end every sample of both is there once, equal to the bit to SQLite's. A
 // wrong password is one clear error in /api/status and the daemon acquires anyway.
 #include <doctest/doctest.h>
@@ -72,11 +72,22 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   CHECK(acquired(a) > before);  // acquisition went on
   server.start();
 
-  // Killed while catching up (after its first pass back: 10 batches of 20,000 samples, of a
-  // backlog of about 3·10^5), restarted on the same files: it resumes from PostgreSQL's marks.
-  const std::int64_t copied = a.get("/api/status")["lab"]["postgresql"]["samples"].get<std::int64_t>();
-  REQUIRE(wait_until([&] { return a.get("/api/status")["lab"]["postgresql"]["samples"].get<std::int64_t>() > copied; }, 60));
-  a.stop(SIGKILL);
+  // Killed mid-batch while catching up (a backlog of about 3·10^5 samples, batches of 20,000):
+  // when PostgreSQL shows its session inside a transaction that has begun a COPY of samples
+  // (pg_stat_activity; the replicator names its session), the daemon dies. Restarted on the same
+  // files, it resumes from PostgreSQL's marks: the batch that died with it is copied again, once.
+  {
+    db::PgConnection watch(server.url(), PostgresServer::kPassword);
+    const auto copying = [&] {
+      return watch
+                 .query(
+                     "SELECT count(*) FROM pg_stat_activity WHERE application_name = 'hystlabd frame-pc-1' AND xact_start IS NOT NULL "
+                     "AND query LIKE 'COPY hystlab.samples%'")
+                 .integer(0, 0) > 0;
+    };
+    REQUIRE(wait_until(copying, 60, std::chrono::milliseconds(1)));
+    a.stop(SIGKILL);
+  }
   a.start();
   db::PgConnection pg(server.url(), PostgresServer::kPassword);
   REQUIRE(wait_until([&] { return campaign_state(b.db(), cb) == "completed"; }, 120));
@@ -140,4 +151,40 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   CHECK(post->status == 405);
   CHECK(post->body.find("read-only") != std::string::npos);
   CHECK(view.get("/api/status")["mode"] == "lab view");
+
+  // A rig daemon's read endpoints, answered from the lab database at /daemons/NAME/api/...: the
+  // same JSON as the daemon's own (its campaign completed and caught up above).
+  const std::string c1 = std::to_string(cb);
+  std::vector<std::string> paths = {"/api/campaigns", "/api/campaigns?state=completed", "/api/tables"};
+  for (const char* tail : {"", "/events", "/nodes", "/loops", "/runs", "/sweep", "/transmissibility"}) paths.push_back("/api/campaigns/" + c1 + tail);
+  const json runs = b.get("/api/campaigns/" + c1 + "/runs");
+  REQUIRE(runs.size() >= 2);  // its run and its validation run
+  for (const json& r : runs)
+    for (const char* tail : {"", "/samples?points=300", "/samples?points=40&t0=1.5&t1=9.25", "/loop?points=300"})
+      paths.push_back("/api/runs/" + std::to_string(r["id"].get<std::int64_t>()) + tail);
+  const json tables = b.get("/api/tables");
+  REQUIRE(tables.size() >= 1);
+  for (const json& tb : tables) {
+    const std::string id = std::to_string(tb["id"].get<std::int64_t>());
+    paths.push_back("/api/tables/" + id);
+    paths.push_back("/api/tables/" + id + "/score?run=" + std::to_string(runs.back()["id"].get<std::int64_t>()));
+    paths.push_back("/api/tables/" + id + "/export?format=json");
+  }
+  for (const std::string& p : paths) {
+    CAPTURE(p);
+    CHECK(view.get("/daemons/frame-pc-2" + p) == b.get(p));
+  }
+  const std::string table = std::to_string(tables[0]["id"].get<std::int64_t>());
+  CHECK(view.text("/daemons/frame-pc-2/api/tables/" + table + "/export?format=csv") == b.text("/api/tables/" + table + "/export?format=csv"));
+  CHECK(view.text("/daemons/frame-pc-2/api/campaigns/" + c1 + "/sweep.csv") == b.text("/api/campaigns/" + c1 + "/sweep.csv"));
+  (void)view.text("/daemons/frame-pc-9/api/campaigns", &status);
+  CHECK(status == 404);
+  CHECK(view.text("/daemons/frame-pc-2/api/campaigns/999", &status).find("no campaign 999") != std::string::npos);
+  CHECK(status == 404);
+  // The rig's own page over it, read-only (the page reads its API's place from the meta).
+  const std::string page = view.text("/daemons/frame-pc-2/", &status);
+  CHECK(status == 200);
+  CHECK(page.find(R"(<meta name="hystlab-base" content="/daemons/frame-pc-2" data-daemon="frame-pc-2">)") != std::string::npos);
+  (void)view.text("/app.js", &status);
+  CHECK(status == 200);
 }

@@ -192,7 +192,7 @@ TEST_CASE("replication: PostgreSQL stopped mid-campaign and started again, or a 
       db::PgConnection admin(server.url(), PostgresServer::kPassword);
       while (!done)
         if (admin
-                .query("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE application_name = 'hystlabd' AND state = 'active' AND pid <> "
+                .query("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE application_name = 'hystlabd frame-pc-1' AND state = 'active' AND pid <> "
                        "pg_backend_pid()")
                 .rows() > 0)
           return;

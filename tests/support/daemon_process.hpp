@@ -86,12 +86,12 @@ inline bool accepts(int port) {
   return ok;
 }
 
-// Polls cond every 20 ms until it holds or the deadline passes; returns the last answer.
-inline bool wait_until(const std::function<bool()>& cond, double seconds) {
+// Polls cond every `every` (20 ms) until it holds or the deadline passes; returns the last answer.
+inline bool wait_until(const std::function<bool()>& cond, double seconds, std::chrono::milliseconds every = std::chrono::milliseconds(20)) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (!cond()) {
     if (std::chrono::steady_clock::now() > end) return cond();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::this_thread::sleep_for(every);
   }
   return true;
 }

@@ -7,6 +7,7 @@
 
 #include "api_support.hpp"
 #include "event_stream.hpp"
+#include "read_routes.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
 
@@ -57,9 +58,13 @@ HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg, La
   });
   add_status_routes(s, m.ctx);
   add_campaign_routes(s, m.ctx);
+  // The read endpoints, from this daemon's own file (the lab view serves the same from PostgreSQL).
+  add_read_routes(s, "", [&c = m.ctx, xy = make_xy_cache()](const httplib::Request& req, httplib::Response& res, const ReadHandler& h) {
+    ReadContext rc{reader(c.db_path), *xy};
+    h(req, res, rc);
+  });
   add_data_routes(s, m.ctx);
   add_loop_routes(s, m.ctx);
-  add_sweep_routes(s, m.ctx);
   add_h5_routes(s, m.ctx);
   add_report_routes(s, m.ctx);
   add_stream_route(s, m.ctx);

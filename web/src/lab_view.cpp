@@ -3,6 +3,8 @@
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
+#include <cctype>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -10,8 +12,11 @@
 
 #include "api_support.hpp"
 #include "hystlab/db/lab_reads.hpp"
+#include "hystlab/db/pg_reads.hpp"
 #include "lab_view_json.hpp"
+#include "read_routes.hpp"
 #include "request_guard.hpp"
+#include "routes.hpp"
 
 namespace hystlab::web {
 using nlohmann::json;
@@ -30,9 +35,15 @@ struct LabView::Impl {
   std::unique_ptr<db::PgConnection> pg;
   std::string pg_error;
 
-  // f(reads) under the connection's lock, connecting first when needed; a lost server is a 503
-  // naming it, and the next request connects again.
   void with_lab(httplib::Response& res, const std::function<void(db::LabReads&)>& f) {
+    with_pg(res, [&](db::PgConnection& c) {
+      db::LabReads reads(c);
+      f(reads);
+    });
+  }
+  // f(connection) under the connection's lock, connecting first when needed; a lost server is a
+  // 503 naming it, and the next request connects again.
+  void with_pg(httplib::Response& res, const std::function<void(db::PgConnection&)>& f) {
     const std::lock_guard lock(pg_mu);
     try {
       if (!pg || !pg->ok()) {
@@ -41,8 +52,7 @@ struct LabView::Impl {
         pg->exec("SET default_transaction_read_only = on");
         pg->exec("SET statement_timeout = '20s'");
       }
-      db::LabReads reads(*pg);
-      f(reads);
+      f(*pg);
       pg_error.clear();
     } catch (const db::PgError& e) {
       pg_error = e.what();
@@ -66,6 +76,55 @@ std::string file_text(const std::string& path) {
 db::LabFilter filter_of(const httplib::Request& req, const std::string& lab) {
   return {lab, req.get_param_value("daemon"), req.get_param_value("specimen"), req.get_param_value("kind"),
           static_cast<int>(query_number(req, "limit", 200, 1, 5000))};
+}
+
+// A daemon's read endpoints at /daemons/NAME/api/..., answered from its rows in the lab database
+// with the rig daemon's own handlers (read_routes.hpp).
+void add_daemon_routes(httplib::Server& s, LabView::Impl& m) {
+  add_read_routes(s, "/daemons/([^/]+)", [&m](const httplib::Request& req, httplib::Response& res, const ReadHandler& h) {
+    const std::string daemon = req.matches[1].str();
+    m.with_pg(res, [&](db::PgConnection& pg) {
+      const auto id = db::PgReads::daemon_id(pg, m.lab.name, daemon);
+      if (!id) return send_error(res, 404, "not found", "no daemon '" + daemon + "' in lab " + m.lab.name);
+      db::PgReads reads(pg, *id);
+      // A cache for this request only: a run still replicating must be read again next time.
+      const auto xy = make_xy_cache();
+      ReadContext rc{reads, *xy};
+      h(req, res, rc);
+    });
+  });
+}
+
+// The rig's own page, showing one daemon's records read-only (web/static/api.js: the meta says
+// where its API is); its name escaped, as it goes into HTML.
+std::string archive_page(const std::string& index, const std::string& daemon) {
+  std::string name;
+  for (const char ch : daemon) {
+    if (ch == '&')
+      name += "&amp;";
+    else if (ch == '<')
+      name += "&lt;";
+    else if (ch == '>')
+      name += "&gt;";
+    else if (ch == '"')
+      name += "&quot;";
+    else
+      name += ch;
+  }
+  std::string base;  // the path segment as the browser sent it, percent-encoded where needed
+  for (const char c : daemon) {
+    const auto ch = static_cast<unsigned char>(c);
+    if (std::isalnum(ch) || ch == '-' || ch == '_' || ch == '.' || ch == '~') {
+      base += static_cast<char>(ch);
+    } else {
+      constexpr const char* kHex = "0123456789ABCDEF";
+      base += '%', base += kHex[ch >> 4], base += kHex[ch & 15];
+    }
+  }
+  const std::string meta = "<meta name=\"hystlab-base\" content=\"/daemons/" + base + "\" data-daemon=\"" + name + "\">\n";
+  std::string out = index;
+  const std::size_t at = out.find("<head>");
+  return at == std::string::npos ? out : out.insert(at + 6, "\n" + meta);
 }
 
 void add_lab_routes(httplib::Server& s, LabView::Impl& m) {
@@ -137,16 +196,22 @@ LabView::LabView(const control::HttpConfig& http, const lab::LabConfig& lab, Liv
     if (res.body.empty() && res.status == 404) send_error(res, 404, "not found", "no such resource: " + req.method + " " + req.path);
   });
   add_lab_routes(s, m);
+  add_daemon_routes(s, m);
   const std::string root = default_dir(http.web_root, "", HYSTLAB_WEB_ROOT), vendor = default_dir(http.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT);
   s.set_mount_point("/vendor/uplot", vendor);
-  // The lab's page at "/", and only the files it uses (the rig page's own are not served here).
-  for (const char* f : {"/lab.js", "/style.css", "/fmt.js", "/favicon.svg"})
-    s.Get(f, [root, f](const httplib::Request&, httplib::Response& res) {
-      const std::string path = std::string(f);
-      const char* type = path.ends_with(".js") ? "text/javascript" : path.ends_with(".css") ? "text/css" : "image/svg+xml";
-      res.set_content(file_text(root + path), type);
-    });
+  // The lab's page at "/"; the rig page's scripts and style beside it (a daemon's records are shown
+  // on the rig's own page, /daemons/NAME/). Files by name, so that "/" stays the lab's page.
+  for (const auto& entry : std::filesystem::directory_iterator(root)) {
+    const std::string name = entry.path().filename().string();
+    const bool js = name.ends_with(".js"), css = name.ends_with(".css"), svg = name.ends_with(".svg");
+    if (!js && !css && !svg) continue;
+    const char* type = js ? "text/javascript" : css ? "text/css" : "image/svg+xml";
+    s.Get("/" + name, [path = entry.path().string(), type](const httplib::Request&, httplib::Response& res) { res.set_content(file_text(path), type); });
+  }
   s.Get("/", [root](const httplib::Request&, httplib::Response& res) { res.set_content(file_text(root + "/lab.html"), "text/html; charset=utf-8"); });
+  s.Get("/daemons/([^/]+)/", [root](const httplib::Request& req, httplib::Response& res) {
+    res.set_content(archive_page(file_text(root + "/index.html"), req.matches[1].str()), "text/html; charset=utf-8");
+  });
   m.port = http.port == 0 ? s.bind_to_any_port(http.bind) : (s.bind_to_port(http.bind, http.port) ? http.port : -1);
   if (m.port <= 0) throw std::runtime_error("http: cannot listen on " + http.bind + ":" + std::to_string(http.port) + " (in use, or not an address here)");
   m.thread = std::thread([&s] { s.listen_after_bind(); });

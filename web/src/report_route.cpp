@@ -27,7 +27,7 @@ std::int64_t own_run(const json& campaign) {
   return run;
 }
 
-json report_document(ApiContext& c, db::Reads& store, const db::CampaignRow& row, XYCache& cache) {
+json report_document(ApiContext& c, db::ReadSource& store, const db::CampaignRow& row, XYCache& cache) {
   json doc{{"campaign", campaign_json(store, row, true)},
            {"software", std::string("hystlab ") + HYSTLAB_VERSION},
            {"generated_at", utc_now()},

@@ -8,15 +8,13 @@
 #include "routes.hpp"
 
 namespace hystlab::web {
-db::CampaignRow campaign_or_404(db::Reads& store, std::int64_t id) {
+db::CampaignRow campaign_or_404(db::ReadSource& store, std::int64_t id) {
   auto row = store.campaign(id);
   if (!row) throw ApiError(404, "not found", "no campaign " + std::to_string(id));
   return *row;
 }
 
-namespace {
-
-json runs_of(db::Reads& store, std::int64_t campaign) {
+json runs_of(db::ReadSource& store, std::int64_t campaign) {
   json runs = json::array();
   for (const db::RunInfo& r : store.runs(campaign))
     runs.push_back({{"id", r.id},
@@ -30,8 +28,10 @@ json runs_of(db::Reads& store, std::int64_t campaign) {
   return runs;
 }
 
+namespace {
+
 // Each table with the warnings of the run it was computed over (the campaign's last).
-json tables_of(db::Reads& store, std::int64_t campaign, const json& runs) {
+json tables_of(db::ReadSource& store, std::int64_t campaign, const json& runs) {
   json out = json::array();
   for (const db::TableInfo& t : store.tables(campaign)) {
     json j = table_json(t);
@@ -53,14 +53,14 @@ json tables_of(db::Reads& store, std::int64_t campaign, const json& runs) {
 }
 
 // The newest online evaluation of the partial table ("fit" event), if any.
-json last_fit(db::Reads& store, std::int64_t campaign) {
+json last_fit(db::ReadSource& store, std::int64_t campaign) {
   const auto fits = db::events_of<domain::FitEvent>(store, campaign);
   return fits.empty() ? json(nullptr) : domain::detail_json(fits.back());
 }
 
 }  // namespace
 
-json nodes_json(db::Reads& store, const db::CampaignRow& row) {
+json nodes_json(db::ReadSource& store, const db::CampaignRow& row) {
   json nodes = json::array();
   const std::vector<db::NodeInfo> measured = store.nodes(row.id);
   for (const db::NodeInfo& n : measured) nodes.push_back(node_json(n));
@@ -78,14 +78,14 @@ json nodes_json(db::Reads& store, const db::CampaignRow& row) {
   return out;
 }
 
-json events_json(db::Reads& store, std::int64_t campaign) {
+json events_json(db::ReadSource& store, std::int64_t campaign) {
   json out = json::array();
   for (const auto& e : store.events(campaign))
     out.push_back({{"id", e.id}, {"at", e.at}, {"kind", e.kind}, {"from", e.from_state}, {"to", e.to_state}, {"detail", event_detail(e.kind, e.detail)}});
   return out;
 }
 
-json loops_json(db::Reads& store, std::int64_t campaign) {
+json loops_json(db::ReadSource& store, std::int64_t campaign) {
   json out = json::array();
   for (const db::LoopInfo& l : store.loops(campaign)) {
     json j = parse_or_text(l.figures_json);
@@ -98,7 +98,7 @@ json loops_json(db::Reads& store, std::int64_t campaign) {
   return out;
 }
 
-json campaign_json(db::Reads& store, const db::CampaignRow& row, bool details) {
+json campaign_json(db::ReadSource& store, const db::CampaignRow& row, bool details) {
   json j{{"id", row.id},
          {"rig", store.rig_name(row.rig_id)},
          {"kind", domain::to_string(row.kind)},
@@ -144,29 +144,12 @@ json campaign_json(db::Reads& store, const db::CampaignRow& row, bool details) {
 }
 
 void add_campaign_routes(httplib::Server& s, ApiContext& c) {
-  s.Get("/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          const std::string state = req.has_param("state") ? req.get_param_value("state") : "";
-          if (!state.empty() && !domain::campaign_state_from(state)) {
-            std::string known;
-            for (const domain::CampaignState k : domain::kCampaignStates) known += (known.empty() ? "" : ", ") + std::string(domain::to_string(k));
-            throw ApiError(400, "invalid parameter", "state: '" + state + "' is not a campaign state (" + known + ")", "state");
-          }
-          json out = json::array();
-          for (const auto& row : store.campaigns())
-            if (state.empty() || domain::to_string(row.state) == state) out.push_back(campaign_json(store, row, false));
-          send_json(res, out);
-        }));
   post_route(s, c, "/api/campaigns", guarded([&c](const httplib::Request& req, httplib::Response& res) {
                const PlanRequest r = decode_plan_request(body_object(req));
                const std::int64_t id = c.daemon.submit(r.rig, r.plan);
                res.set_header("Location", "/api/campaigns/" + std::to_string(id));
                send_json(res, campaign_json(reader(c.db_path), campaign_or_404(reader(c.db_path), id), false), 201);
              }));
-  s.Get(R"(/api/campaigns/(\d+))", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          send_json(res, campaign_json(store, campaign_or_404(store, path_id(req)), true));
-        }));
   // The specimen and notes, changed after submission (any state): {"specimen": ..., "notes": ...}.
   post_route(s, c, R"(/api/campaigns/(\d+)/record)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
                const auto row = campaign_or_404(reader(c.db_path), path_id(req));
@@ -196,22 +179,6 @@ void add_campaign_routes(httplib::Server& s, ApiContext& c) {
                }
                send_outcome(res, json{{"campaign", row.id}, {"command", verb}}, c.daemon.command(row.id, *cmd));
              }));
-  s.Get(R"(/api/campaigns/(\d+)/events)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          send_json(res, events_json(store, campaign_or_404(store, path_id(req)).id));
-        }));
-  s.Get(R"(/api/campaigns/(\d+)/nodes)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          send_json(res, nodes_json(store, campaign_or_404(store, path_id(req))));
-        }));
-  s.Get(R"(/api/campaigns/(\d+)/loops)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          send_json(res, loops_json(store, campaign_or_404(store, path_id(req)).id));
-        }));
-  s.Get(R"(/api/campaigns/(\d+)/runs)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          send_json(res, runs_of(store, campaign_or_404(store, path_id(req)).id));
-        }));
 }
 
 }  // namespace hystlab::web

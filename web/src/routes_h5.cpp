@@ -95,13 +95,13 @@ void send_file(httplib::Response& res, std::shared_ptr<OpenFile> file, const std
 
 void add_h5_routes(httplib::Server& s, ApiContext& c) {
   s.Get(R"(/api/runs/(\d+)/samples\.h5)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          db::Reads& store = reader(c.db_path);
+          db::ReadSource& store = reader(c.db_path);
           const std::int64_t id = path_id(req);
           auto file = export_to_temp(c.db_path, [&](const std::string& path) { (void)db::export_run_h5(store, id, path); });
           send_file(res, std::move(file), "run-" + std::to_string(id) + ".h5");
         }));
   s.Get(R"(/api/campaigns/(\d+)/samples\.h5)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          db::Reads& store = reader(c.db_path);
+          db::ReadSource& store = reader(c.db_path);
           const std::int64_t id = path_id(req);
           auto file = export_to_temp(c.db_path, [&](const std::string& path) { (void)db::export_campaign_h5(store, id, path); });
           send_file(res, std::move(file), "campaign-" + std::to_string(id) + ".h5");

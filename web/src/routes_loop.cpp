@@ -52,7 +52,7 @@ std::shared_ptr<XYCache> make_xy_cache() { return std::make_shared<XYCache>(); }
 namespace {
 double rounded(double v) { return std::round(v * 1e4) / 1e4; }  // 0.1 µm, 0.1 mN: the JSON stays short
 
-std::unique_ptr<models::HysteresisModel> table_model(db::Reads& store, std::int64_t table_id) {
+std::unique_ptr<models::HysteresisModel> table_model(db::ReadSource& store, std::int64_t table_id) {
   const auto doc = store.table_document(table_id);
   if (!doc) return nullptr;
   return std::make_unique<models::PreisachModel>(std::make_shared<const models::EverettTable>(models::table_from_json(*doc).table));
@@ -60,7 +60,7 @@ std::unique_ptr<models::HysteresisModel> table_model(db::Reads& store, std::int6
 
 }  // namespace
 
-json loop_json(db::Reads& store, XYCache& cache, std::int64_t run_id, std::size_t points) {
+json loop_json(db::ReadSource& store, XYCache& cache, std::int64_t run_id, std::size_t points) {
   const auto run = store.run(run_id);
   if (!run) throw ApiError(404, "not found", "no run " + std::to_string(run_id));
   const auto campaign = store.campaign(run->campaign);
@@ -131,11 +131,6 @@ json preview_json(ApiContext& c, const PlanRequest& req) {
 }  // namespace
 
 void add_loop_routes(httplib::Server& s, ApiContext& c) {
-  auto cache = std::make_shared<XYCache>();
-  s.Get(R"(/api/runs/(\d+)/loop)", guarded([&c, cache](const httplib::Request& req, httplib::Response& res) {
-          const auto points = static_cast<std::size_t>(query_number(req, "points", 2000, 2, 200000));
-          send_json(res, loop_json(reader(c.db_path), *cache, path_id(req), points));
-        }));
   post_route(s, c, "/api/plans/preview",
              guarded([&c](const httplib::Request& req, httplib::Response& res) { send_json(res, preview_json(c, decode_plan_request(body_object(req)))); }));
   // The plan's fields as the parser checks them and the page's form offers them (one table).

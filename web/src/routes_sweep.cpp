@@ -145,7 +145,7 @@ std::string points_csv(const std::vector<db::TransmissibilityInfo>& rows) {
 }
 }  // namespace
 
-json sweep_json(db::Reads& store, const db::CampaignRow& row) {
+json sweep_json(db::ReadSource& store, const db::CampaignRow& row) {
   const auto rows = store.transmissibility(row.id);
   const double threshold = jump_threshold(row.plan);
   json points = json::array();
@@ -158,26 +158,11 @@ json sweep_json(db::Reads& store, const db::CampaignRow& row) {
           {"predicted", any_prediction ? report_json(rows, points, threshold, true) : json()}};
 }
 
-void add_sweep_routes(httplib::Server& s, ApiContext& c) {
-  s.Get(R"(/api/campaigns/(\d+)/transmissibility)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          const auto row = campaign_or_404(store, path_id(req));
-          json out = json::array();
-          for (const db::TransmissibilityInfo& t : store.transmissibility(row.id)) out.push_back(point_json(t));
-          send_json(res, out);
-        }));
-  s.Get(R"(/api/campaigns/(\d+)/sweep)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          const auto row = campaign_or_404(store, path_id(req));
-          res.set_header("Content-Disposition", "inline; filename=\"sweep-" + std::to_string(row.id) + ".json\"");
-          send_json(res, sweep_json(store, row));
-        }));
-  s.Get(R"(/api/campaigns/(\d+)/sweep\.csv)", guarded([&c](const httplib::Request& req, httplib::Response& res) {
-          auto& store = reader(c.db_path);
-          const auto row = campaign_or_404(store, path_id(req));
-          res.set_header("Content-Disposition", "attachment; filename=\"sweep-" + std::to_string(row.id) + ".csv\"");
-          res.set_content(points_csv(store.transmissibility(row.id)), "text/csv");
-        }));
+json transmissibility_json(const std::vector<db::TransmissibilityInfo>& rows) {
+  json out = json::array();
+  for (const db::TransmissibilityInfo& t : rows) out.push_back(point_json(t));
+  return out;
 }
+std::string sweep_csv(const std::vector<db::TransmissibilityInfo>& rows) { return points_csv(rows); }
 
 }  // namespace hystlab::web

@@ -79,7 +79,7 @@ json table_json(const db::TableInfo& t) {
           {"accuracy", parse_or_text(t.accuracy_json)}};
 }
 
-json run_quality(db::Reads& store, std::int64_t campaign, std::int64_t run) {
+json run_quality(db::ReadSource& store, std::int64_t campaign, std::int64_t run) {
   for (const domain::QualityEvent& e : db::events_of<domain::QualityEvent>(store, campaign)) {
     if (e.run != run) continue;
     json q = domain::detail_json(e);

@@ -16,11 +16,19 @@ export class ApiError extends Error {
 
 export const token = () => sessionStorage.getItem(TOKEN_KEY);
 
+// Where this page's daemon answers. A rig's own daemon: here (""). The lab view shows a daemon's
+// records from the lab database at /daemons/NAME/ and says so in the page's head (docs/LAB.md):
+// the same endpoints under that prefix, read-only (ARCHIVE: no commands, no live stream).
+const baseMeta = document.querySelector('meta[name="hystlab-base"]');
+export const BASE = baseMeta ? baseMeta.content : '';
+export const ARCHIVE = !!baseMeta;
+export const href = path => BASE + path;
+
 export async function api(path, options = {}) {
   const headers = Object.assign({}, options.body ? { 'Content-Type': 'application/json' } : {}, options.headers || {});
   const t = token();
   if (t) headers.Authorization = 'Bearer ' + t;
-  const res = await fetch(path, Object.assign({ signal: AbortSignal.timeout(API_TIMEOUT_MS) }, options, { headers }));
+  const res = await fetch(BASE + path, Object.assign({ signal: AbortSignal.timeout(API_TIMEOUT_MS) }, options, { headers }));
   const body = res.headers.get('Content-Type')?.includes('json') ? await res.json().catch(() => null) : await res.text();
   if (res.status === 401 && !options.retried && !asked) {
     asked = true;

@@ -2,7 +2,7 @@
 // The pieces: the rig panel (rigs.js), the form (form.js), data quality (quality.js), the
 // plots (plots.js), a shaker's sine sweep (shaker.js); this file holds the campaign being shown
 // and the live stream.
-import { api, post, token } from './api.js';
+import { api, post, token, href, ARCHIVE } from './api.js';
 import { XYPlot, TimePlot, TriangleHeatmap, LOOP_SHARE, relayout } from './plots.js';
 import { parseRoute, setRoute, routeHref } from './route.js';
 import { RecordView } from './record.js';
@@ -33,10 +33,10 @@ const sweep = new SweepView({ trans: $('trans-plot'), time: $('shaker-time-plot'
 $('time-mode').addEventListener('change', e => { sweep.time.setMode(e.target.value); sweep.time.redraw(); });
 const isSine = () => !!S.detail && S.detail.kind === 'sine';
 const shakedown = new ShakedownPlot($('shakedown-plot'));
-const rigPanel = new RigPanel($('rigs'), { onChange: rigs => planForm.setRigs(rigs) });
+const rigPanel = ARCHIVE ? null : new RigPanel($('rigs'), { onChange: rigs => planForm.setRigs(rigs) });
 // In the chain with the stream's handlers: a select() running beside them would reset what
 // they just added (a sweep's first transmissibility point, say).
-const planForm = new PlanForm($('plan-form'), { rigPanel, onSubmitted: c => serial(async () => { S.follow = true; await refreshList(); if (S.selected !== c.id) await select(c.id); })() });
+const planForm = ARCHIVE ? null : new PlanForm($('plan-form'), { rigPanel, onSubmitted: c => serial(async () => { S.follow = true; await refreshList(); if (S.selected !== c.id) await select(c.id); })() });
 
 // For tests and the curious: what the page shows, as numbers.
 window.hystlab = {
@@ -53,7 +53,7 @@ window.hystlab = {
   jumps: () => [...document.querySelectorAll('#resonance .jumps li')].map(li => li.textContent),
   backbone: () => sweep.backbone.shown(),
   timeAxes: () => (isSine() ? sweep.time.axes() : timeplot.axes()),
-  rigs: () => rigPanel.rigs(), warnings: () => S.warnings.slice(),
+  rigs: () => (rigPanel ? rigPanel.rigs() : []), archive: () => ARCHIVE, warnings: () => S.warnings.slice(),
   shakedownPoints: () => shakedown.points(), shakedownTicks: () => shakedown.ticks(), loopRows: () => $('loops').querySelectorAll('tbody tr').length,
   heldOut: () => [...document.querySelectorAll('#accuracy .heldout')].map(e => e.textContent),
   recommended: () => { const r = document.querySelector('#accuracy .recommended'); return r ? Number(r.dataset.table) : null; },
@@ -237,11 +237,13 @@ function link(href, text, name = true) { return el('a', { href, download: name, 
 function showDownloads(d) {
   const links = [];
   for (const t of d.tables)
-    for (const f of ['json', 'csv', 'm', 'h', 'fmu']) links.push(link(`/api/tables/${t.id}/export?format=${f}`, `table #${t.id} (${t.method}) .${f}`));
+    for (const f of ['json', 'csv', 'm', 'h', 'fmu']) links.push(link(href(`/api/tables/${t.id}/export?format=${f}`), `table #${t.id} (${t.method}) .${f}`));
   if (d.kind === 'sine') {
-    links.push(link(`/api/campaigns/${d.id}/sweep.csv`, 'sweep points .csv', `sweep-${d.id}.csv`));
-    links.push(link(`/api/campaigns/${d.id}/sweep`, 'sweep points and resonances .json', `sweep-${d.id}.json`));
+    links.push(link(href(`/api/campaigns/${d.id}/sweep.csv`), 'sweep points .csv', `sweep-${d.id}.csv`));
+    links.push(link(href(`/api/campaigns/${d.id}/sweep`), 'sweep points and resonances .json', `sweep-${d.id}.json`));
   }
+  // A run's full samples and the report come from the rig's own daemon (or `hystlab runs export --pg`).
+  if (ARCHIVE) return $('downloads').replaceChildren(...links);
   links.push(el('a', { href: `/api/campaigns/${d.id}/report.html`, target: '_blank', class: 'report', text: 'report (to print or file)' }));
   for (const r of d.runs) {
     if (!(r.samples > 0)) continue;  // nothing stored: nothing to download
@@ -387,7 +389,7 @@ async function refreshStatus() {
   const s = await api('/api/status');
   $('daemon').textContent = `hystlabd ${s.version}`;
   showLab(s.lab);
-  if (!rigPanel.rigs().length) planForm.setRigs(s.rigs);
+  if (planForm && !rigPanel.rigs().length) planForm.setRigs(s.rigs);
 }
 
 // What this daemon shares with its lab (docs/LAB.md), when its config has a lab section: the
@@ -476,7 +478,7 @@ for (const verb of ['pause', 'resume', 'abort']) {
 }
 
 // Specimen and notes under the plots (serial: defined above with the stream's handlers).
-const record = new RecordView($('record'), { onSaved: serial(async () => { await refreshList(); await refreshDetail(); }) });
+const record = new RecordView($('record'), { readOnly: ARCHIVE, onSaved: serial(async () => { await refreshList(); await refreshDetail(); }) });
 
 // The address names a campaign (and a run): shown, and the page does not follow the newest.
 function followRoute() {
@@ -494,8 +496,8 @@ function followRoute() {
 window.addEventListener('popstate', followRoute);
 window.addEventListener('hashchange', followRoute);
 followRoute();
-rigPanel.start();
-connect();
+if (ARCHIVE) startArchive();
+else { rigPanel.start(); connect(); }
 // Now and then, the selected campaign from the API, while it is live: a record the stream
 // missed (or a request that failed) never leaves the page stale for long; the ETA moves on.
 setInterval(() => {
@@ -503,3 +505,26 @@ setInterval(() => {
   if (S.online && d && !d.final) serial(refreshDetail)();
   if (S.online && !$('lab-status').hidden) api('/api/status').then(s => showLab(s.lab), () => {});
 }, 5000);
+
+// A daemon's records in the lab view (api.js: ARCHIVE): what the lab database holds, read-only.
+// No commands, no form, no live stream: the campaigns and the shown one are read again every 5 s
+// (a campaign still replicating grows).
+function startArchive() {
+  document.body.classList.add('archive');
+  for (const e of [$('plan-form').closest('section'), document.querySelector('#summary .controls'), $('rigs')]) e.hidden = true;
+  $('link').textContent = 'lab database';
+  $('link').className = 'link up';
+  $('daemon').textContent = `${document.querySelector('meta[name="hystlab-base"]').dataset.daemon} (read-only, from the lab database)`;
+  const tick = serial(async () => {
+    try {
+      await refreshList();  // the shown campaign, while not final: the interval above
+      setOnline(true);
+      $('link').textContent = 'lab database';
+    } catch (e) {
+      setOnline(false);
+      $('link').textContent = `lab database: ${e.message}`;
+    }
+  });
+  tick();
+  setInterval(tick, 5000);
+}

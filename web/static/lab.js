@@ -121,6 +121,8 @@ async function showCampaign(daemon, id) {
     const c = await get(`/api/lab/campaigns/${encodeURIComponent(daemon)}/${id}`);
     $('lab-campaign').hidden = false;
     $('lab-campaign-title').textContent = `${c.daemon} · campaign ${c.id} (${c.kind}) · ${c.state}`;
+    // The rig's own page over this daemon's records in the lab database (the same read endpoints).
+    $('lab-campaign-open').href = `/daemons/${encodeURIComponent(c.daemon)}/#campaign/${c.id}`;
     $('lab-campaign-line').textContent = `rig ${c.rig} · specimen ${text(c.specimen)} · ${when(c.created_at)} to ${when(c.updated_at)} · ${c.tables.length} table(s)`;
     $('lab-runs').tBodies[0].replaceChildren(...c.runs.map((r) => el('tr', {}, el('td', {}, r.id), el('td', {}, r.role), el('td', {}, r.state), el('td', {}, r.samples))));
     $('lab-events').replaceChildren(...c.events.slice(-30).map((e) => el('li', {}, `${when(e.at)} ${e.kind}${e.to ? ` → ${e.to}` : ''}`)));

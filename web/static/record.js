@@ -5,7 +5,7 @@ import { post } from './api.js';
 import { el } from './fmt.js';
 
 export class RecordView {
-  constructor(box, { onSaved }) { this.box = box; this.onSaved = onSaved; this.editing = null; }
+  constructor(box, { onSaved, readOnly = false }) { this.box = box; this.onSaved = onSaved; this.readOnly = readOnly; this.editing = null; }
 
   show(d) {
     if (this.editing === d.id) return;  // never wipe what the operator is typing
@@ -14,7 +14,7 @@ export class RecordView {
     edit.addEventListener('click', () => this.form(d));
     // (replaceChildren would write a null as the text "null")
     this.box.replaceChildren(...[d.specimen ? el('span', {}, el('b', { text: 'specimen ' }), d.specimen) : null,
-      d.notes ? el('span', { class: 'notes', text: d.notes }) : null, edit].filter(Boolean));
+      d.notes ? el('span', { class: 'notes', text: d.notes }) : null, this.readOnly ? null : edit].filter(Boolean));
   }
 
   form(d) {

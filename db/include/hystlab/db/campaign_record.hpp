@@ -18,6 +18,6 @@ struct CampaignRecord {
 };
 
 // The record as it stands: the newest "record" event's, else the plan's fields.
-[[nodiscard]] CampaignRecord campaign_record(Reads& store, const CampaignRow& row);
+[[nodiscard]] CampaignRecord campaign_record(ReadSource& store, const CampaignRow& row);
 
 }  // namespace hystlab::db

@@ -74,11 +74,6 @@ class LabReads {
   LabOverview overview(int daemon_id, std::int64_t run, bool shaker, int buckets);
   // Every sample of a run in seq order, columns as overview's; chunked reads (a run of any size).
   void for_each_sample(int daemon_id, std::int64_t run, bool shaker, const std::function<void(std::int64_t seq, const std::vector<double>&)>& f);
-  // Every sample of a run in seq order as the daemon's store gives it (status included, a NULL
-  // value 0 as SQLite reads one): an export from the lab writes the same bytes as one from the
-  // daemon's file (run_csv.hpp's append_csv_row). Chunked reads.
-  void for_each_frame_row(int daemon_id, std::int64_t run, const std::function<void(const SampleRow&)>& f);
-  void for_each_shaker_row(int daemon_id, std::int64_t run, const std::function<void(const ShakerRow&)>& f);
 
  private:
   PgConnection& pg_;

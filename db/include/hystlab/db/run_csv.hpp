@@ -12,13 +12,13 @@
 
 namespace hystlab::db {
 
-class Reads;
+class ReadSource;
 struct SampleRow;
 struct ShakerRow;
 
 // Where a run's samples are: a load frame's table, a shaker's, or none.
 enum class RunSamples { none, frame, shaker };
-[[nodiscard]] RunSamples run_samples(Reads& store, std::int64_t run);
+[[nodiscard]] RunSamples run_samples(ReadSource& store, std::int64_t run);
 
 // The header line (with its '\n') of a load frame's run, or of a shaker's.
 [[nodiscard]] std::string run_csv_header(bool shaker);
@@ -30,9 +30,9 @@ void append_csv_row(std::string& out, const ShakerRow& r);
 // The rows of samples seq0..seq1 (inclusive) of the run appended to out; returns how many. A
 // window of kRunCsvWindow seq keeps a streamed export's buffer near a megabyte.
 inline constexpr std::int64_t kRunCsvWindow = 8192;
-std::int64_t append_csv_rows(Reads& store, std::int64_t run, bool shaker, std::int64_t seq0, std::int64_t seq1, std::string& out);
+std::int64_t append_csv_rows(ReadSource& store, std::int64_t run, bool shaker, std::int64_t seq0, std::int64_t seq1, std::string& out);
 
 // The last seq of the run's samples (-1: none).
-[[nodiscard]] std::int64_t last_seq(Reads& store, std::int64_t run, bool shaker);
+[[nodiscard]] std::int64_t last_seq(ReadSource& store, std::int64_t run, bool shaker);
 
 }  // namespace hystlab::db

@@ -9,7 +9,7 @@
 
 namespace hystlab::db {
 
-class Reads;
+class ReadSource;
 
 inline constexpr const char* kRunH5Format = "hystlab-run-h5";
 inline constexpr int kRunH5Version = 1;
@@ -32,9 +32,9 @@ struct H5ExportStats {
 
 // Writes run `run_id` and its campaign's records to `path` (created or truncated). Throws
 // H5ExportError: no such run, a run without samples, or a write that failed; the file is then removed.
-H5ExportStats export_run_h5(Reads& store, std::int64_t run_id, const std::string& path, const H5ExportOptions& opt = {});
+H5ExportStats export_run_h5(ReadSource& store, std::int64_t run_id, const std::string& path, const H5ExportOptions& opt = {});
 // The same for every run of a campaign that has samples (at least one must).
-H5ExportStats export_campaign_h5(Reads& store, std::int64_t campaign_id, const std::string& path, const H5ExportOptions& opt = {});
+H5ExportStats export_campaign_h5(ReadSource& store, std::int64_t campaign_id, const std::string& path, const H5ExportOptions& opt = {});
 
 // What an export took, given back: the HDF5 library's free lists and the heap's freed pages
 // (a long-running daemon kept about 2.2 MB more after each export without it).

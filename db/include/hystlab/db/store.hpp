@@ -21,38 +21,7 @@ namespace hystlab::db {
 
 inline constexpr std::int64_t kBlockSize = 1024;  // samples per summary block
 
-struct SampleRow {  // a load frame's sample
-  std::int64_t run_id = 0, seq = 0;
-  double t = 0, cmd = 0, disp = 0, force = 0;
-  std::int64_t status = 0;
-};
-
-struct ShakerRow {  // a shaker's sample
-  std::int64_t run_id = 0, seq = 0;
-  double t = 0;
-  domain::ShakerSample v;
-  std::int64_t status = 0;
-};
-
 using AnyRow = std::variant<SampleRow, ShakerRow>;
-
-struct Bucket {  // min/max of one stretch of a run: no peak is lost by decimation
-  double t_min = 0, t_max = 0, disp_min = 0, disp_max = 0, force_min = 0, force_max = 0;
-  std::int64_t n = 0;
-};
-
-struct CampaignRow {
-  std::int64_t id = 0, rig_id = 0;
-  domain::CampaignKind kind = domain::CampaignKind::fot;
-  std::string plan;
-  domain::CampaignState state = domain::CampaignState::queued;
-  std::string created_at, updated_at;
-};
-
-struct EventRow {
-  std::int64_t id = 0;
-  std::string at, kind, from_state, to_state, detail;
-};
 
 // Bumped after every committed change of the records the API streams (campaigns and their
 // events, FOT nodes, tables, transmissibility) made through a Store of this process: event
@@ -60,57 +29,57 @@ struct EventRow {
 [[nodiscard]] std::uint64_t record_generation() noexcept;
 
 // The store is split by concern; a Store is all three on one connection. A part that only
-// reads (the API's routes, the CLI's views, exports) takes a Reads&: it cannot write.
+// reads (the API's routes, the CLI's views, exports) takes a ReadSource& (reads.hpp): it cannot write, and the lab database can answer it too.
 //   Reads      every query (store_reads.cpp, store.cpp's sample reads)
 //   Writes     what a running campaign produces, row by row: samples (the writer thread), FOT
 //              nodes, sine points (store.cpp)
 //   Lifecycle  rigs, campaigns, runs, events and their state changes, tables and the finishing
 //              of a run, each in one transaction (store_lifecycle.cpp)
-class Reads {
+class Reads : public ReadSource {
  public:
   explicit Reads(Database& db) noexcept : db_(db) {}
-  [[nodiscard]] std::int64_t table_count(std::int64_t campaign_id);
+  [[nodiscard]] std::int64_t table_count(std::int64_t campaign_id) override;
   // Every run of the campaign, or those of one role.
-  [[nodiscard]] std::vector<std::int64_t> runs_of_campaign(std::int64_t campaign_id, std::optional<domain::RunRole> role = std::nullopt);
+  [[nodiscard]] std::vector<std::int64_t> runs_of_campaign(std::int64_t campaign_id, std::optional<domain::RunRole> role = std::nullopt) override;
   [[nodiscard]] std::vector<std::string> rig_names();
   [[nodiscard]] std::vector<std::int64_t> queued_campaigns(std::int64_t rig_id);
-  [[nodiscard]] std::vector<std::tuple<double, double, double, double>> fot_nodes_of_campaign(std::int64_t campaign_id);
+  [[nodiscard]] std::vector<std::tuple<double, double, double, double>> fot_nodes_of_campaign(std::int64_t campaign_id) override;
 
-  [[nodiscard]] std::optional<CampaignRow> campaign(std::int64_t id);
-  [[nodiscard]] std::vector<CampaignRow> campaigns();
-  [[nodiscard]] std::vector<EventRow> events(std::int64_t campaign_id);
-  [[nodiscard]] std::int64_t sample_count(std::int64_t run_id);
-  [[nodiscard]] std::int64_t max_seq(std::int64_t run_id);  // -1 when none
+  [[nodiscard]] std::optional<CampaignRow> campaign(std::int64_t id) override;
+  [[nodiscard]] std::vector<CampaignRow> campaigns() override;
+  [[nodiscard]] std::vector<EventRow> events(std::int64_t campaign_id) override;
+  [[nodiscard]] std::int64_t sample_count(std::int64_t run_id) override;
+  [[nodiscard]] std::int64_t max_seq(std::int64_t run_id) override;  // -1 when none
   // Decimated overview of [t0, t1] in at most `buckets` buckets (blocks when the range is long,
   // raw samples when it is short).
   // A shaker run's buckets hold base (disp_*) and mass (force_*) displacement.
-  [[nodiscard]] std::vector<Bucket> overview(std::int64_t run_id, double t0, double t1, int buckets, bool shaker = false);
-  void for_each_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1, const std::function<void(const SampleRow&)>& f);
-  void for_each_shaker_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1, const std::function<void(const ShakerRow&)>& f);
-  [[nodiscard]] std::int64_t max_shaker_seq(std::int64_t run_id);  // -1 when none
+  [[nodiscard]] std::vector<Bucket> overview(std::int64_t run_id, double t0, double t1, int buckets, bool shaker = false) override;
+  void for_each_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1, const std::function<void(const SampleRow&)>& f) override;
+  void for_each_shaker_sample(std::int64_t run_id, std::int64_t seq0, std::int64_t seq1, const std::function<void(const ShakerRow&)>& f) override;
+  [[nodiscard]] std::int64_t max_shaker_seq(std::int64_t run_id) override;  // -1 when none
   [[nodiscard]] std::string integrity_check();
 
-  [[nodiscard]] std::string rig_name(std::int64_t rig_id);
+  [[nodiscard]] std::string rig_name(std::int64_t rig_id) override;
   // The rig's name and its config as hystlabd stored it ({"", "{}"} for no such rig).
-  [[nodiscard]] std::pair<std::string, std::string> rig_record(std::int64_t rig_id);
-  [[nodiscard]] std::vector<std::pair<std::int64_t, std::string>> rigs();                       // id, name
+  [[nodiscard]] std::pair<std::string, std::string> rig_record(std::int64_t rig_id) override;
+  [[nodiscard]] std::vector<std::pair<std::int64_t, std::string>> rigs() override;              // id, name
   [[nodiscard]] std::vector<std::pair<domain::CampaignState, std::int64_t>> campaign_counts();  // by state
-  [[nodiscard]] std::optional<RunInfo> run(std::int64_t id);
-  [[nodiscard]] std::vector<RunInfo> runs(std::int64_t campaign_id);
-  [[nodiscard]] std::optional<std::pair<double, double>> time_span(std::int64_t run_id);  // rig seconds
-  [[nodiscard]] std::vector<TableInfo> tables(std::optional<std::int64_t> campaign_id = std::nullopt);
-  [[nodiscard]] std::optional<TableInfo> table(std::int64_t id);
-  [[nodiscard]] std::optional<std::string> table_document(std::int64_t id);
+  [[nodiscard]] std::optional<RunInfo> run(std::int64_t id) override;
+  [[nodiscard]] std::vector<RunInfo> runs(std::int64_t campaign_id) override;
+  [[nodiscard]] std::optional<std::pair<double, double>> time_span(std::int64_t run_id) override;  // rig seconds
+  [[nodiscard]] std::vector<TableInfo> tables(std::optional<std::int64_t> campaign_id = std::nullopt) override;
+  [[nodiscard]] std::optional<TableInfo> table(std::int64_t id) override;
+  [[nodiscard]] std::optional<std::string> table_document(std::int64_t id) override;
   // The newest table of this method from a campaign of this rig (or of this campaign).
-  [[nodiscard]] std::optional<TableInfo> newest_table_of_rig(std::int64_t rig_id, const std::string& method);
-  [[nodiscard]] std::optional<TableInfo> newest_table_of_campaign(std::int64_t campaign_id, const std::string& method);
-  [[nodiscard]] std::vector<NodeInfo> nodes(std::int64_t campaign_id);
-  [[nodiscard]] std::vector<TransmissibilityInfo> transmissibility(std::int64_t campaign_id);
-  [[nodiscard]] std::vector<LoopInfo> loops(std::int64_t campaign_id);  // every run's, by run and order of closing
+  [[nodiscard]] std::optional<TableInfo> newest_table_of_rig(std::int64_t rig_id, const std::string& method) override;
+  [[nodiscard]] std::optional<TableInfo> newest_table_of_campaign(std::int64_t campaign_id, const std::string& method) override;
+  [[nodiscard]] std::vector<NodeInfo> nodes(std::int64_t campaign_id) override;
+  [[nodiscard]] std::vector<TransmissibilityInfo> transmissibility(std::int64_t campaign_id) override;
+  [[nodiscard]] std::vector<LoopInfo> loops(std::int64_t campaign_id) override;  // every run's, by run and order of closing
   // Details of a campaign's events of one kind, oldest first.
-  [[nodiscard]] std::vector<std::string> event_details(std::int64_t campaign_id, const std::string& kind);
+  [[nodiscard]] std::vector<std::string> event_details(std::int64_t campaign_id, const std::string& kind) override;
   // Why the campaign is in `state`: the reason of its newest transition there ("" when none).
-  [[nodiscard]] std::string state_reason(std::int64_t campaign_id, domain::CampaignState state);
+  [[nodiscard]] std::string state_reason(std::int64_t campaign_id, domain::CampaignState state) override;
   // Records since an id, across campaigns, oldest first, at most limit (the event stream).
   [[nodiscard]] std::vector<EventInfo> events_after(std::int64_t id, int limit);
   [[nodiscard]] std::vector<NodeInfo> nodes_after(std::int64_t id, int limit);
@@ -119,7 +88,7 @@ class Reads {
   // Appends two columns of a run's samples from seq0 on, in order, as floats (plots):
   // displacement and force, or (base_mass) the command (base) and displacement (mass).
   // Returns the next seq to read.
-  std::int64_t read_xy(std::int64_t run_id, std::int64_t seq0, bool base_mass, std::vector<float>& x, std::vector<float>& y);
+  std::int64_t read_xy(std::int64_t run_id, std::int64_t seq0, bool base_mass, std::vector<float>& x, std::vector<float>& y) override;
 
  protected:
   Database& db_;
@@ -224,7 +193,7 @@ class Store : private detail::OpenDatabase, public Reads, public Writes, public 
 // A campaign's events of one kind, typed (domain/events.hpp), oldest first; those whose detail
 // does not fit their type (written by another version) are left out.
 template <class E>
-std::vector<E> events_of(Reads& store, std::int64_t campaign) {
+std::vector<E> events_of(ReadSource& store, std::int64_t campaign) {
   std::vector<E> out;
   const std::string kind(domain::kind_of(E{}));
   std::string error;
