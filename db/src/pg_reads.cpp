@@ -52,7 +52,8 @@ const std::string kTableSelect = "SELECT id, campaign_id, run_id, coalesce(metho
                                  iso("created_at") + ", coalesce(accuracy, '') FROM hystlab.tables WHERE daemon_id = $1 ";
 
 const std::string kNodeSelect =
-    "SELECT f.id, coalesce(u.campaign_id, 0), f.run_id, f.alpha, f.beta, f.force_alpha, f.force_alpha_beta, coalesce(f.t, 0) FROM hystlab.fot_nodes f "
+    "SELECT f.id, coalesce(u.campaign_id, 0), f.run_id, coalesce(f.alpha, 0), coalesce(f.beta, 0), coalesce(f.force_alpha, 0), "
+    "coalesce(f.force_alpha_beta, 0), coalesce(f.t, 0) FROM hystlab.fot_nodes f "
     "JOIN hystlab.runs u ON u.daemon_id = f.daemon_id AND u.id = f.run_id WHERE f.daemon_id = $1 ";
 
 constexpr std::array<const char*, 6> kShakerValues = {"drive_frequency_hz",   "drive_amplitude_mm", "base_displacement_mm",

@@ -421,7 +421,7 @@ TEST_CASE("every frequency step of an isolation sweep keeps the base at its dema
 }
 
 TEST_CASE(
-    "a loop check learns every frequency before the sweep: through the resonance the base stays above 60 % of its demand across a change (22 % without)") {
+    "a loop check learns every frequency, and the loop corrects every cycle: through the resonance the base stays above 75 % of its demand across a change") {
   // Through the isolator's resonance (17.7 Hz), where the mass's reaction on the table changes its
   // response 2.5 times between 17 and 18.5 Hz. Without the loop check each step started at the
   // drive learnt at the step before: the base read 22 % of its demand for a window after 17 ->
@@ -429,7 +429,10 @@ TEST_CASE(
   // base beyond it; the step then starts at the right drive (0.0076 mm at 18.5 Hz, as the loop
   // ends there), and what is left is the isolator's free vibration, excited by the jump, beating
   // with the table: 64 % to 175 % for half a second (a glide of 8 cycles between the steps, at the
-  // drive interpolated between the two, did not help: 68 %). The issue's 90 % is not met here.
+  // drive interpolated between the two, did not help: 68 %). The loop's correction every cycle
+  // beyond the tolerance (sine_strategy.cpp, on_cycle) cuts that short: 81-84 % in three runs, the
+  // first cycle or two after the jump still +40-60 % and the cycle after them the weakest. The
+  // issue's 90 % is not met here.
   ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.5", "--linear", "40"},
                    {{"kind", "sine"},
                     {"frequencies_hz", {12, 15, 17, 18.5, 22}},
@@ -454,7 +457,7 @@ TEST_CASE(
   // From the first step's measurement to the last's: every window of one 12 Hz period.
   const double weakest = weakest_base_window(*b.store, r.run_id, pts.front()["t_s"].get<double>(), pts.back()["t_s"].get<double>(), 1 / 12.0, 0.005);
   MESSAGE("the weakest window of the base: " << weakest << " of its demand");
-  CHECK(weakest >= 0.60);
+  CHECK(weakest >= 0.75);
   CHECK(weakest < 1.0);  // the windows were read: a real minimum, not the initial value
   // The check itself stays low: while it runs its base is never beyond half the demand.
   double t_first = NAN, check_peak = 0;

@@ -78,15 +78,22 @@ TEST_CASE("lab: two daemons replicate into one database through a 30 s outage an
   // files, it resumes from PostgreSQL's marks: the batch that died with it is copied again, once.
   {
     db::PgConnection watch(server.url(), PostgresServer::kPassword);
+    std::string xid;  // the batch's transaction, streaming its COPY
     const auto copying = [&] {
-      return watch
-                 .query(
-                     "SELECT count(*) FROM pg_stat_activity WHERE application_name = 'hystlabd frame-pc-1' AND xact_start IS NOT NULL "
-                     "AND query LIKE 'COPY hystlab.samples%'")
-                 .integer(0, 0) > 0;
+      const db::PgResult r = watch.query(
+          "SELECT backend_xid::text FROM pg_stat_activity WHERE application_name = 'hystlabd frame-pc-1' AND state = 'active' "
+          "AND backend_xid IS NOT NULL AND query LIKE 'COPY hystlab.samples%'");
+      if (r.rows() == 0) return false;
+      xid = r.text(0, 0);
+      return true;
     };
     REQUIRE(wait_until(copying, 60, std::chrono::milliseconds(1)));
     a.stop(SIGKILL);
+    // The server notices the client gone and ends its session: the batch's transaction aborted
+    // (a fresh cluster: its 32-bit xid is its xid8), its rows and its mark with it.
+    REQUIRE(
+        wait_until([&] { return watch.query("SELECT count(*) FROM pg_stat_activity WHERE application_name = 'hystlabd frame-pc-1'").integer(0, 0) == 0; }, 30));
+    CHECK(watch.query("SELECT pg_xact_status($1::xid8)", {xid.c_str()}).text(0, 0) == "aborted");
   }
   a.start();
   db::PgConnection pg(server.url(), PostgresServer::kPassword);

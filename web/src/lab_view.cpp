@@ -8,6 +8,7 @@
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "api_support.hpp"
@@ -29,10 +30,13 @@ struct LabView::Impl {
   httplib::Server server;
   std::thread thread;
   int port = 0;
-  // One connection to the lab's database for every request, in turn: the view is read by a few
-  // people, and libpq's connection is not to be shared between threads at once.
+  // Connections to the lab's database, one per request at a time (libpq's connection is not to be
+  // shared between threads at once), kept for the next: a request over a long run (its loop, its
+  // score) never holds the others up. pg_mu guards the idle ones and the status, never a query.
+  static constexpr std::size_t kIdle = 4;
   std::mutex pg_mu;
-  std::unique_ptr<db::PgConnection> pg;
+  std::vector<std::unique_ptr<db::PgConnection>> idle;
+  bool connected = false;
   std::string pg_error;
 
   void with_lab(httplib::Response& res, const std::function<void(db::LabReads&)>& f) {
@@ -41,28 +45,47 @@ struct LabView::Impl {
       f(reads);
     });
   }
-  // f(connection) under the connection's lock, connecting first when needed; a lost server is a
-  // 503 naming it, and the next request connects again.
-  void with_pg(httplib::Response& res, const std::function<void(db::PgConnection&)>& f) {
-    const std::lock_guard lock(pg_mu);
-    try {
-      if (!pg || !pg->ok()) {
-        pg = std::make_unique<db::PgConnection>(lab.postgres.conninfo, lab.postgres.password);
-        // A view only reads, and a slow query never holds the others (one connection) for long.
-        pg->exec("SET default_transaction_read_only = on");
-        pg->exec("SET statement_timeout = '20s'");
+  std::unique_ptr<db::PgConnection> take() {
+    {
+      const std::lock_guard lock(pg_mu);
+      while (!idle.empty()) {
+        auto c = std::move(idle.back());
+        idle.pop_back();
+        if (c->ok()) return c;
       }
-      f(*pg);
-      pg_error.clear();
+    }
+    auto c = std::make_unique<db::PgConnection>(lab.postgres.conninfo, lab.postgres.password);
+    // A view only reads, and a slow query is cut off (504) rather than left to run.
+    c->exec("SET default_transaction_read_only = on");
+    c->exec("SET statement_timeout = '20s'");
+    return c;
+  }
+  void give_back(std::unique_ptr<db::PgConnection> c, const std::string& error) {
+    const std::lock_guard lock(pg_mu);
+    connected = error.empty() || (c && c->ok());
+    if (error.empty() || !connected) pg_error = error;
+    if (c && c->ok() && idle.size() < kIdle) idle.push_back(std::move(c));
+  }
+  // f(a connection of its own), connecting first when none is idle. A server lost (or never
+  // reached) is a 503 naming it, and the next request connects again; a statement cut off by the
+  // timeout is a 504; any other error of the database, a 500 with its words.
+  void with_pg(httplib::Response& res, const std::function<void(db::PgConnection&)>& f) {
+    std::unique_ptr<db::PgConnection> c;
+    try {
+      c = take();
+      f(*c);
+      give_back(std::move(c), "");
     } catch (const db::PgError& e) {
-      pg_error = e.what();
-      if (pg && !pg->ok()) pg.reset();
-      send_error(res, 503, "lab database unavailable", e.what());
+      const bool lost = !c || !c->ok() || e.sqlstate.starts_with("08");
+      give_back(std::move(c), e.what());
+      if (lost) return send_error(res, 503, "lab database unavailable", e.what());
+      if (e.sqlstate == "57014") return send_error(res, 504, "lab database too slow", e.what());
+      send_error(res, 500, "lab database error", e.what());
     }
   }
   json pg_status() {
     const std::lock_guard lock(pg_mu);
-    return {{"connected", pg && pg->ok()}, {"error", pg_error.empty() ? json(nullptr) : json(pg_error)}};
+    return {{"connected", connected}, {"error", pg_error.empty() ? json(nullptr) : json(pg_error)}};
   }
 };
 
@@ -201,12 +224,15 @@ LabView::LabView(const control::HttpConfig& http, const lab::LabConfig& lab, Liv
   s.set_mount_point("/vendor/uplot", vendor);
   // The lab's page at "/"; the rig page's scripts and style beside it (a daemon's records are shown
   // on the rig's own page, /daemons/NAME/). Files by name, so that "/" stays the lab's page.
-  for (const auto& entry : std::filesystem::directory_iterator(root)) {
+  std::error_code ec;  // a folder that is not there serves nothing (the page then says so), never throws
+  for (const auto& entry : std::filesystem::directory_iterator(root, ec)) {
     const std::string name = entry.path().filename().string();
     const bool js = name.ends_with(".js"), css = name.ends_with(".css"), svg = name.ends_with(".svg");
     if (!js && !css && !svg) continue;
     const char* type = js ? "text/javascript" : css ? "text/css" : "image/svg+xml";
-    s.Get("/" + name, [path = entry.path().string(), type](const httplib::Request&, httplib::Response& res) { res.set_content(file_text(path), type); });
+    std::string pattern = "/";  // the route is a regex: its name's dots (and any other special) as themselves
+    for (const char ch : name) pattern += std::string_view(".^$|?*+()[]{}\\").find(ch) != std::string_view::npos ? std::string("\\") + ch : std::string(1, ch);
+    s.Get(pattern, [path = entry.path().string(), type](const httplib::Request&, httplib::Response& res) { res.set_content(file_text(path), type); });
   }
   s.Get("/", [root](const httplib::Request&, httplib::Response& res) { res.set_content(file_text(root + "/lab.html"), "text/html; charset=utf-8"); });
   s.Get("/daemons/([^/]+)/", [root](const httplib::Request& req, httplib::Response& res) {

@@ -309,7 +309,7 @@ function showLoopCaption() {
   // Live, the samples the stream brought (it updates as they come); at the end, the stored run's.
   const shown = S.runId != null && S.detail.runs.find(r => r.id === S.runId);
   if (shown) text += `, run #${shown.id}` + (shown.role === 'validation' ? ' (validation)' : '');
-  const live = !shaker && S.detail && !S.detail.final && shown && shown.state === 'running';
+  const live = !ARCHIVE && !shaker && S.detail && !S.detail.final && shown && shown.state === 'running';
   if (live) text += ` — live: ${count(loop.points(0))} samples drawn (${S.streamRate}/s of the rig's)`;
   else if (i) text += ` — ${count(i.samples)} samples, ${count(i.reversals)} reversals (drawn with ${count(i.points)} points)` +
     (i.table ? `; orange: table #${i.table}` : '');
@@ -517,7 +517,9 @@ function startArchive() {
   $('daemon').textContent = `${document.querySelector('meta[name="hystlab-base"]').dataset.daemon} (read-only, from the lab database)`;
   const tick = serial(async () => {
     try {
-      await refreshList();  // the shown campaign, while not final: the interval above
+      await refreshList();  // the shown campaign's record, while not final: the interval above
+      // Its plots too, from the store (there is no stream to grow them), until it is final.
+      if (S.detail && !S.detail.final && S.runId) { await loadRunAndLoop(); redraw(); }
       setOnline(true);
       $('link').textContent = 'lab database';
     } catch (e) {
