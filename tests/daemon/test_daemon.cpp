@@ -337,10 +337,23 @@ TEST_CASE("hystlabd: the supervised simulator killed; the next campaign runs on 
 TEST_CASE("hystlabd: a second daemon on a port already taken is refused at start (exit 2)") {
   Dir d;
   d.write("cfg.json", kConfig);
-  const std::string port = std::to_string(20000 + getpid() % 20000);
-  const pid_t pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", port}, d.path / "log");
+  // A free port (20000 + pid % 20000 once fell among the ephemeral ports of the tests running beside
+  // it, and the first daemon was the one refused: stop 36's CI); another if it is taken meanwhile.
+  std::string port;
+  pid_t pid = -1;
   const Reaper reaper{pid};
-  REQUIRE(eventually([&] { return log_of(d.path / "log").find("http: serving") != std::string::npos; }));
+  for (int attempt = 0; attempt < 3 && pid < 0; ++attempt) {
+    port = std::to_string(test_support::free_port());
+    const auto log = d.path / ("log" + std::to_string(attempt));
+    pid = spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d.db(), "--port", port}, log);
+    if (!eventually([&] {
+          const std::string text = log_of(log);
+          return text.find("http: serving") != std::string::npos || text.find("cannot listen") != std::string::npos;
+        }))
+      FAIL("hystlabd neither served nor was refused in 60 s; its log:\n" << log_of(log));
+    if (log_of(log).find("http: serving") == std::string::npos) (void)wait_exit(pid), pid = -1;
+  }
+  REQUIRE(pid > 0);
   Dir d2;
   const int rc = wait_exit(spawn({HYSTLABD, "--config", (d.path / "cfg.json").string(), "--db", d2.db(), "--port", port}, d2.path / "log"));
   CHECK(rc == 2);
