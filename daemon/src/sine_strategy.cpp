@@ -51,9 +51,13 @@ class SineStrategy final : public Strategy {
     }
     w_.advance(s.time_s, L.drive_hz);
     w_.collect(s.time_s, s.base_displacement_mm, s.mass_displacement_mm);
-    if (drive_ != cycle_drive_ || f_ != cycle_f_) cycle_.restart(w_.phase()), cycle_drive_ = drive_, cycle_f_ = f_;
-    double a = NAN;
-    if (cycle_.add(w_.phase(), s.base_displacement_mm, kCycleSamples, a) && cycle_loop() && !on_cycle(L, s.time_s, a)) return going(L);
+    if (cycle_loop()) {
+      if (drive_ != cycle_drive_ || f_ != cycle_f_) cycle_.restart(w_.phase()), cycle_drive_ = drive_, cycle_f_ = f_;
+      double a = NAN;
+      if (cycle_.add(w_.phase(), s.base_displacement_mm, kCycleSamples, a) && !on_cycle(L, s.time_s, a)) return going(L);
+    } else {
+      cycle_drive_ = NAN;  // no sums while it does not run (measured windows, sweeps): afresh when it does
+    }
     if (mode_ == Mode::sweep && w_.phase() >= next_cycle_) {
       next_cycle_ += kTwoPi;
       if (!sweep_frequency(L, s.time_s)) return L.result.end == CampaignEnd::none;

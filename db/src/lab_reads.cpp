@@ -193,30 +193,4 @@ LabOverview LabReads::overview(int daemon_id, std::int64_t run, bool shaker, int
   return o;
 }
 
-namespace {
-// Every row of a run's samples in seq order, `cols` after seq, in chunks of 50000.
-void for_each_row(PgConnection& pg, const std::string& table, const std::string& cols, int daemon_id, std::int64_t run,
-                  const std::function<void(const PgResult&, int)>& f) {
-  const std::string d = std::to_string(daemon_id), u = std::to_string(run);
-  std::int64_t after = -1;
-  for (;;) {
-    const std::string a = std::to_string(after);
-    const PgResult r = pg.query("SELECT seq, " + cols + " FROM " + table + " WHERE daemon_id = $1 AND run_id = $2 AND seq > $3 ORDER BY seq LIMIT 50000",
-                                {d.c_str(), u.c_str(), a.c_str()});
-    if (r.rows() == 0) return;
-    for (int k = 0; k < r.rows(); ++k) f(r, k);
-    after = r.integer(r.rows() - 1, 0);
-  }
-}
-}  // namespace
-
-void LabReads::for_each_sample(int daemon_id, std::int64_t run, bool shaker, const std::function<void(std::int64_t, const std::vector<double>&)>& f) {
-  const std::vector<std::string> cols = columns_of(shaker);
-  std::vector<double> row(cols.size());
-  for_each_row(pg_, shaker ? "hystlab.shaker_samples" : "hystlab.samples", joined(cols), daemon_id, run, [&](const PgResult& r, int k) {
-    for (std::size_t c = 0; c < cols.size(); ++c) row[c] = pg_num(r, k, static_cast<int>(c) + 1);
-    f(r.integer(k, 0), row);
-  });
-}
-
 }  // namespace hystlab::db

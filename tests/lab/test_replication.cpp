@@ -7,11 +7,13 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <thread>
 
 #include "../support/postgres_server.hpp"
 #include "hystlab/db/lab_reads.hpp"
+#include "hystlab/db/pg_reads.hpp"
 #include "hystlab/db/replicator.hpp"
 #include "hystlab/db/store.hpp"
 #include "lab_checksum.hpp"
@@ -145,9 +147,9 @@ TEST_CASE("replication: every row once, samples equal to the bit, changes follow
   CHECK(peak == lite_peak);
   std::int64_t n = 0, last = -1;
   bool ordered = true;
-  lab.for_each_sample(one->daemon_id, fa.run, false, [&](std::int64_t seq, const std::vector<double>&) {
-    ordered = ordered && seq == last + 1;
-    last = seq, ++n;
+  db::PgReads(pg, one->daemon_id).for_each_sample(fa.run, 0, std::numeric_limits<std::int64_t>::max(), [&](const db::SampleRow& row) {
+    ordered = ordered && row.seq == last + 1;
+    last = row.seq, ++n;
   });
   CHECK(n == 23456 + 777);
   CHECK(ordered);

@@ -16,6 +16,7 @@
 #include "hystlab/db/pg_reads.hpp"
 #include "lab_view_json.hpp"
 #include "read_routes.hpp"
+#include "report_svg.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
 
@@ -121,19 +122,7 @@ void add_daemon_routes(httplib::Server& s, LabView::Impl& m) {
 // The rig's own page, showing one daemon's records read-only (web/static/api.js: the meta says
 // where its API is); its name escaped, as it goes into HTML.
 std::string archive_page(const std::string& index, const std::string& daemon) {
-  std::string name;
-  for (const char ch : daemon) {
-    if (ch == '&')
-      name += "&amp;";
-    else if (ch == '<')
-      name += "&lt;";
-    else if (ch == '>')
-      name += "&gt;";
-    else if (ch == '"')
-      name += "&quot;";
-    else
-      name += ch;
-  }
+  const std::string name = report::esc(daemon);
   std::string base;  // the path segment as the browser sent it, percent-encoded where needed
   for (const char c : daemon) {
     const auto ch = static_cast<unsigned char>(c);

@@ -72,8 +72,6 @@ class LabReads {
   std::vector<LabTable> campaign_tables(int daemon_id, std::int64_t campaign);
   std::optional<std::string> table_document(const std::string& daemon, std::int64_t id);
   LabOverview overview(int daemon_id, std::int64_t run, bool shaker, int buckets);
-  // Every sample of a run in seq order, columns as overview's; chunked reads (a run of any size).
-  void for_each_sample(int daemon_id, std::int64_t run, bool shaker, const std::function<void(std::int64_t seq, const std::vector<double>&)>& f);
 
  private:
   PgConnection& pg_;
