@@ -104,9 +104,17 @@ TEST_CASE("the mission's chain: springs identified on the simulated load frame p
     if (t["method"] == "fot") table = t["id"];
   REQUIRE(table > 0);
 
-  const json plan{{"kind", "sine"},        {"frequencies_hz", {10, 15, 17, 18.5, 24}},
-                  {"amplitude_mm", 0.005}, {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
-                  {"measured_cycles", 8},  {"isolator", {{"table", table}}}};
+  // "resonance": the steps refined around the peak until its half-power band holds 5 points, so
+  // that the resonance is compared as a frequency (measured and predicted at the same steps),
+  // not as a ratio on its flanks, where the ratio changes about 140 % a hertz (Q 25, 0.4 Hz off
+  // the peak) and a table's 1.5 % spread in small-loop stiffness moves it 20 %.
+  const json plan{{"kind", "sine"},
+                  {"frequencies_hz", {10, 15, 17, 18.5, 24}},
+                  {"amplitude_mm", 0.005},
+                  {"settle", {{"change", "1 %"}, {"consecutive", 2}}},
+                  {"measured_cycles", 8},
+                  {"resonance", true},
+                  {"isolator", {{"table", table}}}};
   json missing = plan;  // a table the store does not hold: refused, named, before anything moves
   missing["isolator"]["table"] = table + 1000;
   r = c.Post("/api/campaigns", json{{"plan", missing}, {"rig", "sim shaker"}}.dump(), "application/json");
@@ -120,20 +128,33 @@ TEST_CASE("the mission's chain: springs identified on the simulated load frame p
   REQUIRE(r->status == 201);
   const std::string id = std::to_string(json::parse(r->body)["id"].get<std::int64_t>());
   REQUIRE(live.wait_json(
-      "/api/campaigns/" + id, [](const json& j) { return j["state"] == "completed"; }, 180));
+      "/api/campaigns/" + id, [](const json& j) { return j["state"] == "completed"; }, 300));
   const json pts = json::parse(c.Get(("/api/campaigns/" + id + "/transmissibility").c_str())->body);
-  REQUIRE(pts.size() == 5);
+  REQUIRE(pts.size() > 5);  // the planned steps and the refinement's
   for (const json& p : pts) {
     CAPTURE(p.dump());
     REQUIRE(p["predicted_ratio"].is_number());
-    // Measured against predicted from the frame's table: within 8 % off the resonance (10, 15,
-    // 24 Hz; seen 0.1-3.5 %), within 25 % at 17 and 18.5 Hz, on its flanks, where the ratio
-    // changes 30 % a hertz (seen 0.2-19 % over seven runs: the n = 16 table's small-loop
-    // stiffness at the 0.80 mm preload varies about 1.5 % from one identification to the next,
-    // the resonance predicted within 0.15 Hz).
+    // Measured against predicted from the frame's table, off the resonance (10, 15, 24 Hz):
+    // within 8 % (seen 0.1-3.5 %).
     const double f = p["frequency_hz"].get<double>(), off = std::fabs(p["predicted_ratio"].get<double>() / p["ratio"].get<double>() - 1);
-    CHECK(off < (f > 16 && f < 20 ? 0.25 : 0.08));
+    if (f < 16 || f > 21) CHECK(off < 0.08);
   }
+  // The resonance, measured and predicted at the same steps: within 0.4 Hz (2 %; seen 0.006 to
+  // 0.07 Hz over three runs, measured 17.65 Hz each time: the n = 16 table's small-loop
+  // stiffness at the 0.80 mm preload varies about 1.5 % from one identification to the next,
+  // 0.75 % in frequency), its peak within 35 % (seen -6 to +17 %: at 5 µm the damping is the
+  // table's interpolation inside its 0.125 mm cells, which a Q of 25 shows whole).
+  const json sweep = json::parse(c.Get(("/api/campaigns/" + id + "/sweep").c_str())->body);
+  const json& measured = sweep["measured"]["curves"][0]["resonance"];
+  const json& predicted = sweep["predicted"]["curves"][0]["resonance"];
+  CAPTURE(measured.dump());
+  CAPTURE(predicted.dump());
+  REQUIRE(measured.is_object());
+  REQUIRE(predicted.is_object());
+  CHECK(measured["resolved"] == true);
+  MESSAGE("the chain's resonance: measured " << measured.dump() << ", predicted " << predicted.dump());
+  CHECK(std::fabs(measured["frequency_hz"].get<double>() - predicted["frequency_hz"].get<double>()) < 0.4);
+  CHECK(std::fabs(predicted["peak_ratio"].get<double>() / measured["peak_ratio"].get<double>() - 1) < 0.35);
   // The provenance with the prediction: which table, how identified, from which campaign.
   const json events = json::parse(c.Get(("/api/campaigns/" + id + "/events").c_str())->body);
   std::string with;
