@@ -102,9 +102,17 @@ std::string say(const domain::RetakeEvent& d) {
   return "row(s) " + rows + " again (round " + (d.round ? n(*d.round) : "?") + "): " + d.why;
 }
 
+// How the step was reached from the one before (sine_step's change).
+std::string reached(const domain::SineStepEvent& d) {
+  if (d.change == "glide") return ", glided to over " + n(d.glide_cycles) + " frequencies";
+  if (d.change == "burst") return ", the drive's phase moved " + n(d.shift_deg) + "° across the resonance";
+  if (d.change == "jump") return ", jumped to";
+  return "";
+}
+
 std::string say(const domain::SineStepEvent& d) {
   return "step " + n(d.k) + " of " + n(d.of) + " (pass " + n(d.pass) + " of " + n(d.passes) + "): " + n(d.frequency_hz) + " Hz, " + n(d.amplitude_mm) + " mm " +
-         d.direction + ", drive " + n(d.drive_mm) + " mm; about " + n(d.eta_s) + " s left";
+         d.direction + ", drive " + n(d.drive_mm) + " mm" + reached(d) + "; about " + n(d.eta_s) + " s left";
 }
 
 std::string say(const domain::TransmissibilityEvent& d) {

@@ -65,6 +65,8 @@ const char* to_string(CampaignPhase p) noexcept {
       return "shaker_sweep";
     case P::shaker_dwell:
       return "shaker_dwell";
+    case P::shaker_change:
+      return "shaker_change";
   }
   return "?";
 }

@@ -15,6 +15,7 @@
 
 #include "hystlab/domain/events.hpp"
 #include "hystlab/domain/sine_plan.hpp"
+#include "sine_change.hpp"
 
 namespace hystlab::daemon {
 
@@ -23,7 +24,7 @@ class SinePretest {
   static constexpr double kAgree = 0.02;  // two windows' responses this close: settled
   static constexpr int kMaxWindows = 8;   // a frequency's windows at most
 
-  explicit SinePretest(const domain::SinePlan& s) : freqs_(domain::pretest_frequencies(s)) {
+  explicit SinePretest(const domain::SinePlan& s) : freqs_(domain::pretest_frequencies(s)), phases_(freqs_.size()) {
     double smallest = INFINITY;
     for (const double a : s.amplitudes_mm) smallest = std::min(smallest, a);
     level_ = s.control.pretest_level * smallest;
@@ -37,9 +38,11 @@ class SinePretest {
   // The frequency (again, after a pause or a held link): its windows counted afresh.
   void restart_frequency() noexcept { windows_here_ = 0, prev_ = NAN; }
 
-  // A window's response at the current frequency. True when the frequency is done: two in a row
-  // agree (a ringing isolator's do not: its windows go on), or it is out of windows.
-  bool window(double response) noexcept {
+  // A window's response at the current frequency, with the phases the step changes plan from
+  // (the last window's are kept). True when the frequency is done: two in a row agree (a ringing
+  // isolator's do not: its windows go on), or it is out of windows.
+  bool window(double response, const LearntResponse& phases) noexcept {
+    phases_[k_] = phases;
     ++windows_, ++windows_here_;
     const bool agree = windows_here_ > 1 && std::fabs(response / prev_ - 1) <= kAgree;
     prev_ = response;
@@ -51,6 +54,13 @@ class SinePretest {
     return true;
   }
 
+  // What was learnt at f (a planned frequency; NaN elsewhere): freqs_ ascending.
+  [[nodiscard]] LearntResponse phases_at(double f) const noexcept {
+    const auto it = std::lower_bound(freqs_.begin(), freqs_.end(), f * (1 - 1e-9));
+    if (it == freqs_.end() || std::fabs(*it - f) > 1e-9 * f) return {};
+    return phases_[static_cast<std::size_t>(it - freqs_.begin())];
+  }
+
   [[nodiscard]] domain::PretestEvent summary(double seconds) const {
     domain::PretestEvent e;
     e.frequencies = static_cast<std::int64_t>(freqs_.size()), e.windows = windows_, e.unsettled = unsettled_;
@@ -60,6 +70,7 @@ class SinePretest {
 
  private:
   std::vector<double> freqs_;
+  std::vector<LearntResponse> phases_;  // at each of freqs_
   std::size_t k_ = 0;
   double level_ = 0, prev_ = NAN, lo_ = INFINITY, hi_ = -INFINITY;
   std::int64_t windows_ = 0, unsettled_ = 0;

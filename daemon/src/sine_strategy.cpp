@@ -16,6 +16,7 @@
 #include "hystlab/models/sine_fit.hpp"
 #include "hystlab/models/sweep_analysis.hpp"
 #include "phase_tracker.hpp"
+#include "sine_change.hpp"
 #include "sine_cycle.hpp"
 #include "sine_pretest.hpp"
 #include "sine_window.hpp"
@@ -58,6 +59,7 @@ class SineStrategy final : public Strategy {
     } else {
       cycle_drive_ = NAN;  // no sums while it does not run (measured windows, sweeps): afresh when it does
     }
+    if (mode_ == Mode::change) return change_segment(L, s.time_s);
     if (mode_ == Mode::sweep && w_.phase() >= next_cycle_) {
       next_cycle_ += kTwoPi;
       if (!sweep_frequency(L, s.time_s)) return L.result.end == CampaignEnd::none;
@@ -72,7 +74,8 @@ class SineStrategy final : public Strategy {
   // The step is taken again from its start (a pause, a held link): the response has changed.
   void on_resume(Loop& L, double t, bool) override {
     w_.restart(t);
-    resumed_ = true;  // from zero drive: the level is ramped to again
+    change_.cancel();  // from zero drive: the step itself, ramped to
+    resumed_ = true;   // from zero drive: the level is ramped to again
     if (pre_.active()) {
       pre_.restart_frequency();
       (void)pretest_step(L, t);
@@ -94,6 +97,8 @@ class SineStrategy final : public Strategy {
         return CampaignPhase::shaker_dwell;
       case Mode::pretest:
         return CampaignPhase::shaker_check;
+      case Mode::change:
+        return CampaignPhase::shaker_change;
       default:
         return CampaignPhase::shaker_control;
     }
@@ -108,7 +113,7 @@ class SineStrategy final : public Strategy {
   }
 
  private:
-  enum class Mode { pretest, ramp, control, settle, measure, sweep, dwell };
+  enum class Mode { pretest, ramp, control, settle, measure, sweep, dwell, change };
   // Amplitude changes between the plan's levels go at most ×2 (6 dB) a control window.
   static constexpr double kRampStep = 2.0;
 
@@ -122,24 +127,33 @@ class SineStrategy final : public Strategy {
   // cycle, and the windows' loop (every window_cycles cycles) takes over at the new drive. A
   // window is too slow for a lightly damped isolator ringing after a step across its resonance:
   // its reaction on the table beats with the drive, and the base read 64 % of its demand for a
-  // window there (stop 34); with the cycle loop its weakest window reads 81-84 % (three runs; the
-  // ringing's first cycle or two outrun any loop that measures a cycle before it acts: a gain of
-  // 0.35 or 1.0 a cycle did worse, 76 %). Bounded: the control gain towards the demand, at most
-  // ×1.5 a cycle, within the drive's cap, kMaxCycleCorrections a step; only with kCycleSamples a
-  // cycle or more.
+  // window there (stop 34); with the cycle loop 81-84 % (stop 36), the ringing's first cycle or
+  // two outrunning any loop that measures a cycle before it acts, which the step changes now
+  // avoid (sine_change.hpp). It also runs through a glide's cycles, which it moves on. Bounded: the
+  // control gain towards the demand, at most ×1.5 a cycle, within the drive's cap,
+  // kMaxCycleCorrections a step; only with kCycleSamples a cycle or more.
   [[nodiscard]] bool cycle_loop() const {
-    return s_.control.closed && (mode_ == Mode::control || mode_ == Mode::settle) && plan_.sample_rate_hz >= kCycleSamples * f_;
+    const bool gliding = mode_ == Mode::change && change_.kind() == SineChange::Kind::glide;
+    return s_.control.closed && (mode_ == Mode::control || mode_ == Mode::settle || gliding) && plan_.sample_rate_hz >= kCycleSamples * f_;
   }
   bool on_cycle(Loop& L, double t, double a) {
+    bool corrected = false;
+    if (!cycle_correction(L, t, a, corrected)) return false;
+    if (mode_ == Mode::change) return change_.after_cycle((a / demand() - 1) * 100) ? change_moved(L, t) : true;  // a glide's cycle
+    if (!corrected) return true;
+    if (mode_ == Mode::settle) stable_ = 0, prev_mass_ = NAN;  // settled again from here
+    return open(Mode::control, 1, s_.control.window_cycles);
+  }
+  // False: the drive write failed.
+  bool cycle_correction(Loop& L, double t, double a, bool& corrected) {
     const double d = demand();
     if (!(a > 0) || cycle_corrections_ >= kMaxCycleCorrections || std::fabs(a / d - 1) * 100 <= s_.control.tolerance_pct) return true;
     const double next = std::clamp(drive_ * std::clamp(1 + s_.control.gain * (d / a - 1), 1 / 1.5, 1.5), 1e-6, s_.control.max_drive_ratio * d);
     if (std::fabs(next - drive_) <= 1e-9 * drive_) return true;  // at the cap already
     drive_ = next;
     ++cycle_corrections_;
-    if (!L.command_drive(t, f_, drive_)) return false;
-    if (mode_ == Mode::settle) stable_ = 0, prev_mass_ = NAN;  // settled again from here
-    return open(Mode::control, 1, s_.control.window_cycles);
+    corrected = true;
+    return L.command_drive(t, f_, drive_);
   }
 
   // A step (stepped pass) or the start of a continuous pass: drive at the learnt response.
@@ -152,7 +166,9 @@ class SineStrategy final : public Strategy {
     prev_mass_ = NAN;
     if (!L.command_drive(t, f_, drive_)) return going(L);
     L.event(domain::SineStepEvent{points_ + 1, static_cast<std::int64_t>(total_), static_cast<std::int64_t>(pass_) + 1,
-                                  static_cast<std::int64_t>(passes_.size()), f_, passes_[pass_].amplitude_mm, drive_, eta(t), up() ? "up" : "down"});
+                                  static_cast<std::int64_t>(passes_.size()), f_, passes_[pass_].amplitude_mm, drive_, eta(t), up() ? "up" : "down", change_how_,
+                                  change_shift_deg_, change_glide_});
+    change_how_ = "start", change_shift_deg_ = NAN, change_glide_ = 0;
     if (ramping_) return open(Mode::ramp, 1, s_.control.window_cycles);
     if (s_.control.closed) return open(Mode::control, 1, s_.control.window_cycles);
     return to_settle();
@@ -196,8 +212,8 @@ class SineStrategy final : public Strategy {
     if (!L.command_drive(t, f_, drive_)) return going(L);
     return open(Mode::pretest, 1, s_.control.window_cycles);
   }
-  bool after_pretest(Loop& L, double t, const ControlVerdict& v, double base) {
-    if (!pre_.window(base / drive_)) {
+  bool after_pretest(Loop& L, double t, const ControlVerdict& v, double base, const LearntResponse& phases) {
+    if (!pre_.window(base / drive_, phases)) {
       drive_ = v.next_drive_mm;
       if (!L.command_drive(t, f_, drive_)) return going(L);
       return open(Mode::pretest, 1, s_.control.window_cycles);
@@ -208,6 +224,15 @@ class SineStrategy final : public Strategy {
     last_level_ = pre_.level();  // the first pass is ramped to from here
     return begin_step(L, t);
   }
+  // The phases a check's window learns for the step changes (sine_change.hpp): the mass's against
+  // the base's in (-3π/2, π/2] (a lag beyond 180° far above the resonance stays one), and against
+  // the drive's.
+  static LearntResponse learnt_phases(const models::HarmonicFit& b, const models::HarmonicFit& m) {
+    double tr = std::remainder(m.fundamental.phase_rad - b.fundamental.phase_rad, kTwoPi);
+    if (tr > std::numbers::pi / 2) tr -= kTwoPi;
+    return {m.fundamental.amplitude / b.fundamental.amplitude, tr, m.fundamental.phase_rad};
+  }
+
   // A check's window against the level about to be driven (the first pass's): only a base above
   // its bands counts. The check's own level is far below them on purpose, so a base under the
   // demand is never an alarm here, whatever the windows before it (a frequency's under-demand
@@ -257,7 +282,7 @@ class SineStrategy final : public Strategy {
     if (!check_band(L, t, check ? against_demand(v, b.fundamental.amplitude) : v, b.fundamental.amplitude)) return false;
     switch (mode_) {
       case Mode::pretest:
-        return after_pretest(L, t, v, b.fundamental.amplitude);
+        return after_pretest(L, t, v, b.fundamental.amplitude, learnt_phases(b, m));
       case Mode::ramp:
         return after_ramp(L, t);
       case Mode::control:
@@ -270,6 +295,8 @@ class SineStrategy final : public Strategy {
         return after_sweep_window(L, t, b, m, v);
       case Mode::dwell:
         return after_dwell_window(L, t, b, m, v);
+      case Mode::change:
+        return true;  // not reached: a change's samples go to change_segment
     }
     return true;
   }
@@ -448,8 +475,42 @@ class SineStrategy final : public Strategy {
       if (pass_ < passes_.size()) load_pass();
     }
     if (pass_ >= passes_.size()) return true;
+    if (step_ > 0 && s_.control.closed && !s_.dwell.on) return start_change(L, t);
     return begin_step(L, t);
   }
+
+  // From this step's frequency to the next one's, within a pass (sine_change.hpp): a burst that
+  // moves the drive's phase across the resonance, else a glide; then the step itself.
+  bool start_change(Loop& L, double t) {
+    const double next = freqs_[step_];
+    change_.plan(f_, next, w_.phase(), pre_.phases_at(f_), pre_.phases_at(next), s_.lowest_hz(), s_.highest_hz());
+    change_how_ = change_.kind() == SineChange::Kind::burst ? "burst" : change_.kind() == SineChange::Kind::glide ? "glide" : "jump";
+    change_shift_deg_ = change_.kind() == SineChange::Kind::burst ? change_.shift_rad() * 180 / std::numbers::pi : NAN;
+    change_glide_ = change_.kind() == SineChange::Kind::glide ? change_.glide_cycles() : 0;
+    if (!change_.active()) return begin_step(L, t);
+    change_corr_ = 1.0;
+    return drive_change(L, t, next);
+  }
+
+  // The drive for the change's segment: a glide's at the level learnt at its frequency, with the
+  // correction the cycle loop has made so far; a burst's at the new step's level.
+  bool drive_change(Loop& L, double t, double next) {
+    const bool glide = change_.kind() == SineChange::Kind::glide;
+    if (glide && mode_ == Mode::change && f_ > 0) change_corr_ = std::clamp(drive_ / control_.start(f_, demand()), 1 / 1.5, 1.5);
+    f_ = change_.frequency();
+    drive_ = std::min(control_.start(glide ? f_ : next, demand()) * (glide ? change_corr_ : 1.0), s_.control.max_drive_ratio * demand());
+    mode_ = Mode::change;
+    if (!L.command_drive(t, f_, drive_)) return going(L);
+    return true;
+  }
+
+  // A change's sample: at the end of its segment the next one, or the step. A glide measured by
+  // the cycle loop moves on with its cycles (on_cycle), each segment one of them.
+  bool change_segment(Loop& L, double t) {
+    if (cycle_loop() || !change_.advance(w_.phase())) return true;
+    return change_.active() ? drive_change(L, t, freqs_[step_]) : begin_step(L, t);
+  }
+  bool change_moved(Loop& L, double t) { return change_.active() ? drive_change(L, t, freqs_[step_]) : begin_step(L, t); }
 
   // A stepped pass's frequencies in the order driven (into reserved storage).
   void load_pass() {
@@ -564,6 +625,10 @@ class SineStrategy final : public Strategy {
   static constexpr int kMaxRetakes = 3;
   static constexpr int kCycleSamples = 16, kMaxCycleCorrections = 64;
   CycleAmplitude cycle_;
+  SineChange change_;
+  std::string change_how_ = "start";  // how the step about to begin was reached (its sine_step event)
+  double change_shift_deg_ = NAN, change_corr_ = 1.0;
+  std::int64_t change_glide_ = 0;
   double cycle_drive_ = NAN, cycle_f_ = NAN;  // what the cycle being summed is driven at
   int cycle_corrections_ = 0;
   Mode mode_ = Mode::control;

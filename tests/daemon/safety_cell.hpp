@@ -53,7 +53,7 @@ json next_plan(bool shaker) {  // after a reset: the next campaign must run
 
 bool shaker_state(State s) {
   return s == State::shaker_check || s == State::shaker_control || s == State::shaker_measure || s == State::shaker_ramp || s == State::shaker_sweep ||
-         s == State::shaker_dwell;
+         s == State::shaker_dwell || s == State::shaker_change;
 }
 // The shaker's campaign that passes through the state: a second level ramped to from the first,
 // a continuous sweep, a dwell tracking the phase (the fake mass is 0.3 rad behind at every
@@ -287,6 +287,8 @@ struct Cell {
         return p == CampaignPhase::shaker_sweep && ticks > 30;
       case State::shaker_dwell:
         return p == CampaignPhase::shaker_dwell && ticks > 30;
+      case State::shaker_change:  // 20 -> 30 Hz: a glide of a few cycles
+        return p == CampaignPhase::shaker_change;
       default:
         return false;
     }

@@ -30,6 +30,7 @@ const char* to_string(State s) noexcept {
                                    "shaker ramp between levels",
                                    "shaker continuous sweep",
                                    "shaker resonance dwell",
+                                   "shaker change between steps (a glide)",
                                    "finishing",
                                    "held after restart",
                                    "limit recovery (latched, on the way back)"};

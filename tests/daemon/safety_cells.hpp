@@ -27,6 +27,7 @@ enum class State {
   shaker_ramp,
   shaker_sweep,
   shaker_dwell,
+  shaker_change,
   finishing,
   held_after_restart,
   limit_recovery
@@ -54,9 +55,10 @@ enum class Event {
   finisher_failing
 };
 inline constexpr std::array kStates{
-    State::idle,           State::queued,      State::arming_ready, State::arming_enable, State::preamble,  State::training,           State::ramping,
-    State::dwelling,       State::retake,      State::validation,   State::paused,        State::safing,    State::shaker_check,       State::shaker_control,
-    State::shaker_measure, State::shaker_ramp, State::shaker_sweep, State::shaker_dwell,  State::finishing, State::held_after_restart, State::limit_recovery};
+    State::idle,           State::queued,      State::arming_ready, State::arming_enable, State::preamble,      State::training,     State::ramping,
+    State::dwelling,       State::retake,      State::validation,   State::paused,        State::safing,        State::shaker_check, State::shaker_control,
+    State::shaker_measure, State::shaker_ramp, State::shaker_sweep, State::shaker_dwell,  State::shaker_change, State::finishing,    State::held_after_restart,
+    State::limit_recovery};
 inline constexpr std::array kEvents{
     Event::rig_estop, Event::campaign_estop,     Event::abort,     Event::pause,          Event::resume,    Event::reset,           Event::ctl_estop,
     Event::ctl_fault, Event::limit_trip,         Event::not_ready, Event::enable_dropped, Event::link_lost, Event::stale_counter,   Event::heartbeat_lost,

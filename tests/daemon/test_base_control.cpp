@@ -3,9 +3,11 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "hystlab/daemon/base_control.hpp"
+#include "sine_change.hpp"
 #include "sine_pretest.hpp"
 
 using namespace hystlab::daemon;
@@ -106,16 +108,16 @@ TEST_CASE("the loop check: every frequency ascending at a quarter of the smalles
   CHECK(p.level() == doctest::Approx(0.005));
   REQUIRE(p.active());
   CHECK(p.frequency() == 12);
-  CHECK_FALSE(p.window(0.80));  // the first window is never enough
-  CHECK(p.window(0.81));        // within 2 % of the one before: done
+  CHECK_FALSE(p.window(0.80, {}));  // the first window is never enough
+  CHECK(p.window(0.81, {}));        // within 2 % of the one before: done
   CHECK(p.frequency() == 18.5);
   // A ringing isolator: its windows never agree; after 8 the check goes on, and says so.
-  for (int k = 0; k < 7; ++k) CHECK_FALSE(p.window(k % 2 ? 0.3 : 0.6));
-  CHECK(p.window(0.45));
+  for (int k = 0; k < 7; ++k) CHECK_FALSE(p.window(k % 2 ? 0.3 : 0.6, {}));
+  CHECK(p.window(0.45, {}));
   CHECK(p.frequency() == 30);
   p.restart_frequency();  // a pause: the frequency's windows count afresh
-  CHECK_FALSE(p.window(1.2));
-  CHECK(p.window(1.2));
+  CHECK_FALSE(p.window(1.2, {}));
+  CHECK(p.window(1.2, {}));
   CHECK_FALSE(p.active());
   const PretestEvent e = p.summary(3.5);
   CHECK(e.frequencies == 3);
@@ -140,4 +142,76 @@ TEST_CASE("the loop check: every frequency ascending at a quarter of the smalles
   dwell.dwell.on = true;
   CHECK_FALSE(has_pretest(dwell));
   CHECK(has_pretest(s));  // and the plan they were made from has one
+}
+
+TEST_CASE("the loop check keeps the response it learnt at each planned frequency, for the step changes") {
+  SinePlan s;
+  s.frequencies_hz = {12, 18.5};
+  s.amplitudes_mm = {0.005};
+  SinePretest p(s);
+  CHECK(p.window(1.0, {2.0, -0.2, -0.1}) == false);
+  CHECK(p.window(1.0, {2.1, -0.21, -0.11}));  // the last window's are kept
+  CHECK(p.window(0.5, {9.0, -2.7, -2.9}) == false);
+  CHECK(p.window(0.5, {9.1, -2.75, -2.95}));
+  CHECK(p.phases_at(12).ratio == doctest::Approx(2.1));
+  CHECK(p.phases_at(18.5).mass_rad == doctest::Approx(-2.95));
+  CHECK_FALSE(p.phases_at(15).known());  // not a planned frequency: nothing learnt there
+}
+
+TEST_CASE("a step change: a burst that moves the drive's phase across the resonance, a glide elsewhere, waiting for the base") {
+  const double pi = std::numbers::pi;
+  // 17 -> 18.5 Hz across a resonance at 17.7: the mass's phase against the base from -28° to
+  // -157°, against the drive by 94° less.
+  const LearntResponse at17{12.1, -28 * pi / 180, -0.6}, at18{9.4, -157 * pi / 180, -0.6 - 94 * pi / 180};
+  SineChange c;
+  c.plan(17, 18.5, 100.0, at17, at18, 12, 22);
+  REQUIRE(c.kind() == SineChange::Kind::burst);
+  CHECK(c.shift_rad() * 180 / pi == doctest::Approx(94));
+  const double fb = c.frequency();
+  CHECK(fb > 18.5);
+  CHECK(fb <= 22);  // within the plan's range: its envelope was checked there
+  // The burst lasts until the drive's phase leads a jump's by the shift: (fb - f2)·t = Δ/2π.
+  double phase = 100.0;
+  int samples = 0;
+  while (!c.advance(phase)) phase += 2 * pi * fb * 1e-4, ++samples;
+  CHECK_FALSE(c.active());
+  CHECK((fb - 18.5) * samples * 1e-4 * 360 == doctest::Approx(94).epsilon(0.01));
+  // Down the same way: the phase moved back, below 18.5 Hz.
+  c.plan(18.5, 17, 0.0, at18, at17, 12, 22);
+  REQUIRE(c.kind() == SineChange::Kind::burst);
+  CHECK(c.shift_rad() * 180 / pi == doctest::Approx(-94));
+  CHECK(c.frequency() < 17);
+  CHECK(c.frequency() >= 12);
+  // At the range's edge with no room for the shift: a glide instead.
+  c.plan(17, 18.5, 0.0, at17, at18, 12, 18.5);
+  CHECK(c.kind() == SineChange::Kind::glide);
+
+  // Both on one side: a glide, its cycles from how much the mass's motion changes (3 a unit).
+  const LearntResponse at12{2.1, -0.05, -0.1}, at15{3.6, -0.14, -0.2};
+  c.plan(12, 15, 0.0, at12, at15, 12, 22);
+  REQUIRE(c.kind() == SineChange::Kind::glide);
+  CHECK(c.glide_cycles() == 5);  // |3.6∠-0.14 − 2.1∠-0.05| = 1.51
+  c.plan(15, 17, 0.0, at15, at17, 12, 22);
+  CHECK(c.glide_cycles() == 24);  // 8.9: the most
+  c.plan(15, 17, 0.0, at15, {}, 12, 22);
+  CHECK(c.glide_cycles() == 24);  // not learnt there: the most
+  c.plan(12, 15, 0.0, at12, at15, 12, 22);
+  // Geometric steps, each cycle on only with the base within 3 % (NaN: not measured, on).
+  std::vector<double> f{c.frequency()};
+  CHECK(c.after_cycle(1.0));
+  f.push_back(c.frequency());
+  CHECK_FALSE(c.after_cycle(-8.0));  // the base 8 % low: the same frequency again
+  CHECK(c.frequency() == f.back());
+  CHECK(c.after_cycle(NAN));
+  f.push_back(c.frequency());
+  CHECK(f[1] / f[0] == doctest::Approx(f[2] / f[1]));
+  CHECK(f[0] == doctest::Approx(12 * std::pow(15.0 / 12, 1.0 / 5)));
+  // Waiting is bounded: 3 cycles a frequency on average, then on regardless.
+  int cycles = 0;
+  while (c.active() && cycles < 100) (void)c.after_cycle(50.0), ++cycles;
+  CHECK_FALSE(c.active());
+  CHECK(cycles <= 15);
+  // Nothing to change.
+  c.plan(15, 15, 0.0, at15, at15, 12, 22);
+  CHECK_FALSE(c.active());
 }

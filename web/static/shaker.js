@@ -210,10 +210,17 @@ export class SweepView {
 }
 
 // A sweep's event for the event list (null: not a sweep's).
+// How a step was reached from the one before (sine_step's change, docs/DAEMON.md).
+function reached(d) {
+  if (d.change === 'glide') return `, glided to over ${d.glide_cycles} frequencies`;
+  if (d.change === 'burst') return `, the drive's phase moved ${num(d.shift_deg)}° across the resonance`;
+  return '';
+}
+
 export function describeSweepEvent(e) {
   const d = e.detail;
   if (!d || typeof d !== 'object') return null;
-  if (e.kind === 'sine_step') return `step ${d.k} of ${d.of}: ${hz(d.frequency_hz)}, ${num(d.amplitude_mm)} mm ${d.direction} (pass ${d.pass} of ${d.passes}), drive ${num(d.drive_mm)} mm`;
+  if (e.kind === 'sine_step') return `step ${d.k} of ${d.of}: ${hz(d.frequency_hz)}, ${num(d.amplitude_mm)} mm ${d.direction} (pass ${d.pass} of ${d.passes}), drive ${num(d.drive_mm)} mm${reached(d)}`;
   if (e.kind === 'transmissibility') return `${hz(d.frequency_hz)}` + (d.amplitude_mm != null ? ` at ${num(d.amplitude_mm)} mm ${d.direction}` : '') +
     `: T = ${num(d.ratio)}, phase ${num(d.phase_rad * 180 / Math.PI)}°` + (d.control_error_pct != null ? `, control error ${pct(d.control_error_pct)}` : '');
   if (e.kind === 'pretest') return `loop check: ${plural(d.frequencies, 'frequency', 'frequencies')} at ${num(d.level_mm)} mm in ${duration(d.seconds)} of rig time, ${plural(d.windows, 'window')}` +

@@ -50,7 +50,8 @@ enum class CampaignPhase : std::uint8_t {
   shaker_measure,  // a step's measured window
   shaker_ramp,     // between two levels, the amplitude stepped x2 a window
   shaker_sweep,    // a continuous sweep: the frequency written every cycle
-  shaker_dwell     // a resonance dwell: the frequency moved after the phase
+  shaker_dwell,    // a resonance dwell: the frequency moved after the phase
+  shaker_change    // between two steps: a glide, or a burst that moves the drive's phase
 };
 [[nodiscard]] const char* to_string(CampaignPhase p) noexcept;
 

@@ -74,7 +74,10 @@ struct RetakeEvent {
 struct SineStepEvent {
   std::int64_t k = 0, of = 0, pass = 0, passes = 0;
   double frequency_hz = NAN, amplitude_mm = NAN, drive_mm = NAN, eta_s = NAN;
-  std::string direction;  // "up" or "down"
+  std::string direction;          // "up" or "down"
+  std::string change;             // how the drive came from the step before: "glide", "burst", "jump"; "start": a pass's first
+  double shift_deg = NAN;         // a burst's phase shift of the drive
+  std::int64_t glide_cycles = 0;  // a glide's frequencies (cycles, unless it waited for the base)
 };
 // A measured point of a sweep (also a row of sine_points).
 struct TransmissibilityEvent {
