@@ -77,11 +77,13 @@ class SineChange {
   // the cycle loop measures moves on with them instead: next_segment.)
   bool advance(double phase) noexcept {
     if (kind_ == Kind::none || phase < end_) return false;
-    end_ += kTwoPi;
-    next_segment();
+    next_segment(phase);
     return true;
   }
-  void next_segment() noexcept {
+  // The next segment from the drive's phase now (each a cycle from its start, whichever way it is
+  // measured: a glide that crosses 1/16 of the sample rate changes ways, review).
+  void next_segment(double phase) noexcept {
+    end_ = phase + kTwoPi;
     if (kind_ == Kind::glide && ++k_ < n_)
       f_ = glide_frequency(k_);
     else
@@ -90,10 +92,10 @@ class SineChange {
   // A glide's cycle measured (cycle loop): the next frequency when its base was within
   // kHoldPct of the demand (error_pct; NaN: not measured), else the same one again, at most
   // kHoldFactor cycles a segment on average. True when the frequency moved (or the glide ended).
-  bool after_cycle(double error_pct) noexcept {
+  bool after_cycle(double error_pct, double phase) noexcept {
     ++cycles_;
     if (std::fabs(error_pct) > kHoldPct && cycles_ < kHoldFactor * k_) return false;
-    next_segment();
+    next_segment(phase);
     return true;
   }
 

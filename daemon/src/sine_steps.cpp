@@ -91,6 +91,7 @@ bool SineStrategy::start_change(Loop& L, double t) {
   change_glide_ = change_.kind() == SineChange::Kind::glide ? change_.glide_cycles() : 0;
   if (!change_.active()) return begin_step(L, t);
   change_corr_ = 1.0;
+  cycle_corrections_ = 0;  // the glide's own budget
   return drive_change(L, t, next);
 }
 
@@ -98,7 +99,10 @@ bool SineStrategy::drive_change(Loop& L, double t, double next) {
   const bool glide = change_.kind() == SineChange::Kind::glide;
   if (glide && mode_ == Mode::change && f_ > 0) change_corr_ = std::clamp(drive_ / control_.start(f_, demand()), 1 / 1.5, 1.5);
   f_ = change_.frequency();
-  drive_ = std::min(control_.start(glide ? f_ : next, demand()) * (glide ? change_corr_ : 1.0), s_.control.max_drive_ratio * demand());
+  // A burst: the new step's drive, or less where the table answers more at the burst's frequency
+  // (the base never driven beyond its demand there: the plan's envelope was checked at the demand).
+  const double level = glide ? control_.start(f_, demand()) * change_corr_ : std::min(control_.start(next, demand()), control_.start(f_, demand()));
+  drive_ = std::min(level, s_.control.max_drive_ratio * demand());
   mode_ = Mode::change;
   if (!L.command_drive(t, f_, drive_)) return going(L);
   return true;

@@ -198,19 +198,26 @@ TEST_CASE("a step change: a burst that moves the drive's phase across the resona
   c.plan(12, 15, 0.0, at12, at15, 12, 22);
   // Geometric steps, each cycle on only with the base within 3 % (NaN: not measured, on).
   std::vector<double> f{c.frequency()};
-  CHECK(c.after_cycle(1.0));
+  CHECK(c.after_cycle(1.0, 0.0));
   f.push_back(c.frequency());
-  CHECK_FALSE(c.after_cycle(-8.0));  // the base 8 % low: the same frequency again
+  CHECK_FALSE(c.after_cycle(-8.0, 0.0));  // the base 8 % low: the same frequency again
   CHECK(c.frequency() == f.back());
-  CHECK(c.after_cycle(NAN));
+  CHECK(c.after_cycle(NAN, 0.0));
   f.push_back(c.frequency());
   CHECK(f[1] / f[0] == doctest::Approx(f[2] / f[1]));
   CHECK(f[0] == doctest::Approx(12 * std::pow(15.0 / 12, 1.0 / 5)));
   // Waiting is bounded: 3 cycles a frequency on average, then on regardless.
   int cycles = 0;
-  while (c.active() && cycles < 100) (void)c.after_cycle(50.0), ++cycles;
+  while (c.active() && cycles < 100) (void)c.after_cycle(50.0, 0.0), ++cycles;
   CHECK_FALSE(c.active());
   CHECK(cycles <= 15);
+  // A glide's segments by phase too (no cycle loop): each a cycle from its own start, however
+  // late the last one was seen (a glide crossing 1/16 of the sample rate changes ways, review).
+  c.plan(12, 15, 0.0, at12, at15, 12, 22);
+  CHECK_FALSE(c.advance(6.0));
+  CHECK(c.advance(2 * pi + 3.0));  // seen 3 rad late: the next one ends 2π from here
+  CHECK_FALSE(c.advance(4 * pi + 2.9));
+  CHECK(c.advance(4 * pi + 3.0));
   // Nothing to change.
   c.plan(15, 15, 0.0, at15, at15, 12, 22);
   CHECK_FALSE(c.active());

@@ -214,6 +214,7 @@ export class SweepView {
 function reached(d) {
   if (d.change === 'glide') return `, glided to over ${d.glide_cycles} frequencies`;
   if (d.change === 'burst') return `, the drive's phase moved ${num(d.shift_deg)}° across the resonance`;
+  if (d.change === 'jump') return ', jumped to';
   return '';
 }
 

@@ -7,7 +7,8 @@
 // What differs from the file, by design: a run's `samples` are those replicated so far (the run's
 // high-water mark), rig time spans and overviews are computed from the samples (the file's block
 // summaries are not copied), and times come back in the file's own form (ISO 8601, UTC, ms).
-// Read-only; not for sharing between threads (one connection).
+// Read-only; one thread at a time (one connection: the HDF5 export reads ahead on a thread of
+// its own, never beside the caller).
 #include <cstdint>
 #include <optional>
 #include <string>
