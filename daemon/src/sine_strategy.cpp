@@ -77,7 +77,7 @@ bool SineStrategy::cycle_loop() const {
 bool SineStrategy::on_cycle(Loop& L, double t, double a) {
   bool corrected = false;
   if (!cycle_correction(L, t, a, corrected)) return false;
-  if (mode_ == Mode::change) return change_band(L, t, a) && (change_.after_cycle((a / demand() - 1) * 100, w_.phase()) ? change_moved(L, t) : true);
+  if (mode_ == Mode::change) return change_.after_cycle((a / demand() - 1) * 100, w_.phase()) ? change_moved(L, t) : true;  // a glide's cycle
   if (!corrected) return true;
   if (mode_ == Mode::settle) stable_ = 0, prev_mass_ = NAN;  // settled again from here
   return open(Mode::control, 1, s_.control.window_cycles);
@@ -215,15 +215,6 @@ bool SineStrategy::on_window(Loop& L, double t) {
       return true;  // not reached: a change's samples go to change_segment
   }
   return true;
-}
-
-bool SineStrategy::change_band(Loop& L, double t, double a) {
-  if (std::isnan(a)) return true;  // too few samples in the cycle to say
-  ControlVerdict v;
-  v.error_pct = (a / demand() - 1) * 100;
-  v.band = control_.band_of(v.error_pct) == ControlBand::abort ? ControlBand::abort : ControlBand::within;
-  v.limited = drive_ >= s_.control.max_drive_ratio * demand() * (1 - 1e-9);
-  return check_band(L, t, v, a);
 }
 
 bool SineStrategy::check_band(Loop& L, double t, const ControlVerdict& v, double base) {

@@ -135,11 +135,6 @@ class SineStrategy final : public Strategy {
   // A warning is said once per step; control.abort_windows windows in a row beyond the abort
   // band (one while measuring) stop the drive and end the campaign with the reason.
   bool check_band(Loop& L, double t, const ControlVerdict& v, double base);
-  // A glide's cycle against the abort band only (a glide's transient is not a step's: no
-  // warning): control.abort_windows cycles in a row beyond it stop the drive and end the campaign
-  // as control windows would (a dead base sensor would otherwise be driven at the cap for the
-  // glide's cycles, review).
-  bool change_band(Loop& L, double t, double a);
 
   bool redrive(Loop& L, double t, const ControlVerdict& v);
 
