@@ -18,7 +18,7 @@ PreisachModel::PreisachModel(std::shared_ptr<const EverettTable> table, Preisach
 }
 
 void PreisachModel::reset() noexcept {
-  now_ = Now{1, table_->grid().lo, 0.0, 0.0};
+  now_ = Now{1, table_->grid().lo, 0.0, 0.0, wipe_bound(turning_.data(), 1), BranchCell{}};
   turning_[0] = table_->grid().lo;
   closed_[0] = 0.0;
   saturations_ = merges_ = invalid_ = 0;
@@ -65,7 +65,7 @@ void PreisachModel::restore_state(std::span<const double> s) {
   for (const double t : turning)
     if (t < g.lo || t > g.hi) throw std::invalid_argument("model state: a turning point lies outside the table's range (another table's state?)");
   if (s[2] < g.lo || s[2] > g.hi) throw std::invalid_argument("model state: the input lies outside the table's range (another table's state?)");
-  now_ = Now{len, s[2], s[3], s[4]};
+  now_ = Now{len, s[2], s[3], s[4], wipe_bound(turning.data(), len), BranchCell{}};  // the cell is read again at the next step
   saturations_ = static_cast<std::uint64_t>(s[5]);
   merges_ = static_cast<std::uint64_t>(s[6]);
   invalid_ = static_cast<std::uint64_t>(s[7]);

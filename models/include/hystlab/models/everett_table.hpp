@@ -18,6 +18,27 @@ struct InterpolationStencil {
   int size = 0;
 };
 
+// The cell a branch of the Preisach step reads (PreisachModel::advance). Along a branch one of F's
+// arguments is the branch's turning point and stays; only the input moves, a little a step when
+// it is a smooth signal (an isolator's spring: tens to hundreds of steps a cell, 40 % of them in
+// the diagonal's triangle when the spring's stroke is within a cell). While the input stays in
+// one cell, F is the same arithmetic on the same numbers, so the step keeps them and computes only
+// the input's weight: no cell search, no index, no loads (bench_sdof: 108 instructions a table
+// spring's step without it, issue 27). The same operations in the same order as value_in_range,
+// on the same numbers: bit-identical to it.
+struct BranchCell {
+  enum class Kind : unsigned char { rectangle, triangle };
+  Kind kind = Kind::rectangle;
+  bool rising = false;          // the input is F's first argument (rising from a minimum), else its second
+  double from = 0.0, to = 0.0;  // the input's cell, [from, to) in u = (x − lo)/h (uniform) or in x; empty at first
+  // Rectangle: a, b, c, d the corners f00, f01, f10, f11, g0 and g1 F along the cell's two
+  // column edges at the turning point's t; rising F = (1−s)·g0 + s·g1, falling
+  // F = (1−s)·((1−t)·a + t·b) + s·((1−t)·c + t·d). Triangle: a = f1, b = f2 − f1, c = f3 − f2,
+  // d = a + b·s; rising F = a + b·s + c·min(t, s), falling F = d + c·min(t, s). Both directions'
+  // numbers are kept, so that keeping them has no branch on the direction (random inputs).
+  double a = 0.0, b = 0.0, c = 0.0, d = 0.0, g0 = 0.0, g1 = 0.0, s = 0.0, t = 0.0;
+};
+
 class EverettTable {
  public:
   EverettTable() : EverettTable(Grid{}) {}
@@ -45,24 +66,63 @@ class EverettTable {
   // it is the Preisach step's one lookup, and GCC 12 at -O2 kept it out of line (bench_preisach:
   // the step at 0.65 of the bare loop with it and the step called, issue 27).
   [[nodiscard, gnu::always_inline]] double value_in_range(double a, double b) const noexcept {
-    int i = 0, j = 0;
-    double s = 0.0, t = 0.0;
-    cell_of(a, b, i, j, s, t);
-    const double* r1 = values_.data() + Grid::index(i - 1, 0);
-    const double* r2 = values_.data() + Grid::index(i, 0);
-    if (j < i) {  // rectangle, Eq. 8: bilinear in the four corners
-      const double f00 = r1[j - 1], f01 = r1[j], f10 = r2[j - 1], f11 = r2[j];
-      return (1.0 - s) * ((1.0 - t) * f00 + t * f01) + s * ((1.0 - t) * f10 + t * f11);
+    BranchCell unused;
+    return read<false>(a, b, false, unused);
+  }
+
+  // F on a branch: rising from a minimum m, F(x, m); falling from a maximum M, F(M, x).
+  // in_cell: x is in the cell kept for this direction; cell_value: F there. branch_value reads F
+  // anew and keeps x's cell.
+  [[nodiscard, gnu::always_inline]] bool in_cell(const BranchCell& c, bool rising, double x) const noexcept {
+    const double v = nodes_ ? x : (x - grid_.lo) * inv_step_;
+    return v >= c.from && v < c.to && c.rising == rising;
+  }
+  [[nodiscard, gnu::always_inline]] double cell_value(const BranchCell& c, double x) const noexcept {
+    // x's weight in its cell (s rising, t falling), as cell_of computes it: uniform, from is
+    // floor(u) and the difference exact; refined, as Grid::cell_among.
+    const double w = nodes_ ? (x - c.from) / (c.to - c.from) : (x - grid_.lo) * inv_step_ - c.from;
+    if (c.kind == BranchCell::Kind::rectangle) {
+      if (c.rising) return (1.0 - w) * c.g0 + w * c.g1;
+      return (1.0 - c.s) * ((1.0 - w) * c.a + w * c.b) + c.s * ((1.0 - w) * c.c + w * c.d);
     }
-    // triangle on the diagonal, Eq. 9: linear through (δ_{i-1},δ_{i-1}), (δ_i,δ_{i-1}), (δ_i,δ_i)
-    const double f1 = r1[i - 1], f2 = r2[i - 1], f3 = r2[i];
-    return f1 + (f2 - f1) * s + (f3 - f2) * (t < s ? t : s);
+    if (c.rising) return c.a + c.b * w + c.c * (c.t < w ? c.t : w);
+    return c.d + c.c * (w < c.s ? w : c.s);
+  }
+  [[nodiscard, gnu::always_inline]] double branch_value(double a, double b, bool rising, BranchCell& keep) const noexcept {
+    return read<true>(a, b, rising, keep);
   }
 
   // The same interpolation as value(), as weights on nodes (for linear identification).
   [[nodiscard]] InterpolationStencil stencil(double a, double b) const noexcept;
 
  private:
+  template <bool kKeep>
+  [[gnu::always_inline]] double read(double a, double b, bool rising, BranchCell& keep) const noexcept {
+    int i = 0, j = 0;
+    double s = 0.0, t = 0.0;
+    cell_of(a, b, i, j, s, t);
+    const double* r1 = values_.data() + Grid::index(i - 1, 0);
+    const double* r2 = values_.data() + Grid::index(i, 0);
+    if constexpr (kKeep) {  // the input's cell: its column rising, its row falling
+      const int k = rising ? i : j;
+      keep.from = nodes_ ? nodes_[k - 1] : static_cast<double>(k - 1);
+      keep.to = nodes_ ? nodes_[k] : static_cast<double>(k);
+      keep.rising = rising;
+    }
+    using K = BranchCell::Kind;
+    if (j < i) {  // rectangle, Eq. 8: bilinear in the four corners
+      const double f00 = r1[j - 1], f01 = r1[j], f10 = r2[j - 1], f11 = r2[j];
+      const double g0 = (1.0 - t) * f00 + t * f01, g1 = (1.0 - t) * f10 + t * f11;
+      if constexpr (kKeep) keep.kind = K::rectangle, keep.a = f00, keep.b = f01, keep.c = f10, keep.d = f11, keep.g0 = g0, keep.g1 = g1, keep.s = s, keep.t = t;
+      return (1.0 - s) * g0 + s * g1;
+    }
+    // triangle on the diagonal, Eq. 9: linear through (δ_{i-1},δ_{i-1}), (δ_i,δ_{i-1}), (δ_i,δ_i)
+    const double f1 = r1[i - 1], f2 = r2[i - 1], f3 = r2[i];
+    const double along = f1 + (f2 - f1) * s;
+    if constexpr (kKeep) keep.kind = K::triangle, keep.a = f1, keep.b = f2 - f1, keep.c = f3 - f2, keep.d = along, keep.s = s, keep.t = t;
+    return along + (f3 - f2) * (t < s ? t : s);
+  }
+
   // Cell of (a, b), lo <= b <= a <= hi: column i with a in [δ_{i-1}, δ_i], row j <= i with b in
   // [δ_{j-1}, δ_j], and the local coordinates s, t in [0, 1] (t <= s in a triangle).
   [[gnu::always_inline]] void cell_of(double a, double b, int& i, int& j, double& s, double& t) const noexcept {

@@ -3,7 +3,9 @@
 //
 // Memory: turning points t[0] = δmin = m0, t[1] = M1, t[2] = m1, ... (wiping-out rule).
 // closed_[k] keeps Σ_{i<=k} [F(M_i, m_{i-1}) - F(M_i, m_i)], so a step costs one F lookup
-// whatever the history's length; wiped pairs are dropped in amortised O(1).
+// whatever the history's length; wiped pairs are dropped in amortised O(1). A step along the
+// branch that stays in the input's cell costs no lookup: the cell's numbers are kept
+// (BranchCell), what a smooth input's steps mostly are.
 //
 // Bounded memory: a reversal within merge_tolerance of the previous turning point is merged
 // (that tiny excursion is forgotten); when max_turning_points are stored, a new reversal is
@@ -33,7 +35,7 @@ class PreisachModel final : public HysteresisModel {
   explicit PreisachModel(EverettTable table, PreisachOptions options = {}) : PreisachModel(std::make_shared<const EverettTable>(std::move(table)), options) {}
 
   void reset() noexcept override;
-  double step(double x) noexcept override { return advance(*this, x); }
+  [[gnu::always_inline]] double step(double x) noexcept override { return advance(*this, x); }
   [[nodiscard]] double peek(double x) const noexcept override { return advance(*this, x); }
   [[nodiscard]] std::unique_ptr<HysteresisModel> clone() const override { return std::make_unique<PreisachModel>(*this); }
   [[nodiscard]] double input() const noexcept override { return now_.x; }
@@ -51,10 +53,16 @@ class PreisachModel final : public HysteresisModel {
 
  private:
   // One implementation for step (Self non-const: the new state is stored) and peek (const).
-  // Always inlined, as what it calls: a caller that knows the model (a loop over a
-  // PreisachModel, the C API, the FMU, SdofSystem) gets the step without a call in it.
+  // Always inlined, as what it calls, and step with it: a caller that knows the model (a loop
+  // over a PreisachModel, the C API, the FMU, SdofSystem) has the step without a call in it
+  // (GCC 12 at -O2 kept step out of line in SdofSystem, 108 instructions a step there, issue 27).
   template <class Self>
   [[gnu::always_inline]] static double advance(Self& self, double x) noexcept;
+  // The input that wipes out the branch's next turning point, two below the top: rising (len
+  // odd), a maximum, or +inf when len is 1; falling (len even), a minimum (δmin at len 2).
+  [[nodiscard]] static double wipe_bound(const double* turning, std::size_t len) noexcept {
+    return len >= 2 ? turning[len - 2] : std::numeric_limits<double>::infinity();
+  }
 
   std::shared_ptr<const EverettTable> table_;
   PreisachOptions options_;
@@ -64,8 +72,10 @@ class PreisachModel final : public HysteresisModel {
   struct Now {
     std::size_t len = 1;  // turning points stored
     double x = 0.0;
-    double f = 0.0;     // without offset
-    double base = 0.0;  // rising: closed_[N]; falling: closed_[N-1] + F(M_N, m_{N-1})
+    double f = 0.0;                                          // without offset
+    double base = 0.0;                                       // rising: closed_[N]; falling: closed_[N-1] + F(M_N, m_{N-1})
+    double bound = std::numeric_limits<double>::infinity();  // wipe_bound of the turning points
+    BranchCell cell;                                         // the input's cell on this branch (EverettTable::in_cell)
   } now_;
   std::uint64_t saturations_ = 0, merges_ = 0, invalid_ = 0;
 };
@@ -103,6 +113,12 @@ inline double PreisachModel::advance(Self& self, double x) noexcept {
       ++c.len, pushed = true;
       c.base = c.f;  // Eqs. 6-7: the new branch starts from the force at the reversal
     }
+  } else if ((up ? x < c.bound : x > c.bound) && t.in_cell(c.cell, up, x)) [[likely]] {
+    // Along the branch (nothing to wipe) in the cell of the last step: F from what it kept.
+    const double e = t.cell_value(c.cell, x);
+    c.x = x;
+    c.f = up ? c.base + e : c.base - e;
+    return c.f + offset;
   }
   // Wiping-out: the turning point two below the top is of the kind the input moves toward (a
   // maximum when rising, a minimum when falling); reaching it removes it with the one after it.
@@ -115,8 +131,10 @@ inline double PreisachModel::advance(Self& self, double x) noexcept {
   if constexpr (!kCommit) last = pushed && !wiped ? c.x : last;  // a peek stored no turning point
   if (wiped) c.base = c.len & 1U ? self.closed_[c.len / 2] : self.closed_[c.len / 2 - 1] + t.value_in_range(last, tp[c.len - 2]);
   c.x = x;
-  // Rising from m_N: + F(x, m_N); falling from M_N: - F(M_N, x).
-  c.f = up ? c.base + t.value_in_range(x, last) : c.base - t.value_in_range(last, x);
+  // Rising from m_N: + F(x, m_N); falling from M_N: - F(M_N, x); x's cell kept for the next step.
+  const double e = up ? t.branch_value(x, last, true, c.cell) : t.branch_value(last, x, false, c.cell);
+  c.f = up ? c.base + e : c.base - e;
+  c.bound = wipe_bound(tp, c.len);
   return c.f + offset;
 }
 
