@@ -1,14 +1,21 @@
-// wrk (Debian's) against hystlabd's GET /api/status for 10 s, next to a bare cpp-httplib server
-// answering a JSON document of the same size, with the same transport settings (TCP_NODELAY, a
-// pool sized like the daemon's, bounded keep-alive), in the same run: the ratio is what the
-// daemon's own work per request costs. Target: at least 50 % of the bare server's requests/s.
+// wrk (Debian's) against hystlabd's GET /api/status, next to a bare cpp-httplib server answering a
+// JSON document of the same size, with the same transport settings (TCP_NODELAY, a pool sized like
+// the daemon's, bounded keep-alive), in the same run: the ratio is what the daemon's own work per
+// request costs. Six rounds of 3 s each, the two servers in turn (each order in three), and the
+// median of the rounds' ratios: one 10 s run of each read 0.90 to 1.03 over the last stops' clean-
+// clone runs (issue 27), where a slow spell of the shared machine fell on one side only.
+// Target (issue 27): at least 0.95 of the bare server's requests/s.
+// (Not the request threads' lower priority, nice 5: against a bare server at nice 5 in the same
+// rounds hystlabd read 0.79 to 1.00, as against one at nice 0; stop 38.)
 #include <httplib.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "../support/daemon_process.hpp"
 
@@ -49,7 +56,8 @@ WrkResult run_wrk(int port, int seconds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int seconds = argc > 2 && std::string(argv[1]) == "--seconds" ? std::atoi(argv[2]) : 10;
+  const int seconds = argc > 2 && std::string(argv[1]) == "--seconds" ? std::atoi(argv[2]) : 3;
+  constexpr int kRounds = 6;  // even: as many rounds with the bare server first as with hystlabd first
   try {
     hystlab::test_support::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 1}}]})");
     httplib::Client c("127.0.0.1", daemon.port());
@@ -67,15 +75,28 @@ int main(int argc, char** argv) {
     const int bare_port = bare.bind_to_any_port("127.0.0.1");
     std::thread t([&bare] { bare.listen_after_bind(); });
 
-    const WrkResult b = run_wrk(bare_port, seconds);
-    const WrkResult d = run_wrk(daemon.port(), seconds);
+    std::vector<double> ratios;
+    long errors = 0;
+    std::printf("bench_http: wrk -t2 -c32, %d rounds of %d s a server, the order alternating\n", kRounds, seconds);
+    for (int r = 0; r < kRounds; ++r) {
+      WrkResult b, d;
+      if (r % 2 == 0)
+        b = run_wrk(bare_port, seconds), d = run_wrk(daemon.port(), seconds);
+      else
+        d = run_wrk(daemon.port(), seconds), b = run_wrk(bare_port, seconds);
+      ratios.push_back(d.rps / b.rps);
+      errors += b.errors + d.errors;
+      std::printf(
+          "  round %d: bare cpp-httplib (%zu-byte JSON) %.0f requests/s (p50 %.3f ms, p99 %.3f ms); hystlabd GET /api/status (%zu bytes) %.0f "
+          "requests/s (p50 %.3f ms, p99 %.3f ms); ratio %.3f\n",
+          r + 1, body.size(), b.rps, b.p50_ms, b.p99_ms, size, d.rps, d.p50_ms, d.p99_ms, ratios.back());
+    }
     bare.stop();
     t.join();
-    std::printf("bare cpp-httplib (%zu-byte JSON): %.0f requests/s, latency p50 %.3f ms, p99 %.3f ms\n", body.size(), b.rps, b.p50_ms, b.p99_ms);
-    std::printf("hystlabd GET /api/status (%zu bytes): %.0f requests/s, latency p50 %.3f ms, p99 %.3f ms\n", size, d.rps, d.p50_ms, d.p99_ms);
-    const double ratio = d.rps / b.rps;  // issue 27 asks 0.95 (an earlier issue 0.5)
-    std::printf("ratio hystlabd / bare: %.2f (target >= 0.95: %s)%s\n", ratio, ratio >= 0.95 ? "met" : "NOT met",
-                b.errors + d.errors ? "; wrk reported errors" : "");
+    std::sort(ratios.begin(), ratios.end());
+    const double ratio = 0.5 * (ratios[kRounds / 2 - 1] + ratios[kRounds / 2]);  // the median; issue 27 asks 0.95 (an earlier issue 0.5)
+    std::printf("ratio hystlabd / bare, median of %d rounds: %.2f (rounds %.2f to %.2f; target >= 0.95: %s)%s\n", kRounds, ratio, ratios.front(), ratios.back(),
+                ratio >= 0.95 ? "met" : "NOT met", errors ? "; wrk reported errors" : "");
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_http: %s\n", e.what());

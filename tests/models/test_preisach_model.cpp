@@ -212,10 +212,11 @@ TEST_CASE("preisach: merge tolerance forgets excursions smaller than it") {
 }
 
 // A step along a branch within the input's cell reads F from what the step kept of that cell
-// (EverettTable::value_in_cell); restore_state keeps no cell, so a model restored from the same
-// state reads F by the whole rule. The two must agree to the bit, with the state after, on every
-// kind of cell: rectangles and the diagonal's triangles, rising and falling, uniform and refined
-// grids, smooth inputs (tens of steps a cell, where the kept cell is read) and jumps.
+// (EverettTable::in_cell, cell_value); restore_state keeps no cell, so a model restored from the
+// same state reads F by the whole rule. The two must agree to the bit, with the state after, on
+// every kind of cell: rectangles and the diagonal's triangles, rising and falling, uniform and
+// refined grids, smooth inputs (tens of steps a cell, where the kept cell is read: counted), jumps,
+// NaN, inputs beyond the ends, nodes, and merges (a small stack cap, a merge tolerance).
 TEST_CASE("preisach: a step from the branch's kept cell equals the whole rule's, to the bit (seeded)") {
   // A saved state ends with closed[len/2]; falling (len even) nothing reads it: a scratch slot
   // whose value depends on the model's earlier history, not part of its memory.
@@ -223,26 +224,41 @@ TEST_CASE("preisach: a step from the branch's kept cell equals the whole rule's,
     if (static_cast<std::size_t>(s[1]) % 2 == 0) s.pop_back();
     return s;
   };
+  int kept[2][2][2] = {};  // [uniform][triangle][rising]: steps whose input was in the kept cell
   for (std::uint64_t seed = 1; seed <= 24; ++seed) {
     CAPTURE(seed);
     std::mt19937_64 rng(seed);
     const int n = 3 + static_cast<int>(seed % 7);
     const Grid g = seed % 2 ? Grid::make(0.0, 4.0, n) : Grid::refined(0.0, 4.0, n, 2.0, 1.0);
     const EverettTable table = RelayGrid(hystlab::test::random_relays(rng, g)).everett_table(g);
-    PreisachModel m(table);
-    std::uniform_real_distribution<double> centre(0.3, 3.7), stroke(0.01, 1.5), jump(0.0, 4.0);
+    const PreisachOptions o = seed % 3 ? PreisachOptions{} : PreisachOptions{0.02, 3 + static_cast<std::size_t>(seed % 4)};
+    PreisachModel m(table, o);
+    std::uniform_real_distribution<double> centre(0.3, 3.7), stroke(0.01, 1.5), jump(-0.5, 4.5);
+    std::uniform_int_distribution<int> node(0, n);
     double c = centre(rng), a = stroke(rng), phase = 0.0;
     for (int k = 0; k < 3000; ++k) {
       if (k % 500 == 0) c = centre(rng), a = stroke(rng);  // a new sine: new turning points, other cells
       phase += 2.0 * std::numbers::pi / 97.0;              // 97 steps a period: several a cell
-      const double x = k % 250 == 249 ? jump(rng) : std::clamp(c + a * std::sin(phase), 0.0, 4.0);
+      double x = std::clamp(c + a * std::sin(phase), 0.0, 4.0);
+      if (k % 61 == 60) x = k % 4 == 0 ? NAN : k % 4 == 1 ? g.node(node(rng)) : jump(rng);  // beyond the ends too
       CAPTURE(k);
       CAPTURE(x);
-      PreisachModel whole(table);
+      const bool up = x > m.input();
+      if (x >= 0.0 && x <= 4.0 && up == static_cast<bool>(m.depth() & 1U) && EverettTable::in_cell(m.kept_cell(), up, table.coordinate(x)))
+        ++kept[g.uniform()][m.kept_cell().kind == BranchCell::Kind::triangle][up];
+      PreisachModel whole(table, o);
       whole.restore_state(m.save_state());
-      const double kept = m.step(x), anew = whole.step(x);
-      REQUIRE(kept == anew);
+      const double by_cell = m.step(x), anew = whole.step(x);
+      REQUIRE(((std::isnan(by_cell) && std::isnan(anew)) || by_cell == anew));
       REQUIRE(meaningful(m.save_state()) == meaningful(whole.save_state()));
     }
   }
+  for (int uniform = 0; uniform < 2; ++uniform)
+    for (int triangle = 0; triangle < 2; ++triangle)
+      for (int rising = 0; rising < 2; ++rising) {
+        CAPTURE(uniform);
+        CAPTURE(triangle);
+        CAPTURE(rising);
+        CHECK(kept[uniform][triangle][rising] > 100);  // each kind of kept cell read, not only the whole rule
+      }
 }

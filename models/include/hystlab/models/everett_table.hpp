@@ -23,14 +23,14 @@ struct InterpolationStencil {
 // it is a smooth signal (an isolator's spring: tens to hundreds of steps a cell, 40 % of them in
 // the diagonal's triangle when the spring's stroke is within a cell). While the input stays in
 // one cell, F is the same arithmetic on the same numbers, so the step keeps them and computes only
-// the input's weight: no cell search, no index, no loads (bench_sdof: 108 instructions a table
-// spring's step without it, issue 27). The same operations in the same order as value_in_range,
-// on the same numbers: bit-identical to it.
+// the input's weight: no cell search, no index, no loads (bench_sdof, issue 27: an isolator of
+// two different tables from 0.67 to 0.84 of linear springs with it and the step inlined). The same
+// operations in the same order as value_in_range, on the same numbers: bit-identical to it.
 struct BranchCell {
   enum class Kind : unsigned char { rectangle, triangle };
   Kind kind = Kind::rectangle;
   bool rising = false;          // the input is F's first argument (rising from a minimum), else its second
-  double from = 0.0, to = 0.0;  // the input's cell, [from, to) in u = (x − lo)/h (uniform) or in x; empty at first
+  double from = 0.0, to = 0.0;  // the input's cell, [from, to) in u = (x − lo)·(1/h) as cell_of computes it (uniform) or in x; empty at first
   // Rectangle: a, b, c, d the corners f00, f01, f10, f11, g0 and g1 F along the cell's two
   // column edges at the turning point's t; rising F = (1−s)·g0 + s·g1, falling
   // F = (1−s)·((1−t)·a + t·b) + s·((1−t)·c + t·d). Triangle: a = f1, b = f2 − f1, c = f3 − f2,
@@ -71,16 +71,20 @@ class EverettTable {
   }
 
   // F on a branch: rising from a minimum m, F(x, m); falling from a maximum M, F(M, x).
-  // in_cell: x is in the cell kept for this direction; cell_value: F there. branch_value reads F
-  // anew and keeps x's cell.
-  [[nodiscard, gnu::always_inline]] bool in_cell(const BranchCell& c, bool rising, double x) const noexcept {
-    const double v = nodes_ ? x : (x - grid_.lo) * inv_step_;
+  // coordinate: x where cells are found (uniform: u, as cell_of computes it; refined: x itself);
+  // in_cell: that is in the cell kept for this direction; cell_value: F there. branch_value reads
+  // F anew and keeps x's cell. The weight comes from the one rounded coordinate the cell test
+  // compared, as cell_of's comes from its rounded u (converted to an int there): so where a
+  // compiler fuses a·b + c into one FMA (GCC's default on aarch64), the two paths still round
+  // alike, their other expressions being the same ones.
+  [[nodiscard, gnu::always_inline]] double coordinate(double x) const noexcept { return nodes_ ? x : (x - grid_.lo) * inv_step_; }
+  [[nodiscard, gnu::always_inline]] static bool in_cell(const BranchCell& c, bool rising, double v) noexcept {
     return v >= c.from && v < c.to && c.rising == rising;
   }
-  [[nodiscard, gnu::always_inline]] double cell_value(const BranchCell& c, double x) const noexcept {
+  [[nodiscard, gnu::always_inline]] double cell_value(const BranchCell& c, double v) const noexcept {
     // x's weight in its cell (s rising, t falling), as cell_of computes it: uniform, from is
     // floor(u) and the difference exact; refined, as Grid::cell_among.
-    const double w = nodes_ ? (x - c.from) / (c.to - c.from) : (x - grid_.lo) * inv_step_ - c.from;
+    const double w = nodes_ ? (v - c.from) / (c.to - c.from) : v - c.from;
     if (c.kind == BranchCell::Kind::rectangle) {
       if (c.rising) return (1.0 - w) * c.g0 + w * c.g1;
       return (1.0 - c.s) * ((1.0 - w) * c.a + w * c.b) + c.s * ((1.0 - w) * c.c + w * c.d);

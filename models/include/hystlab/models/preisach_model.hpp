@@ -48,6 +48,8 @@ class PreisachModel final : public HysteresisModel {
   [[nodiscard]] std::uint64_t merge_count() const noexcept { return merges_; }
   [[nodiscard]] std::uint64_t invalid_input_count() const noexcept { return invalid_; }
   [[nodiscard]] std::size_t depth() const noexcept { return now_.len; }
+  // The cell the next step along the branch may read (for tests: which kinds of cell are kept).
+  [[nodiscard]] const BranchCell& kept_cell() const noexcept { return now_.cell; }
   [[nodiscard]] const EverettTable& table() const noexcept { return *table_; }
   [[nodiscard]] const PreisachOptions& options() const noexcept { return options_; }
 
@@ -113,16 +115,17 @@ inline double PreisachModel::advance(Self& self, double x) noexcept {
       ++c.len, pushed = true;
       c.base = c.f;  // Eqs. 6-7: the new branch starts from the force at the reversal
     }
-  } else if ((up ? x < c.bound : x > c.bound) && t.in_cell(c.cell, up, x)) [[likely]] {
+  } else if (const double v = t.coordinate(x); (up ? x < c.bound : x > c.bound) && EverettTable::in_cell(c.cell, up, v)) [[likely]] {
     // Along the branch (nothing to wipe) in the cell of the last step: F from what it kept.
-    const double e = t.cell_value(c.cell, x);
+    const double e = t.cell_value(c.cell, v);
     c.x = x;
     c.f = up ? c.base + e : c.base - e;
     return c.f + offset;
   }
   // Wiping-out: the turning point two below the top is of the kind the input moves toward (a
   // maximum when rising, a minimum when falling); reaching it removes it with the one after it.
-  // Falling to δmin clears all. (len & 1) == up from here on.
+  // Falling to δmin clears all (len 1 then, odd while falling: the one place where len's parity
+  // is not the direction, and why in_cell also checks the kept cell's direction).
   if (up)
     while (c.len >= 3 && x >= tp[c.len - 2]) c.len -= 2, wiped = true;
   else
