@@ -30,3 +30,32 @@ export class Checks {
     return cond;
   };
 }
+
+// After a change of the viewport's width, the page's plots follow their containers through
+// ResizeObserver callbacks, a frame or more later, one after another (each plot's new size may
+// resize the next); a machine that freezes for a moment delays them further. Stop 38's CI read
+// scrollWidth 1005 at 800 px once the loop plot had shrunk but before every other one had.
+// So this waits until nothing reaches past the width and no plot's canvas has changed its width
+// for 10 frames (up to timeout ms, polled each frame), and says what still reaches past it when
+// it gives up: the settled layout is what is checked, and a layout that never fits still fails,
+// naming its widest elements.
+export async function settledWidth(page, width, timeout = 10000) {
+  await page.waitForFunction(w => {
+    const now = [...document.querySelectorAll('canvas')].map(c => c.getBoundingClientRect().width).join(',');
+    const s = window.__settle || (window.__settle = { last: '', frames: 0 });
+    s.frames = now === s.last ? s.frames + 1 : 0;
+    s.last = now;
+    return document.documentElement.scrollWidth <= w && s.frames >= 10;
+  }, width, { timeout, polling: 'raf' }).catch(() => {});
+  await page.evaluate(() => { delete window.__settle; });
+  return page.evaluate(w => {
+    const over = [];
+    for (const el of document.querySelectorAll('body *')) {
+      const r = el.getBoundingClientRect();
+      if (r.width > 0 && r.right + window.scrollX > w) {
+        over.push(`${el.tagName.toLowerCase()}${el.id ? '#' + el.id : ''}${el.className && typeof el.className === 'string' ? '.' + el.className.split(' ')[0] : ''} ${Math.round(r.right + window.scrollX)}`);
+      }
+    }
+    return { scrollWidth: document.documentElement.scrollWidth, over: over.slice(0, 6) };
+  }, width);
+}

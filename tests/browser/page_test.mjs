@@ -9,7 +9,7 @@
 // Saves screenshots in OUT_DIR.
 // usage: [ONLY=outage] node page_test.mjs HYSTLABD OUT_DIR
 import { startDaemon as startHystlabd, stopDaemon as stopHystlabd } from './hystlabd.mjs';
-import { Checks, chromium, chromiumPath as findChromium, freshDir } from './harness.mjs';
+import { Checks, chromium, chromiumPath as findChromium, freshDir, settledWidth } from './harness.mjs';
 import fs from 'node:fs';
 import path from 'node:path';
 
@@ -516,12 +516,13 @@ try {
     // The layout at 800 px: no sideways scrolling, the commands in view; at 2560 px the plots grow.
     await page.setViewportSize({ width: 800, height: 900 });
     await wait(page, () => document.querySelector('#loop-plot canvas').getBoundingClientRect().width <= 800, null, 'the plots at 800 px', 10000);
+    const settled = await settledWidth(page, 800);
     const fits = await page.evaluate(() => {
       const inside = el => { const r = el.getBoundingClientRect(); return r.width > 0 && r.left >= 0 && r.top >= 0 && r.right <= innerWidth && r.bottom <= innerHeight; };
       return { scrollWidth: document.documentElement.scrollWidth, pause: inside(document.getElementById('pause')), abort: inside(document.getElementById('abort')),
                estop: [...document.querySelectorAll('button.estop')].every(inside), loop: document.getElementById('loop-plot').getBoundingClientRect().width };
     });
-    check(fits.scrollWidth <= 800, `no horizontal scrolling at 800 px (scrollWidth ${fits.scrollWidth})`);
+    check(fits.scrollWidth <= 800, `no horizontal scrolling at 800 px (scrollWidth ${fits.scrollWidth}${fits.scrollWidth > 800 && settled.over.length ? '; past 800 px: ' + settled.over.join(', ') : ''})`);
     check(fits.pause && fits.abort && fits.estop, `Pause, Abort and E-STOP inside the viewport at 800 px (${JSON.stringify(fits)})`);
     await page.evaluate(() => window.scrollTo(0, 1500));
     await wait(page, () => window.scrollY > 0, null, 'scrolled', 10000);

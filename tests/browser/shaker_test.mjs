@@ -8,7 +8,7 @@
 // downloads, and the same again after a reload. Saves screenshots in OUT_DIR.
 // usage: node shaker_test.mjs HYSTLABD OUT_DIR
 import { startDaemon, stopDaemon } from './hystlabd.mjs';
-import { Checks, chromium, chromiumPath as findChromium, freshDir } from './harness.mjs';
+import { Checks, chromium, chromiumPath as findChromium, freshDir, settledWidth } from './harness.mjs';
 import fs from 'node:fs';
 import path from 'node:path';
 
@@ -209,8 +209,10 @@ try {
   await checkDownloads(page, id);
   for (const width of [1280, 800]) {
     await page.setViewportSize({ width, height: 1000 });
-    await page.waitForTimeout(1000);
-    if (width === 800) check(await page.evaluate(() => document.documentElement.scrollWidth) <= 800, 'no horizontal scrolling at 800 px');
+    const settled = await settledWidth(page, width);
+    if (width === 800) {
+      check(settled.scrollWidth <= 800, `no horizontal scrolling at 800 px (scrollWidth ${settled.scrollWidth}${settled.scrollWidth > 800 && settled.over.length ? '; past 800 px: ' + settled.over.join(', ') : ''})`);
+    }
     await page.screenshot({ path: path.join(outDir, `sweep-${width}.png`), fullPage: true });
     await shoot(page, '#sweep-fig', `transmissibility-${width}.png`);
     await shoot(page, '#backbone', `backbone-${width}.png`);

@@ -14,11 +14,13 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 #include "temp_dir.hpp"
 
@@ -62,25 +64,56 @@ inline int served_port(const std::string& log) {
   return 0;
 }
 
-// A loopback port nobody listens on now (the kernel's pick, released at once).
-inline int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+// A loopback port nobody listens on now, for a server a test starts next (PostgreSQL, mosquitto,
+// a daemon given --port). Taken below the kernel's ephemeral range
+// (/proc/sys/net/ipv4/ip_local_port_range, 32768-60999 on Debian): the kernel's own pick, as
+// before, is also the local port any client connecting elsewhere may be given before the server
+// binds it, and CI runs six tests at a time, each connecting to its rigs and daemons. Below the
+// range only another test's free_port() competes, from a random start among ~20,000 ports.
+inline std::pair<int, int> ephemeral_ports() {
+  std::ifstream f("/proc/sys/net/ipv4/ip_local_port_range");
+  int lo = 32768, hi = 60999;
+  f >> lo >> hi;
+  return {lo, hi};
+}
+// 127.0.0.1:port (0: the kernel's pick).
+inline sockaddr_in loopback(int port) {
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  return a;
+}
+inline bool can_bind(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a = loopback(port);
+  const bool ok = fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  if (fd >= 0) ::close(fd);
+  return ok;
+}
+inline int free_port() {
+  const int below = ephemeral_ports().first;
+  constexpr int kFirst = 10000;
+  if (below - kFirst >= 1000) {
+    std::random_device seed;
+    const int span = below - kFirst;
+    const int start = static_cast<int>(seed() % static_cast<unsigned>(span));
+    for (int k = 0; k < span; ++k)
+      if (const int port = kFirst + (start + k) % span; can_bind(port)) return port;
+  }
+  // A machine whose ephemeral range starts low: the kernel's pick.
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a = loopback(0);
   socklen_t len = sizeof a;
-  if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 || ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0)
-    throw std::runtime_error("free_port: no loopback port");
-  ::close(fd);
+  const bool ok = fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 && ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0;
+  if (fd >= 0) ::close(fd);
+  if (!ok) throw std::runtime_error("free_port: no loopback port");
   return ntohs(a.sin_port);
 }
 
 inline bool accepts(int port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  sockaddr_in a = loopback(port);
   const bool ok = fd >= 0 && ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
   if (fd >= 0) ::close(fd);
   return ok;
