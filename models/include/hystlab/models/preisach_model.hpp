@@ -41,7 +41,8 @@ class PreisachModel final : public HysteresisModel {
   [[nodiscard]] double input() const noexcept override { return now_.x; }
   [[nodiscard]] double output() const noexcept override { return now_.f + table_->force_offset(); }
   [[nodiscard]] std::uint64_t saturation_count() const noexcept override { return saturations_; }
-  // [kind 1, len, x, f, base, saturations, merges, invalid, turning[0..len), closed[0..len/2]].
+  // [kind 1, len, x, f, base, saturations, merges, invalid, turning[0..len), closed[0..len/2]];
+  // closed[len/2] is 0 when len is even (a scratch slot then: the same memory, the same numbers).
   [[nodiscard]] std::vector<double> save_state() const override;
   void restore_state(std::span<const double> state) override;
 
