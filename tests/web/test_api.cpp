@@ -276,7 +276,21 @@ TEST_CASE("static files: the page and the plotting library, and nothing outside 
   CHECK(r->status == 200);
   CHECK(r->body.find("<title>hystlab</title>") != std::string::npos);
   CHECK(r->get_header_value("Content-Security-Policy").find("default-src 'self'") != std::string::npos);
-  CHECK(c.Get("/app.js")->status == 200);
+  CHECK(r->get_header_value("Content-Type") == "text/html");
+  // The page's modules typed as JavaScript (a browser refuses a module of another type, and
+  // nosniff forbids it to guess); a path no file has, JSON's 404 (page_route.cpp).
+  r = c.Get("/app.js");
+  REQUIRE(r);
+  CHECK(r->status == 200);
+  CHECK(r->get_header_value("Content-Type") == "text/javascript");
+  CHECK(c.Get("/style.css")->get_header_value("Content-Type") == "text/css");
+  for (const std::string missing : {"/nope.js", "/api/nope", "/.hidden", "/a/b/"}) {
+    CAPTURE(missing);
+    r = c.Get(missing);
+    REQUIRE(r);
+    CHECK(r->status == 404);
+    CHECK(r->body.find("no such resource") != std::string::npos);
+  }
   r = c.Get("/vendor/uplot/uPlot.iife.min.js");
   REQUIRE(r);
   CHECK(r->status == 200);  // installed by the set-up command (npm ci in web/)

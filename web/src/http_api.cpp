@@ -10,6 +10,7 @@
 #include "read_routes.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
+#include "security_headers.hpp"
 
 namespace hystlab::web {
 std::string default_dir(const std::string& configured, const std::string& installed_sub, const char* source_tree) {
@@ -42,10 +43,7 @@ HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg, La
   s.set_keep_alive_max_count(100);
   s.set_keep_alive_timeout(5);
   s.set_payload_max_length(cfg.max_body_bytes);
-  s.set_default_headers({{"X-Content-Type-Options", "nosniff"},
-                         {"Content-Security-Policy", "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; frame-ancestors 'none'"},
-                         {"X-Frame-Options", "DENY"},
-                         {"Referrer-Policy", "no-referrer"}});
+  s.set_default_headers(httplib::Headers(security_headers().begin(), security_headers().end()));
   s.set_pre_routing_handler([&m](const httplib::Request& req, httplib::Response& res) { return guard_request(m.ctx, req, res); });
   s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;  // the handler's own JSON error
@@ -71,7 +69,10 @@ HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg, La
   const std::string vendor = default_dir(cfg.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT), root = default_dir(cfg.web_root, "", HYSTLAB_WEB_ROOT);
   if (!s.set_mount_point("/vendor/uplot", vendor))
     spdlog::warn("http: the plotting library is not at '{}' (run 'npm ci' in web/): the page cannot plot", vendor);
-  if (!s.set_mount_point("/", root)) spdlog::warn("http: no page at '{}': the API alone is served", root);
+  if (std::filesystem::is_directory(root))
+    add_page_route(s, root);  // last: a path no API route takes (page_route.cpp: not a mount point)
+  else
+    spdlog::warn("http: no page at '{}': the API alone is served", root);
   // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, and then a second daemon on the
   // same port binds too and the kernel splits requests between them (an abort reached the wrong one).
   s.set_socket_options([](socket_t sock) {

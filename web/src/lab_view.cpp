@@ -19,6 +19,7 @@
 #include "report_svg.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
+#include "security_headers.hpp"
 
 namespace hystlab::web {
 using nlohmann::json;
@@ -187,10 +188,7 @@ LabView::LabView(const control::HttpConfig& http, const lab::LabConfig& lab, Liv
   Impl& m = *impl_;
   httplib::Server& s = m.server;
   s.set_tcp_nodelay(true);
-  s.set_default_headers({{"X-Content-Type-Options", "nosniff"},
-                         {"Content-Security-Policy", "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; frame-ancestors 'none'"},
-                         {"X-Frame-Options", "DENY"},
-                         {"Referrer-Policy", "no-referrer"}});
+  s.set_default_headers(httplib::Headers(security_headers().begin(), security_headers().end()));
   // Read-only by design: only GET (and HEAD); a host this view does not serve is refused, as on a
   // rig's own daemon (a page of another site reaching it through DNS rebinding).
   s.set_pre_routing_handler([&m](const httplib::Request& req, httplib::Response& res) {

@@ -11,11 +11,12 @@
 
 namespace hystlab::web {
 
-void add_status_routes(httplib::Server& s, ApiContext& c);    // status, rigs
-void add_campaign_routes(httplib::Server& s, ApiContext& c);  // campaigns, commands, events, nodes, runs
-void add_data_routes(httplib::Server& s, ApiContext& c);      // samples, tables, exports, evaluation
-void add_loop_routes(httplib::Server& s, ApiContext& c);      // runs' x-y paths, plan previews
-void add_h5_routes(httplib::Server& s, ApiContext& c);        // a run or a campaign as an HDF5 file
+void add_status_routes(httplib::Server& s, ApiContext& c);         // status, rigs
+void add_campaign_routes(httplib::Server& s, ApiContext& c);       // campaigns, commands, events, nodes, runs
+void add_data_routes(httplib::Server& s, ApiContext& c);           // samples, tables, exports, evaluation
+void add_loop_routes(httplib::Server& s, ApiContext& c);           // runs' x-y paths, plan previews
+void add_h5_routes(httplib::Server& s, ApiContext& c);             // a run or a campaign as an HDF5 file
+void add_page_route(httplib::Server& s, const std::string& root);  // the page's files: after every other route
 
 db::CampaignRow campaign_or_404(db::ReadSource& store, std::int64_t id);
 db::RunInfo run_or_404(db::ReadSource& store, std::int64_t id);
