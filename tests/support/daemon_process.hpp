@@ -69,7 +69,8 @@ inline int served_port(const std::string& log) {
 // (/proc/sys/net/ipv4/ip_local_port_range, 32768-60999 on Debian): the kernel's own pick, as
 // before, is also the local port any client connecting elsewhere may be given before the server
 // binds it, and CI runs six tests at a time, each connecting to its rigs and daemons. Below the
-// range only another test's free_port() competes, from a random start among ~20,000 ports.
+// range only another test's free_port() competes (and a service with a fixed port, which can_bind
+// skips), from a random start among the ~22,000 ports from 10000 up to the range.
 inline std::pair<int, int> ephemeral_ports() {
   std::ifstream f("/proc/sys/net/ipv4/ip_local_port_range");
   int lo = 32768, hi = 60999;

@@ -284,6 +284,14 @@ TEST_CASE("static files: the page and the plotting library, and nothing outside 
   CHECK(r->status == 200);
   CHECK(r->get_header_value("Content-Type") == "text/javascript");
   CHECK(c.Get("/style.css")->get_header_value("Content-Type") == "text/css");
+  const auto head = c.Head("/");  // HEAD and ranges as the mount point gave them
+  REQUIRE(head);
+  CHECK(head->status == 200);
+  CHECK(head->body.empty());
+  const auto part = c.Get("/app.js", httplib::Headers{{"Range", "bytes=0-9"}});
+  REQUIRE(part);
+  CHECK(part->status == 206);
+  CHECK(part->body.size() == 10);
   for (const std::string missing : {"/nope.js", "/api/nope", "/.hidden", "/a/b/"}) {
     CAPTURE(missing);
     r = c.Get(missing);

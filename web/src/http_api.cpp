@@ -69,8 +69,8 @@ HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg, La
   const std::string vendor = default_dir(cfg.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT), root = default_dir(cfg.web_root, "", HYSTLAB_WEB_ROOT);
   if (!s.set_mount_point("/vendor/uplot", vendor))
     spdlog::warn("http: the plotting library is not at '{}' (run 'npm ci' in web/): the page cannot plot", vendor);
-  if (std::filesystem::is_directory(root))
-    add_page_route(s, root);  // last: a path no API route takes (page_route.cpp: not a mount point)
+  if (std::error_code ec; std::filesystem::is_directory(root, ec))  // unreadable: warned, never thrown
+    add_page_route(s, root);                                        // last: a path no API route takes (page_route.cpp: not a mount point)
   else
     spdlog::warn("http: no page at '{}': the API alone is served", root);
   // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, and then a second daemon on the

@@ -1,7 +1,7 @@
 // The page's files (index.html, its scripts and styles) from the web root, as one GET route
 // registered after every API route. Not cpp-httplib's mount point at "/": the library tries its
-// mount points before any route, so a mount at "/" made every API request build a path and stat
-// a file that is not there (GET /api/status: 4.6 % of the daemon's CPU under wrk, 3.4 % of it
+// mount points before any route, so a mount at "/" made every GET of the API build a path and
+// stat a file that is not there (GET /api/status: 4.6 % of the daemon's CPU under wrk, 3.4 % of it
 // the stat; stop 39's perf profile, issue 27's bench_http). Here only a request that no API route
 // takes looks for a file.
 #include <algorithm>
@@ -34,7 +34,9 @@ std::string content_type(std::string_view path) {
 }
 
 // A path of the page's folder: segments of letters, digits, '_', '-' and '.', none empty or
-// starting with '.' (no "..", no hidden file), so nothing outside the root can be named.
+// starting with '.' (no "..", no hidden file), so no path names a place outside the root (the path
+// is decoded before it is matched). A symbolic link inside the root is followed, as the mount
+// point followed it: whoever installs the page's folder decides what is in it.
 bool page_path(std::string_view p) {
   std::size_t from = 0;
   while (from <= p.size()) {
