@@ -20,7 +20,6 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
-#include <utility>
 #include <vector>
 #include "temp_dir.hpp"
 
@@ -68,14 +67,14 @@ inline int served_port(const std::string& log) {
 // a daemon given --port). Taken below the kernel's ephemeral range
 // (/proc/sys/net/ipv4/ip_local_port_range, 32768-60999 on Debian): the kernel's own pick, as
 // before, is also the local port any client connecting elsewhere may be given before the server
-// binds it, and CI runs six tests at a time, each connecting to its rigs and daemons. Below the
+// binds it, and CI runs up to six tests at a time, each connecting to its rigs and daemons. Below the
 // range only another test's free_port() competes (and a service with a fixed port, which can_bind
 // skips), from a random start among the ~22,000 ports from 10000 up to the range.
-inline std::pair<int, int> ephemeral_ports() {
+inline int first_ephemeral_port() {
   std::ifstream f("/proc/sys/net/ipv4/ip_local_port_range");
-  int lo = 32768, hi = 60999;
-  f >> lo >> hi;
-  return {lo, hi};
+  int lo = 32768;
+  f >> lo;
+  return lo;
 }
 // 127.0.0.1:port (0: the kernel's pick).
 inline sockaddr_in loopback(int port) {
@@ -93,7 +92,7 @@ inline bool can_bind(int port) {
   return ok;
 }
 inline int free_port() {
-  const int below = ephemeral_ports().first;
+  const int below = first_ephemeral_port();
   constexpr int kFirst = 10000;
   if (below - kFirst >= 1000) {
     std::random_device seed;

@@ -6,7 +6,9 @@
 
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <memory>
+#include <sstream>
 
 #include "hystlab/db/sqlite.hpp"
 #include "hystlab/models/formats.hpp"
@@ -101,6 +103,14 @@ db::Reads& reader(const std::string& db_path) {
   thread_local std::unique_ptr<db::Store> store;
   if (!store || store->database().path() != db_path) store = std::make_unique<db::Store>(db_path);
   return *store;
+}
+
+std::optional<std::string> file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 }  // namespace hystlab::web

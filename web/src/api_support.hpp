@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <regex>
 #include <stdexcept>
 #include <string>
@@ -44,6 +45,8 @@ json body_object(const httplib::Request& req, bool allow_empty = false);
 // The page's folder: the configured one; else the installed one beside the executable
 // (<bindir>/../share/hystlab/web/<sub>); else the source tree's.
 std::string default_dir(const std::string& configured, const std::string& installed_sub, const char* source_tree);
+// A page file's bytes; nullopt when it cannot be opened (the daemon's and the lab view's pages).
+std::optional<std::string> file_bytes(const std::string& path);
 
 // This thread's read connection (WAL: never blocks the writer).
 db::Reads& reader(const std::string& db_path);

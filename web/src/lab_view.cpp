@@ -92,12 +92,7 @@ struct LabView::Impl {
 };
 
 namespace {
-std::string file_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string file_text(const std::string& path) { return file_bytes(path).value_or(std::string()); }
 db::LabFilter filter_of(const httplib::Request& req, const std::string& lab) {
   return {lab, req.get_param_value("daemon"), req.get_param_value("specimen"), req.get_param_value("kind"),
           static_cast<int>(query_number(req, "limit", 200, 1, 5000))};

@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "routes.hpp"
 
@@ -62,14 +62,12 @@ void add_page_route(httplib::Server& s, const std::string& root) {
       res.status = 404;  // the error handler's JSON: no such resource
       return;
     }
-    std::ifstream in(file, std::ios::binary);
-    std::ostringstream body;
-    body << in.rdbuf();
-    if (!in) {
+    std::optional<std::string> body = file_bytes(file.string());
+    if (!body) {
       res.status = 404;
       return;
     }
-    res.set_content(body.str(), content_type(rel));
+    res.set_content(std::move(*body), content_type(rel));
   });
 }
 
