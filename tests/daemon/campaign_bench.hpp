@@ -60,17 +60,17 @@ struct Controls {  // what the HTTP threads will do: queue commands for the acqu
   }
 };
 
-nlohmann::json fot_plan(int n, double rate = 0.1) {
+[[maybe_unused]] nlohmann::json fot_plan(int n, double rate = 0.1) {
   return {{"kind", "fot"},          {"range_mm", {0.0, 4.0}}, {"subdivisions", n},
           {"ramp_rate_mm_s", rate}, {"sample_rate_hz", 1000}, {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 50}}}};
 }
 
-std::unique_ptr<drivers::Rig> tcp_rig(int port) {
+[[maybe_unused]] std::unique_ptr<drivers::Rig> tcp_rig(int port) {
   return drivers::make_rig(
       {{"transport", "modbus-tcp"}, {"port", port}, {"response_timeout_ms", 50}, {"reconnect_min_ms", 10}, {"reconnect_max_ms", 20}, {"stale_after_ms", 5000}});
 }
 
-daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale, bool shaker = false) {
+[[maybe_unused]] daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double scale, bool shaker = false) {
   b.sup = std::make_unique<daemon::Supervisor>(rig, domain::SupervisionSettings{}, shaker, [](const daemon::RigTransition& t) {
     if (std::getenv("HYSTLAB_TRACE"))
       std::fprintf(stderr, "%.3f %s -> %s: %s\n", t.t, std::string(daemon::to_string(t.from)).c_str(), std::string(daemon::to_string(t.to)).c_str(),
@@ -83,7 +83,7 @@ daemon::RunnerContext context(drivers::Rig& rig, Bench& b, Controls* c, double s
   return ctx;
 }
 // Limits for the envelope tests: -1..5 mm, 100 N, and the rate limit given.
-domain::Limits envelope_limits(double rate_mm_s) {
+[[maybe_unused]] domain::Limits envelope_limits(double rate_mm_s) {
   domain::Limits l;
   l.displacement_min_mm = -1;
   l.displacement_max_mm = 5;
@@ -93,13 +93,13 @@ domain::Limits envelope_limits(double rate_mm_s) {
 }
 
 // A campaign as the daemon hands it over: the plan within the rig's envelope (the defaults).
-daemon::RunnerResult run(std::int64_t id, const domain::Plan& plan, daemon::RunnerContext& ctx) {
+[[maybe_unused]] daemon::RunnerResult run(std::int64_t id, const domain::Plan& plan, daemon::RunnerContext& ctx) {
   daemon::CampaignJob j;
   j.id = id;
   j.plan = plan;
   j.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, plan.kind == domain::CampaignKind::sine);
   return daemon::run_campaign(j, ctx);
 }
-std::string end_of(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }
+[[maybe_unused]] std::string end_of(const daemon::RunnerResult& r) { return daemon::to_string(r.end); }
 }  // namespace
 }  // namespace hystlab::test

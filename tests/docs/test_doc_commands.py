@@ -7,7 +7,8 @@ below with what its output must show, or as not run with the reason: a command a
 docs without a check here fails this test, so the docs cannot drift from what works.
 
 They run in a folder of their own (docs/ and build/ linked into it, so relative paths work as
-from the repository's root), with `H` the daemon's address (docs/API.md: "The examples use
+from the repository's root, and nothing outside it is needed: the paper's Table 1 is
+docs/examples/table1-params.json), with `H` the daemon's address (docs/API.md: "The examples use
 H=http://127.0.0.1:8080"; the daemon here takes a free port) and HYSTLAB_DAEMON set to it for
 the CLI. The daemon is `build/daemon/hystlabd --port 0`: the embedded defaults of README's first
 command, a simulated load frame (time scale 10) and a simulated shaker.
@@ -133,7 +134,7 @@ CHECKS = {
     "build/daemon/hystlab report 1 -o report1.pdf": lambda rc, out, cwd: pdf_pages(rc, out, cwd, "report1.pdf"),
     # README's models from the command line, with the reader's own files (my_path.csv,
     # measured.csv) put where theirs would be.
-    "build/daemon/hystlab identify --model simplified --params ../shared/data/table1-params.json --range 0,4 --subdivisions 12 -o T12.json":
+    "build/daemon/hystlab identify --model simplified --params docs/examples/table1-params.json --range 0,4 --subdivisions 12 -o T12.json":
         file_check("T12.json", lambda d: json.loads(d)["subdivisions"] == 12 and len(json.loads(d)["rows"]) > 0, "a table of n = 12"),
     "build/daemon/hystlab eval --table T12.json --input my_path.csv -o predicted.csv":
         file_check("predicted.csv", lambda d: d.count(b"\n") >= 200 and b"force_N" in d.split(b"\n")[0], "a force per input row"),
@@ -200,12 +201,9 @@ def main():
     stale = [c for c in CHECKS if c not in documented]
     for c in stale:
         print("FAIL a checked command that the docs no longer give: " + c)
-    top = tempfile.mkdtemp(prefix="hystlab-docs-")  # top/main is the reader's clone, ../shared beside it
-    cwd = os.path.join(top, "main")
-    os.mkdir(cwd)
+    cwd = tempfile.mkdtemp(prefix="hystlab-docs-")  # the reader's clone, standing alone: nothing beside it is read
     os.symlink(os.path.join(REPO, "docs"), os.path.join(cwd, "docs"))
     os.symlink(BUILD, os.path.join(cwd, "build"))
-    os.symlink(os.path.abspath(os.path.join(REPO, "..", "shared")), os.path.join(top, "shared"))
     readers_files(cwd)
     log = open(os.path.join(cwd, "daemon.log"), "wb")
     daemon = subprocess.Popen(["build/daemon/hystlabd", "--port", "0"], cwd=cwd, stdout=log, stderr=subprocess.STDOUT)
@@ -241,7 +239,7 @@ def main():
             daemon.kill()
         if failures:
             print(open(os.path.join(cwd, "daemon.log"), errors="replace").read()[-4000:])
-        shutil.rmtree(top, ignore_errors=True)
+        shutil.rmtree(cwd, ignore_errors=True)
     print("%d documented commands, %d checked, %d failed" % (len(documented), len(CHECKS), failures))
     return 1 if failures else 0
 
@@ -253,7 +251,7 @@ def readers_files(cwd):
     with open(os.path.join(cwd, "my_path.csv"), "w") as f:
         f.write("displacement_mm\n" + "".join("%.4f\n" % x for x in xs))
     # The 'measurement': the simplified model (Table 1) along that path, as a rig would give it.
-    subprocess.run(["build/daemon/hystlab", "eval", "--model", "simplified", "--params", "../shared/data/table1-params.json",
+    subprocess.run(["build/daemon/hystlab", "eval", "--model", "simplified", "--params", "docs/examples/table1-params.json",
                     "--input", "my_path.csv", "-o", "measured.csv"], cwd=cwd, check=True, stdout=subprocess.DEVNULL)
 
 

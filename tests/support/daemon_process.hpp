@@ -154,6 +154,7 @@ class DaemonProcess {
   }
   ~DaemonProcess() { stop(); }
   [[nodiscard]] int port() const noexcept { return port_; }
+  [[nodiscard]] pid_t pid() const noexcept { return pid_; }
   // kill -9, as a crash would: nothing of the daemon's runs after it (the folder stays).
   void kill9() {
     kill(pid_, SIGKILL);

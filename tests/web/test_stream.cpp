@@ -115,7 +115,11 @@ TEST_CASE("the event stream carries samples, states, nodes and tables; Last-Even
   }
   CHECK(states == std::vector<std::string>{"queued", "arming", "running", "completed"});
   CHECK(nodes == 6);
-  CHECK(sample_frames > 5);
+  // The run's samples reached the stream. How many frames depends on how long the campaign took
+  // in wall time (1.75 s of rig time at 20 times real time, ~90 ms, unless the simulator is
+  // starved: under ThreadSanitizer it once left an 8 s hole, and the stream sent 3 frames where
+  // other runs sent 6-12). Their number is the scheduler's; that they come, whole, is the code's.
+  CHECK(sample_frames >= 1);
   // Decimated to the asked rate: 500 Hz in, about 20 Hz out.
   std::size_t values = 0;
   double t0 = 1e300, t1 = -1e300;

@@ -48,8 +48,11 @@ std::string default_dir(const std::string& configured, const std::string& instal
 // A page file's bytes; nullopt when it cannot be opened (the daemon's and the lab view's pages).
 std::optional<std::string> file_bytes(const std::string& path);
 
-// This thread's read connection (WAL: never blocks the writer).
+// The read connection this thread holds for its request (WAL: never blocks the writer), taken
+// from a small shared pool on first use. release_reader() gives it back: the server's post-routing
+// handler calls it once a request's answer is made, and a stream after each read.
 db::Reads& reader(const std::string& db_path);
+void release_reader() noexcept;
 
 // HTTP threads yield to acquisition and to the rig's simulator: requests run at nice 5, and a
 // thread streaming events at nice 19 and off the acquisition's CPU (its work is small and its

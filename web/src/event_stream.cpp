@@ -152,6 +152,7 @@ void add_stream_route(httplib::Server& s, ApiContext& c) {
                     st->seen_generation = gen;  // taken before the read: a change during it is read next time
                     st->since_read = 0;
                     out += records(reader(c.db_path), st->cursor);
+                    release_reader();  // a stream holds no connection between its reads
                   }
                 }
                 if (out.empty() && ++st->quiet >= kKeepAliveEvery) out = ": keep-alive\n\n";
@@ -159,6 +160,7 @@ void add_stream_route(httplib::Server& s, ApiContext& c) {
                 return write(sink, out) && sink.is_writable();
               },
               [&c](bool) {
+                release_reader();
                 set_thread_nice(kRequestNice);  // a request thread again (stays at 19 without CAP_SYS_NICE)
                 c.daemon.keep_off_acquisition_cpu(false);
                 c.stream_clients.fetch_sub(1);

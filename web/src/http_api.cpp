@@ -45,6 +45,9 @@ HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg, La
   s.set_payload_max_length(cfg.max_body_bytes);
   s.set_default_headers(httplib::Headers(security_headers().begin(), security_headers().end()));
   s.set_pre_routing_handler([&m](const httplib::Request& req, httplib::Response& res) { return guard_request(m.ctx, req, res); });
+  // Called once the handler (or the error handler) made the answer, before it is written: the
+  // request's read connection goes back to the pool (api_support.cpp: reader).
+  s.set_post_routing_handler([](const httplib::Request&, httplib::Response&) { release_reader(); });
   s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;  // the handler's own JSON error
     if (res.status == 404)

@@ -40,7 +40,7 @@ struct TableDocument {
 [[nodiscard]] TableDocument table_from_json(std::string_view text);
 
 [[nodiscard]] nlohmann::json params_to_json(const SmaParameters& p, const std::string& source);
-// Reads the format of shared/data/table1-params.json and validates the model.
+// Reads the format of docs/examples/table1-params.json (docs/FORMATS.md) and validates the model.
 [[nodiscard]] SmaParameters params_from_json(std::string_view text);
 
 }  // namespace hystlab::models

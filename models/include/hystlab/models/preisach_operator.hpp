@@ -1,6 +1,6 @@
 #pragma once
 // The Preisach model's output on one input record as a linear map of its table, applied without
-// ever forming a matrix: out[k] = Σ_node A[k][node] F[node] (MODELS.md §2, Eqs. 6-7).
+// ever forming a matrix: out[k] = Σ_node A[k][node] F[node] (MODELS.md §1, Eqs. 6-7).
 //
 // Why not rows or a Gram matrix: the row of sample k holds the interpolation stencils of every
 // turning point in the memory, so the dense fit's Gram matrix costs Σ_k |row_k|² to build and

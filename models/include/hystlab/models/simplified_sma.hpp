@@ -1,5 +1,5 @@
 #pragma once
-// The physically based simplified SMA model with continuous minor loops (MODELS.md §2).
+// The physically based simplified SMA model with continuous minor loops (docs/MODELS.md §2).
 #include <memory>
 #include <string>
 
@@ -7,7 +7,7 @@
 
 namespace hystlab::models {
 
-// The fields of shared/data/table1-params.json. Stiffness N/mm, mm, N/°C, °C.
+// The fields of docs/examples/table1-params.json (docs/FORMATS.md). Stiffness N/mm, mm, N/°C, °C.
 struct SmaParameters {
   double KA = 40.0, KM = 150.0, dtr_max = 2.95, C = 5.7;
   double Mf0 = 12.7, Ms0 = 17.9, As0 = 17.9, Af0 = 21.5, T = 25.0;

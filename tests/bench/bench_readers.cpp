@@ -1,0 +1,137 @@
+// The daemon's resident memory while the page watches a campaign (issue 40): a real hystlabd, its
+// simulated load frame at time scale 10 (10,000 samples a second), a 1 kHz FOT campaign, and the
+// readers the page has: one event stream (rate 20), GET /api/runs/ID/samples?points=1000 every 2 s
+// of rig time and points=100000 every minute of it, each on a new connection (as curl, or a browser
+// whose keep-alive has lapsed: each lands on another of the server's 190 threads). Then HDF5
+// exports of the run over HTTP, one after another. Printed: resident MB along the way and the
+// growth per sample acquired over the second half of the campaign (after the caches have filled),
+// and per export; target 0 (flat). Before the read connections were pooled the samples reader
+// alone grew the daemon by 1,073 bytes a sample; the bench fails above 300 bytes a sample or
+// 1 MB an export, so that such a growth cannot pass unseen (flat reads within +-60 here).
+#include <httplib.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../support/daemon_process.hpp"
+
+namespace {
+using json = nlohmann::json;
+constexpr double kTimeScale = 10;  // rig seconds per wall second
+
+double rss_mb(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/statm");
+  long pages = 0, resident = 0;
+  in >> pages >> resident;
+  return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1e6;
+}
+
+// A GET on its own connection (no keep-alive), as a new client's.
+int get(int port, const std::string& path, std::string* body = nullptr) {
+  httplib::Client c("127.0.0.1", port);
+  c.set_keep_alive(false);
+  c.set_read_timeout(120, 0);
+  auto r = c.Get(path.c_str());
+  if (!r) return 0;
+  if (body) *body = r->body;
+  return r->status;
+}
+
+// Least-squares slope of y against x over the second half of the points.
+double slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const std::size_t b = x.size() / 2, n = x.size() - b;
+  double mx = 0, my = 0;
+  for (std::size_t k = b; k < x.size(); ++k) mx += x[k], my += y[k];
+  mx /= static_cast<double>(n), my /= static_cast<double>(n);
+  double sxy = 0, sxx = 0;
+  for (std::size_t k = b; k < x.size(); ++k) sxy += (x[k] - mx) * (y[k] - my), sxx += (x[k] - mx) * (x[k] - mx);
+  return sxx > 0 ? sxy / sxx : 0;
+}
+
+// The event stream the page keeps open, until stop.
+void stream(int port, const std::atomic<bool>& stop, std::atomic<long>& frames) {
+  httplib::Client c("127.0.0.1", port);
+  c.set_read_timeout(30, 0);
+  c.Get("/api/stream?rate=20", [&](const char* data, std::size_t n) {
+    if (std::string_view(data, n).find("event: samples") != std::string_view::npos) ++frames;
+    return !stop;
+  });
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  int exports = 20;
+  for (int k = 1; k + 1 < argc; k += 2)
+    if (std::string(argv[k]) == "--exports") exports = std::atoi(argv[k + 1]);
+  try {
+    hystlab::test_support::DaemonProcess daemon(R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 10}}]})");
+    const int port = daemon.port();
+    httplib::Client c("127.0.0.1", port);
+    // 24 rows at 0.18 mm/s: about 530 s of rig time, 53 s here.
+    const json plan{{"kind", "fot"},
+                    {"range_mm", {0, 4}},
+                    {"subdivisions", 24},
+                    {"ramp_rate_mm_s", 0.18},
+                    {"sample_rate_hz", 1000},
+                    {"validation", false},
+                    {"limits", {{"displacement_mm", {-0.5, 4.5}}, {"force_N", 400}, {"rate_mm_s", 20}}}};
+    auto r = c.Post("/api/campaigns", json{{"plan", plan}}.dump(), "application/json");
+    if (!r || r->status != 201) throw std::runtime_error("cannot submit the campaign: " + (r ? r->body : std::string("no answer")));
+    const std::string id = std::to_string(json::parse(r->body)["id"].get<long>());
+    std::atomic<bool> stop{false};
+    std::atomic<long> frames{0};
+    std::thread sse(stream, port, std::cref(stop), std::ref(frames));
+
+    std::vector<double> samples, rss;
+    std::string state, run;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int tick = 0; state != "completed" && state != "failed" && state != "aborted"; ++tick) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(2.0 / kTimeScale));
+      if (std::chrono::steady_clock::now() - t0 > std::chrono::minutes(5)) throw std::runtime_error("the campaign did not end within 5 min");
+      std::string body;
+      if (get(port, "/api/campaigns/" + id, &body) != 200) continue;
+      const json campaign = json::parse(body);
+      state = campaign.value("state", "");
+      if (run.empty() && campaign.contains("runs") && !campaign["runs"].empty()) run = std::to_string(campaign["runs"][0]["id"].get<long>());
+      if (run.empty()) continue;
+      (void)get(port, "/api/runs/" + run + "/samples?points=1000");
+      if (tick % 30 == 0) (void)get(port, "/api/runs/" + run + "/samples?points=100000");
+      if (get(port, "/api/runs/" + run, &body) != 200) continue;
+      samples.push_back(json::parse(body)["samples"].get<double>());
+      rss.push_back(rss_mb(daemon.pid()));
+      if (samples.size() % 50 == 1) std::printf("  %9.0f samples: %6.1f MB resident\n", samples.back(), rss.back());
+    }
+    stop = true;
+    sse.join();
+    if (state != "completed" || samples.size() < 20)
+      throw std::runtime_error("the campaign ended " + state + " after " + std::to_string(samples.size()) + " reads");
+    const double per_sample = slope(samples, rss) * 1e6;
+    std::printf(
+        "campaign with the page's readers (%ld stream frames): %.0f samples, %.1f -> %.1f MB; growth over the second half %.0f bytes a sample (target 0)\n",
+        frames.load(), samples.back(), rss.front(), rss.back(), per_sample);
+
+    std::vector<double> n, after;
+    for (int k = 0; k < exports; ++k) {
+      std::string body;
+      if (get(port, "/api/runs/" + run + "/samples.h5", &body) != 200 || body.size() < 1000)
+        throw std::runtime_error("export " + std::to_string(k) + " failed");
+      n.push_back(k), after.push_back(rss_mb(daemon.pid()));
+    }
+    const double per_export = slope(n, after) * 1e6;
+    std::printf("%d HDF5 exports of the %.0f-sample run over HTTP: %.1f -> %.1f MB; growth over the second half %.0f bytes an export (target 0)\n", exports,
+                samples.back(), after.front(), after.back(), per_export);
+    if (frames.load() == 0) throw std::runtime_error("the event stream carried no samples");
+    if (per_sample > 300) throw std::runtime_error("resident memory grows with the samples acquired while the page reads");
+    if (per_export > 1e6) throw std::runtime_error("resident memory grows with every export");
+    return 0;
+  } catch (const std::exception& e) {
+    std::printf("bench_readers: %s\n", e.what());
+    return 1;
+  }
+}
