@@ -33,6 +33,7 @@ class RampStrategy final : public Strategy {
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
     for (const models::FotNode& n : L.job.prior_nodes) (void)builder_->add(n);
     if (!L.job.prior_nodes.empty()) resume_rows_only(L);
+    validation_to_rerun_ = !L.job.prior_nodes.empty();
     const double band = std::min(0.05 * g.step(), 0.02);
     fot_ = std::make_unique<OnlineFot>(g, band, [this, &L](const models::FotNode& n, double t) {
       if (builder_->add(n)) return;
@@ -42,7 +43,13 @@ class RampStrategy final : public Strategy {
     });
   }
 
-  [[nodiscard]] bool has_work() const override { return !(builder_ && builder_->complete()); }
+  // Rows left to measure, or the validation input to run again: a campaign interrupted during its
+  // validation run (or while finishing) resumes with every node measured, and its tables are scored
+  // on a validation run of its own, driven whole now (the interrupted one's samples end where the
+  // daemon stopped: a held-out score on part of the input would say less than it seems to).
+  [[nodiscard]] bool has_work() const override {
+    return !(builder_ && builder_->complete()) || (builder_ && plan_.validation.enabled && validation_to_rerun_);
+  }
 
   [[nodiscard]] CampaignPhase phase() const override {
     const Segment* cur = seq_.current();
@@ -261,6 +268,7 @@ class RampStrategy final : public Strategy {
   std::optional<std::size_t> cycle_start_;  // the sample a training cycle began at
   std::size_t rows_begin_ = 0, halvings_seen_ = 0;
   bool validating_ = false;
+  bool validation_to_rerun_ = false;  // a resume: the validation input is driven again, whole (has_work)
   std::int64_t campaign_run_ = 0;
   double target_ = 0, started_ = 0, deadline_ = 1e300;
   double stalled_at_arm_ = 0;

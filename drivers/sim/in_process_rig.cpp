@@ -25,12 +25,14 @@ std::error_code InProcessRig::connect(double now_s) noexcept {
 }
 
 // The controller's clock runs from the first time the host passes in, one sample per period; a
-// period not yet whole waits for the next call (as hystlab-sim's world clock does).
+// period not yet whole waits for the next call (as hystlab-sim's world clock does). The host's
+// time may start again (each campaign counts from its own start): the controller's runs on.
 void InProcessRig::advance(double now_s) noexcept {
-  if (!anchored_) {
+  if (!anchored_ || now_s < last_now_s_) {
     anchor_s_ = now_s - rig_.time_s();
     anchored_ = true;
   }
+  last_now_s_ = now_s;
   // Counted in whole periods from the anchor, so rounding never drifts the controller's clock.
   const double due = std::floor((now_s - anchor_s_) / period_s_ + 1e-9);
   for (double done = std::round(rig_.time_s() / period_s_); done < due; done += 1) rig_.step(period_s_);

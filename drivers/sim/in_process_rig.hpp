@@ -48,7 +48,7 @@ class InProcessRig final : public drivers::Rig {
   SimRig rig_;
   Faults faults_;  // none: measurements as the controller has them
   double period_s_;
-  double anchor_s_ = 0;
+  double anchor_s_ = 0, last_now_s_ = 0;
   bool anchored_ = false;
 };
 
