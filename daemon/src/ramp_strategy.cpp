@@ -47,9 +47,7 @@ class RampStrategy final : public Strategy {
   // validation run (or while finishing) resumes with every node measured, and its tables are scored
   // on a validation run of its own, driven whole now (the interrupted one's samples end where the
   // daemon stopped: a held-out score on part of the input would say less than it seems to).
-  [[nodiscard]] bool has_work() const override {
-    return !(builder_ && builder_->complete()) || (builder_ && plan_.validation.enabled && validation_to_rerun_);
-  }
+  [[nodiscard]] bool has_work() const override { return !(builder_ && builder_->complete()) || (builder_ && plan_.validation.enabled && validation_to_rerun_); }
 
   [[nodiscard]] CampaignPhase phase() const override {
     const Segment* cur = seq_.current();
