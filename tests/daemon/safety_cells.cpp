@@ -86,7 +86,7 @@ std::string why_not(State s, Event e) {
       !(s == State::queued && (e == Event::db_busy || e == Event::db_failing || e == Event::ring_full)) && s != State::finishing)
     return "a campaign command here goes through the daemon's main loop (route): tests/daemon/test_daemon.cpp and tests/web";
   if (s == State::finishing && (e == Event::campaign_estop || e == Event::abort || e == Event::pause || e == Event::resume || e == Event::dead_band))
-    return "the campaign no longer moves the rig: the daemon's main loop answers 409 while its tables are being built (daemon.cpp, route)";
+    return "the campaign no longer moves the rig: the daemon's main loop answers 409 while its tables are being built (daemon_impl.hpp, route)";
   return "";
 }
 
