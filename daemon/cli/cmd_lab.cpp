@@ -216,7 +216,7 @@ int show_campaign(db::LabReads& lab, const Args& args, const Options& opt) {
   auto events = lab.events(c->daemon_id, id, 1000000);
   const auto tables = lab.tables({c->lab, c->daemon, {}, {}, 100000});
   std::vector<db::LabTable> mine;
-  std::copy_if(tables.begin(), tables.end(), std::back_inserter(mine), [&](const db::LabTable& t) { return t.campaign == id; });
+  std::copy_if(tables.begin(), tables.end(), std::back_inserter(mine), [id = id](const db::LabTable& t) { return t.campaign == id; });
   if (opt.has("json")) {
     json j{{"lab", c->lab},
            {"daemon", c->daemon},

@@ -314,8 +314,10 @@ TEST_CASE("runs export --pg: a run's CSV from the lab equal byte for byte to the
   Workdir w;
   for (const auto& [db, daemon, run] :
        {std::tuple{l.a_db, "frame-pc-1", 1}, std::tuple{l.a_db, "frame-pc-1", 2}, std::tuple{l.b_db, "frame-pc-2", 1}, std::tuple{l.b_db, "frame-pc-2", 2}}) {
-    CAPTURE(daemon);
-    CAPTURE(run);
+    const std::string daemon_name = daemon;  // CAPTURE takes no binding (clang 14)
+    const int run_id = run;
+    CAPTURE(daemon_name);
+    CAPTURE(run_id);
     const Result file = w.run("runs export " + std::to_string(run) + " --db " + db);
     REQUIRE(file.code == 0);
     const Result pg = l.run(w, "runs export " + std::to_string(run) + " " + l.pg() + " --daemon " + daemon);
@@ -376,8 +378,9 @@ TEST_CASE("runs export --pg --format h5: a run and a campaign as HDF5 from the l
   w.write("same_h5.py", kSameH5);
   for (const auto& [what, db, daemon] :
        {std::tuple{"1", l.a_db, "frame-pc-1"}, std::tuple{"--campaign 1", l.b_db, "frame-pc-2"}, std::tuple{"2", l.b_db, "frame-pc-2"}}) {
-    CAPTURE(std::string(what));
-    CAPTURE(std::string(daemon));
+    const std::string what_text(what), daemon_name(daemon);
+    CAPTURE(what_text);
+    CAPTURE(daemon_name);
     const Result file = w.run("runs export " + std::string(what) + " --format h5 -o file.h5 --db " + db);
     CAPTURE(file.err);
     REQUIRE(file.code == 0);

@@ -37,7 +37,8 @@ TEST_CASE("fmu: a random input gives the CLI's forces to the last digit (uniform
       {"T.json", "--table T.json --clamp"}, {"T2.json", "--table T2.json --clamp"}, {"P.json", "--model simplified --params P.json"}};
   std::uint64_t seed = 7;
   for (const auto& [file, args] : elements) {
-    CAPTURE(file);
+    const std::string& element = file;  // CAPTURE takes no binding (clang 14)
+    CAPTURE(element);
     Fmu f(w.fmu(file, file + ".fmu"), w.dir / (file + "-fmu"));
     const std::vector<double> x = random_input(seed++, -0.3, 4.3, 3000);
     const std::vector<double> want = cli_forces(w, args, x);

@@ -112,7 +112,8 @@ TEST_CASE("5b: calibration recovers Table 1 within 2% from a loop with 1% force 
     const SmaParameters t1 = table1_parameters(), p = cal.parameters;
     const std::pair<double, double> pairs[] = {{p.KA, t1.KA},   {p.KM, t1.KM},   {p.dtr_max, t1.dtr_max}, {p.Mf0, t1.Mf0},
                                                {p.Ms0, t1.Ms0}, {p.As0, t1.As0}, {p.Af0, t1.Af0}};
-    for (const auto& [got, want] : pairs) {
+    for (const auto& pair : pairs) {
+      const double got = pair.first, want = pair.second;
       CAPTURE(got);
       CAPTURE(want);
       CHECK(std::fabs(got - want) <= 0.02 * std::fabs(want));

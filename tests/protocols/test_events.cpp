@@ -70,7 +70,10 @@ TEST_CASE("every event kind round-trips through its struct, with seeded random f
       round_trips(k.kind, d);
     }
     // What is written is the schema: no field outside the list.
-    for (const auto& [name, v] : defaults.items()) CHECK_MESSAGE(std::find(k.fields.begin(), k.fields.end(), name) != k.fields.end(), k.kind << "." << name);
+    for (const auto& item : defaults.items()) {
+      const std::string name = item.key();
+      CHECK_MESSAGE(std::find(k.fields.begin(), k.fields.end(), name) != k.fields.end(), k.kind << "." << name);
+    }
   }
   CHECK(seen.size() == std::variant_size_v<domain::CampaignEvent>);
 }

@@ -54,7 +54,7 @@ void set(json& plan, const PlanField& f, const json& value) {
     (*o)[name][k] = value;
     return;
   }
-  (*o)[path] = f.type == FieldType::list ? json{value} : value;
+  (*o)[path] = f.type == FieldType::list ? json::array({value}) : value;
 }
 
 std::string refused_field(const json& plan) {

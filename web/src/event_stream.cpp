@@ -94,7 +94,6 @@ bool write(httplib::DataSink& sink, const std::string& s) { return s.empty() || 
 std::string StreamCursor::id() const { return std::to_string(event) + "." + std::to_string(node) + "." + std::to_string(table); }
 
 std::optional<StreamCursor> parse_cursor(const std::string& text) {
-  StreamCursor c;
   long long e = -1, n = -1, t = -1;
   int used = 0;
   if (text.size() > 60 || std::sscanf(text.c_str(), "%lld.%lld.%lld%n", &e, &n, &t, &used) != 3 || used != static_cast<int>(text.size()) || e < 0 || n < 0 ||

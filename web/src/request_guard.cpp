@@ -177,7 +177,6 @@ void post_route(httplib::Server& s, ApiContext& c, const std::string& pattern, h
 }
 
 httplib::Server::HandlerResponse check_read(const control::HttpConfig& config, const httplib::Request& req, httplib::Response& res) {
-  using HR = httplib::Server::HandlerResponse;
   const bool data = req.path.rfind("/api/", 0) == 0 || req.path == "/metrics";
   if (config.read_token.empty() || !data) return HR::Unhandled;
   const std::string given = given_token(req);
