@@ -581,6 +581,9 @@ try {
     // Measured against predicted from the named table, with its provenance.
     check(await wait(page, () => window.hystlab.transmissibilityCurves().length === 4 && window.hystlab.transmissibilityCurves().every(c => c.predicted === 3), null, 'the prediction', 20000),
           `each curve predicted from table #${table} is drawn beside the measured one: ${JSON.stringify(await page.evaluate(() => window.hystlab.transmissibilityCurves()))}`);
+    // The status line turns from the last step's progress to the sweep's summary on its own poll,
+    // after the curves: wait for it (stop 41's clean-clone run read the progress line once, too early).
+    await wait(page, () => document.querySelector('#sweep-status').textContent.includes('predicted with '), null, 'the summary line', 20000);
     const said = await page.textContent('#sweep-status');
     check(said.includes('predicted with ') && said.includes(`Preisach table n = 4 (fot, table ${table}: campaign `), `the page names the table and how it was identified: "${said}"`);
     await page.fill('input[name=isotable]', '');
