@@ -34,8 +34,8 @@ double linear_ratio(double f) {
 
 // A campaign on its own hystlab-sim shaker (the simulator's arguments), read in blocks, stored in
 // its own database, run in time_scale: the set-up every test here shares. Its parts are named
-// by a structured binding: auto& [sim, b, rig, plan, id, r] = run_. A CAPTURE takes a plain
-// reference to a part (clang 14, the sanitized tree's compiler, cannot capture a binding).
+// by a structured binding: auto& [sim, b, rig, plan, id, r] = run_; a CAPTURE names a part through
+// run_ (clang 14, the sanitized tree's compiler, cannot capture a binding).
 struct ShakerSweep {
   ShakerSweep(std::vector<std::string> sim_args, const nlohmann::json& plan_json, double scale, std::shared_ptr<const daemon::IsolatorModel> isolator = nullptr)
       : sim(std::move(sim_args)), rig(shaker_rig(sim.modbus_port)), plan(domain::parse_plan(plan_json)), id(b.submit(plan.source)) {
@@ -79,8 +79,7 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
                     {"control", {{"tolerance", "3 %"}, {"window_cycles", 3}}}},
                    0.25, std::make_shared<const daemon::IsolatorModel>(daemon::simulated_isolator()));
   auto& [sim, b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 3);
@@ -121,8 +120,7 @@ TEST_CASE("sine campaign with linear springs: the transmissibility of the analyt
                     {"sample_rate_hz", 1000}},
                    0.25);
   auto& [sim, b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 3);
@@ -149,8 +147,7 @@ TEST_CASE("sine campaign: beyond the abort band the shaker is stopped, at zero d
                     {"control", {{"abort", "30 %"}, {"max_drive_ratio", 1.5}}}},
                    0.25);
   auto& [sim, b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   CHECK(end_of(r) == "aborted");
   CHECK(r.reason.find("control abort") != std::string::npos);
   CHECK(r.reason.find("abort band ±30 %") != std::string::npos);
@@ -180,8 +177,7 @@ TEST_CASE("a resonance dwell tracks the phase: the mass held at -90 degrees agai
                    1.0);
   auto& [sim, b, rig, plan, id, r] = run_;
   CHECK(plan.sine.lowest_hz() == doctest::Approx(16 / 1.25));  // the envelope is checked over where tracking may go
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   const auto dwell = b.store->event_details(id, "dwell");
   REQUIRE(dwell.size() == 1);
@@ -229,8 +225,7 @@ TEST_CASE("amplitude levels ramped: from 0.005 to 0.05 mm and back the drive goe
                     {"sample_rate_hz", 1000}},
                    1.0);
   auto& [sim, b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   // The drive as commanded, sample by sample: each change at most ×2.2 (a ramp's ×2 and the
   // loop's correction on it), after the first step's start.
@@ -263,8 +258,7 @@ TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rat
                     {"sample_rate_hz", 1000}},
                    0.5);
   auto& [sim, b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   const auto pts = points_of(*b.store, id);
   // 2 s from 8 to 11 Hz: about 19 cycles, 4 a point (the last window may cross the end).
@@ -349,8 +343,7 @@ TEST_CASE("resonance refinement on the simulated shaker: a Q of 25 measured, not
                     {"resonance", {{"half_power_points", 5}, {"max_steps", 30}}}},
                    1.0);
   auto& [sim, b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   const auto pts = points_of(*b.store, id);
   CHECK(pts.size() > 4);
@@ -373,8 +366,7 @@ TEST_CASE("resonance refinement on the simulated shaker: a Q of 25 measured, not
   CHECK(b.store->event_details(id, "resonance_unresolved").empty());
   // The samples kept: the controller's window (0.5 s deep) outlasts a starved host's pauses; a
   // longer freeze loses what it overwrote, counted (bench_shaker reports the figure, 0 targeted).
-  const auto missed = r.missed_deadlines;
-  CAPTURE(missed);
+  CAPTURE(run_.r.missed_deadlines);
   CHECK(r.samples > 10000);
   CHECK(r.missed_deadlines * 2000 < r.samples);
 }
@@ -390,8 +382,7 @@ TEST_CASE("a drive write answered 150 ms late at every frequency step (hystlab-s
                     {"sample_rate_hz", 1000}},
                    0.5);
   auto& [sim, b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   CHECK(end_of(r) == "completed");
   // Each new frequency's first write is lost: the loop check's 3 and the sweep's 3 at least.
   CHECK(b.sup->link_losses() >= 6);

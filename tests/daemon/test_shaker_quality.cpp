@@ -23,7 +23,7 @@ namespace {
 // A campaign on the simulated shaker of `hystlab-sim --rig shaker --linear 40` (13 kg on four
 // 40 N/mm springs, the servo-driven table), in process on the fake clock, stored in its own file.
 // Its parts are named by a structured binding: auto& [b, rig, plan, id, r] = run_ (a CAPTURE
-// takes a plain reference to a part: clang 14 cannot capture a binding).
+// names a part through run_: clang 14 cannot capture a binding).
 struct InProcessSweep {
   explicit InProcessSweep(const nlohmann::json& plan_json) : rig(make_shaker()), plan(domain::parse_plan(plan_json)), id(b.submit(plan.source)) {
     daemon::FakeClock clock;
@@ -59,8 +59,7 @@ TEST_CASE("every frequency step of an isolation sweep keeps the base at its dema
                        {"measured_cycles", 8},
                        {"sample_rate_hz", 1000}});
   auto& [b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 5);
@@ -93,8 +92,7 @@ TEST_CASE(
                        {"measured_cycles", 8},
                        {"sample_rate_hz", 1000}});
   auto& [b, rig, plan, id, r] = run_;
-  const auto& reason = r.reason;
-  CAPTURE(reason);
+  CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 10);
