@@ -123,10 +123,21 @@ std::vector<double> smoothing_diagonal(const Grid& g) {
   return d;
 }
 
-NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> force, std::vector<double> mask)
-    : op_(op), mask_(std::move(mask)), cells_(op.grid().cell_count()) {
-  if (mask_.size() != op.samples() || force.size() != op.samples())
+namespace {
+std::vector<double> checked_mask(const PreisachOperator& op, std::span<const double> force, std::vector<double> mask) {
+  if (mask.size() != op.samples() || force.size() != op.samples())
     throw std::invalid_argument("fit: the force record and the mask must have one value per sample");
+  return mask;
+}
+}  // namespace
+
+NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> force, std::vector<double> mask)
+    : NormalSystem(op, force, std::move(mask), nullptr) {}
+
+NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> force, std::vector<double> mask, std::shared_ptr<const NodeGram> gram)
+    : op_(op), mask_(checked_mask(op, force, std::move(mask))), gram_(std::move(gram)), cells_(op.grid().cell_count()) {
+  if (!gram_) gram_ = std::make_shared<const NodeGram>(op, mask_, gram_limit(op));
+  if (gram_->size() != op.nodes() + 1) throw std::invalid_argument("fit: the Gram matrix is not of this record's grid");
   nodes_.assign(op.nodes(), 0.0);
   node_grad_.assign(op.nodes(), 0.0);
   samples_.assign(op.samples(), 0.0);
@@ -134,20 +145,14 @@ NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> f
   rhs_.assign(size(), 0.0);
   pre_nodes_.assign(op.nodes(), 0.0);
   data_gradient(force, rhs_);
-  // The data term's diagonal in node space, E[(Aᵀ M z)_a²] = Σ_k M_k A_ka² for z of random signs,
-  // from 8 probes (it cannot be read off without forming the Gram matrix; ±50 % is plenty for a
-  // preconditioner). The same probes mapped to cells give the trace that scales λ.
-  constexpr int kProbes = 8;
-  std::mt19937_64 rng(0x5eed);
-  std::vector<double> z(op.samples()), t(op.nodes()), tw(cells_);
-  data_diag_.assign(op.nodes(), 0.0);
-  cell_data_diag_.assign(cells_, 0.0);
-  for (int probe = 0; probe < kProbes; ++probe) {
-    for (std::size_t k = 0; k < z.size(); ++k) z[k] = mask_[k] * ((rng() & 1U) != 0U ? 1.0 : -1.0);
-    op.apply_transpose(z, t, prefix_);
-    for (std::size_t a = 0; a < t.size(); ++a) data_diag_[a] += t[a] * t[a] / kProbes;
-    nodes_to_cells_transpose(op.grid(), t, tw);
-    for (std::size_t c = 0; c < cells_; ++c) cell_data_diag_[c] += tw[c] * tw[c] / kProbes;
+  if (gram_->formed()) {  // both diagonals exactly, from G
+    data_diag_.assign(op.nodes(), 0.0);
+    for (std::size_t a = 0; a < data_diag_.size(); ++a) data_diag_[a] = gram_->diagonal(a);
+    cell_data_diag_ = gram_->cell_diagonal(op.grid());
+    gram_in_.assign(gram_->size(), 0.0);
+    gram_out_.assign(gram_->size(), 0.0);
+  } else {
+    estimate_diagonals();
   }
   offset_diag_ = 0.0;
   for (double m : mask_) offset_diag_ += m;
@@ -161,6 +166,24 @@ NormalSystem::NormalSystem(const PreisachOperator& op, std::span<const double> f
   }
   trace_ratio_ = smooth_trace > 0.0 ? std::max(data_trace, 1e-300) / smooth_trace : 1.0;
   set_lambda(0.0);
+}
+
+void NormalSystem::estimate_diagonals() {
+  // The data term's diagonal in node space, E[(Aᵀ M z)_a²] = Σ_k M_k A_ka² for z of random signs,
+  // from 8 probes (without G it cannot be read off; ±50 % is plenty for a preconditioner). The
+  // same probes mapped to cells give the trace that scales λ.
+  constexpr int kProbes = 8;
+  std::mt19937_64 rng(0x5eed);
+  std::vector<double> z(op_.samples()), t(op_.nodes()), tw(cells_);
+  data_diag_.assign(op_.nodes(), 0.0);
+  cell_data_diag_.assign(cells_, 0.0);
+  for (int probe = 0; probe < kProbes; ++probe) {
+    for (std::size_t k = 0; k < z.size(); ++k) z[k] = mask_[k] * ((rng() & 1U) != 0U ? 1.0 : -1.0);
+    op_.apply_transpose(z, t, prefix_);
+    for (std::size_t a = 0; a < t.size(); ++a) data_diag_[a] += t[a] * t[a] / kProbes;
+    nodes_to_cells_transpose(op_.grid(), t, tw);
+    for (std::size_t c = 0; c < cells_; ++c) cell_data_diag_[c] += tw[c] * tw[c] / kProbes;
+  }
 }
 
 void NormalSystem::set_lambda(double lambda) {
@@ -211,6 +234,23 @@ void NormalSystem::data_gradient(std::span<const double> r, std::span<double> ou
 }
 
 void NormalSystem::apply(std::span<const double> u, std::span<double> out) const {
+  if (gram_->formed()) {
+    const std::size_t nodes = op_.nodes();
+    cells_to_nodes(op_.grid(), u.first(cells_), std::span<double>(gram_in_).first(nodes));
+    gram_in_[nodes] = u[cells_];
+    gram_->apply(gram_in_, gram_out_);
+    nodes_to_cells_transpose(op_.grid(), std::span<const double>(gram_out_).first(nodes), out.first(cells_));
+    out[cells_] = gram_out_[nodes];
+  } else {
+    apply_through_operator(u, out);
+  }
+  if (lambda_scaled_ > 0.0) {
+    smoothing_apply(op_.grid(), u.first(cells_), cell_tmp_);
+    for (std::size_t c = 0; c < cells_; ++c) out[c] += lambda_scaled_ * cell_tmp_[c];
+  }
+}
+
+void NormalSystem::apply_through_operator(std::span<const double> u, std::span<double> out) const {
   predict(u, samples_);
   std::vector<double>& pred = samples_;
   for (std::size_t k = 0; k < pred.size(); ++k) pred[k] *= mask_[k];
@@ -219,17 +259,14 @@ void NormalSystem::apply(std::span<const double> u, std::span<double> out) const
   double sum = 0.0;
   for (double v : pred) sum += v;
   out[cells_] = sum;
-  if (lambda_scaled_ > 0.0) {
-    smoothing_apply(op_.grid(), u.first(cells_), cell_tmp_);
-    for (std::size_t c = 0; c < cells_; ++c) out[c] += lambda_scaled_ * cell_tmp_[c];
-  }
 }
 
 std::size_t NormalSystem::scratch_bytes() const noexcept {
   return (mask_.capacity() + samples_.capacity() + nodes_.capacity() + node_grad_.capacity() + cell_tmp_.capacity() + rhs_.capacity() + data_diag_.capacity() +
           smooth_diag_.capacity() + inv_diag_.capacity() + pre_nodes_.capacity() + cell_data_diag_.capacity() + cell_smooth_diag_.capacity() +
-          inv_cell_diag_.capacity() + prefix_.capacity()) *
-         sizeof(double);
+          inv_cell_diag_.capacity() + prefix_.capacity() + gram_in_.capacity() + gram_out_.capacity()) *
+             sizeof(double) +
+         (gram_->formed() ? gram_->bytes() : 0);
 }
 
 SolveStats solve_on_face(const NormalSystem& s, std::span<const double> b, std::vector<double>& u, std::span<const std::uint8_t> free, double tol,

@@ -7,9 +7,11 @@
 // P the cumulative map from masses to node values. Q u = Pᵀ Aᵀ M (A P w + offset) + λ' L w, where
 // M masks the training samples and L = DᵀD smooths neighbouring cells; λ' = λ tr(data)/tr(L).
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
+#include "fit_gram.hpp"
 #include "hystlab/models/preisach_operator.hpp"
 
 namespace hystlab::models::fit {
@@ -29,6 +31,9 @@ class NormalSystem {
  public:
   // mask[k] is 1 for a training sample, 0 for a held-out one. Not thread-safe (scratch buffers).
   NormalSystem(const PreisachOperator& op, std::span<const double> force, std::vector<double> mask);
+  // The same with G already formed for this mask (shared between systems: a fold's matrix serves
+  // both priors); null forms it here.
+  NormalSystem(const PreisachOperator& op, std::span<const double> force, std::vector<double> mask, std::shared_ptr<const NodeGram> gram);
 
   [[nodiscard]] std::size_t size() const noexcept { return cells_ + 1; }
   [[nodiscard]] std::size_t cells() const noexcept { return cells_; }
@@ -47,10 +52,16 @@ class NormalSystem {
   // 4,961 steps for a cross-validated monotone fit at n = 24 on 2·10^5 samples).
   void precondition(std::span<const double> r, std::span<double> z, bool on_face) const;
   [[nodiscard]] std::size_t scratch_bytes() const noexcept;
+  // Whether Q is applied through the node-space Gram matrix (fit_gram.hpp) or the operator.
+  [[nodiscard]] bool through_gram() const noexcept { return gram_->formed(); }
 
  private:
+  void estimate_diagonals();                                                            // data_diag_ and cell_data_diag_ from random probes, without G
+  void apply_through_operator(std::span<const double> u, std::span<double> out) const;  // Q u without λ L
+
   const PreisachOperator& op_;
   std::vector<double> mask_;
+  std::shared_ptr<const NodeGram> gram_;
   std::size_t cells_ = 0;
   std::vector<double> rhs_;
   std::vector<double> data_diag_;                                          // node space: estimated diagonal of the data term
@@ -60,7 +71,7 @@ class NormalSystem {
   double offset_diag_ = 1.0;
   double trace_ratio_ = 1.0;  // tr(data) / tr(L)
   double lambda_scaled_ = 0.0;
-  mutable std::vector<double> nodes_, samples_, node_grad_, cell_tmp_, pre_nodes_, prefix_;
+  mutable std::vector<double> nodes_, samples_, node_grad_, cell_tmp_, pre_nodes_, prefix_, gram_in_, gram_out_;
 };
 
 struct SolveStats {

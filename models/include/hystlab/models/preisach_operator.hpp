@@ -38,17 +38,23 @@ class PreisachOperator {
   // calling it every step allocates nothing.
   void apply_transpose(std::span<const double> u, std::span<double> g, std::vector<double>& prefix) const;
 
- private:
   struct HeldTerm {  // weight * F[node] is part of the output for samples start <= k < end
     std::uint32_t node;
     std::uint32_t start;
     std::uint32_t end;
     double weight;
   };
-  struct LiveStencil {  // the moving input's term at one sample
+  struct LiveStencil {  // the moving input's term at one sample (unused slots: weight 0)
     std::array<std::uint32_t, 4> node;
     std::array<double, 4> weight;
   };
+  // The terms themselves, for the node-space Gram matrix (fit_gram.hpp). A turning point's terms
+  // live from the sample that pushes it on the memory stack to the one that wipes it out, so their
+  // intervals are nested or disjoint, never crossing.
+  [[nodiscard]] std::span<const HeldTerm> held() const noexcept { return held_; }
+  [[nodiscard]] std::span<const LiveStencil> live() const noexcept { return live_; }
+
+ private:
   Grid grid_;
   std::vector<HeldTerm> held_;
   std::vector<LiveStencil> live_;
