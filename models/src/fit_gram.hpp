@@ -38,7 +38,7 @@ class NodeGram {
   NodeGram(const PreisachOperator& op, std::span<const double> mask, std::size_t max_nonzeros);
 
   [[nodiscard]] bool formed() const noexcept { return formed_; }
-  [[nodiscard]] std::size_t size() const noexcept { return static_cast<std::size_t>(g_.rows()); }  // nodes + 1
+  [[nodiscard]] std::size_t size() const noexcept { return static_cast<std::size_t>(g_.rows()); }          // nodes + 1
   [[nodiscard]] std::size_t nonzeros() const noexcept { return static_cast<std::size_t>(g_.nonZeros()); }  // lower triangle
   [[nodiscard]] std::size_t bytes() const noexcept { return nonzeros() * (sizeof(double) + sizeof(std::int32_t)) + (size() + 1) * sizeof(std::int32_t); }
   // out = G v; v and out have size() entries.
