@@ -13,6 +13,7 @@ using Args = std::vector<std::string>;
 int run_eval(const Args& args);
 int run_identify(const Args& args);
 int run_fit(const Args& args);
+int run_design(const Args& args);
 int run_calibrate(const Args& args);
 int run_invert(const Args& args);
 int run_check(const Args& args);

@@ -31,6 +31,7 @@ On files:
   eval       run a table or the simplified model on a displacement series
   identify   a table from a model (virtual FOT campaign) or from measured FOT nodes
   fit        a table from any displacement/force record (least squares, prior decided by held-out data)
+  design     where a next FOT campaign's rows should go on a specimen already identified
   calibrate  simplified-model parameters from one measured loop
   invert     displacements that produce requested forces (force control)
   check      wiping-out and congruency of a record, as numbers
@@ -75,6 +76,7 @@ int dispatch(const std::string& verb, const Args& args) {
   if (verb == "eval") return run_eval(args);
   if (verb == "identify") return run_identify(args);
   if (verb == "fit") return run_fit(args);
+  if (verb == "design") return run_design(args);
   if (verb == "calibrate") return run_calibrate(args);
   if (verb == "invert") return run_invert(args);
   if (verb == "check") return run_check(args);

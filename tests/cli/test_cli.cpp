@@ -69,7 +69,7 @@ const std::vector<double> kPath = ramp_through({0.0, 3.5, 1.0, 3.0, 1.5, 4.0, 0.
 
 TEST_CASE("cli: --help on every verb") {
   Workdir w;
-  for (const char* verb : {"eval", "identify", "fit", "calibrate", "invert", "check", "compare", "loops", "demo"}) {
+  for (const char* verb : {"eval", "identify", "fit", "design", "calibrate", "invert", "check", "compare", "loops", "demo"}) {
     CAPTURE(verb);
     const Result r = w.run(std::string(verb) + " --help");
     CHECK(r.code == 0);

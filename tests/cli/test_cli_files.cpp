@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_workdir.hpp"
 #include "hystlab/fmu/element_export.hpp"
 
@@ -66,6 +68,7 @@ TEST_CASE("cli: --help lists every verb, each sub-command and every export forma
   const std::pair<const char*, std::vector<const char*>> verbs[] = {{"eval", {}},
                                                                     {"identify", {}},
                                                                     {"fit", {}},
+                                                                    {"design", {}},
                                                                     {"calibrate", {}},
                                                                     {"invert", {}},
                                                                     {"check", {}},
@@ -134,4 +137,29 @@ TEST_CASE("cli: a table, parameter or plan file that is not JSON: one error nami
   check_error(w.run("eval --table obj.json --input X.csv"), "table file 'obj.json': missing field 'format'");
   check_error(w.run("eval --model simplified --params obj.json --input X.csv"), "parameter file 'obj.json': missing field 'KA_N_per_mm'");
   check_error(w.run("eval --table missing.json --input X.csv"), "cannot open 'missing.json'");
+}
+
+TEST_CASE("cli: design suggests a next campaign's rows on an identified table, within its budget, and names a bad option") {
+  Workdir w;
+  REQUIRE(w.run("identify --model simplified --range 0,4 --subdivisions 12 -o T.json").code == 0);
+  const Result r = w.run("design --table T.json --budget-s 120 -o D.json");
+  CAPTURE(r.err);
+  CAPTURE(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("row 1: up to ") != std::string::npos);
+  CHECK(r.out.find("stopped: ") != std::string::npos);
+  const auto d = nlohmann::json::parse(hystlab::test::slurp(w / "D.json"));
+  REQUIRE(!d["rows"].empty());
+  CHECK(d["seconds"].get<double>() <= 120);
+  CHECK(d["nodes"].size() == 13 + d["rows"].size());
+  double before = d["rms_before_N"];
+  for (const auto& row : d["rows"]) {  // each row lowers the estimated error, each inside the range
+    CHECK(row["rms_after_N"].get<double>() < before);
+    CHECK(row["alpha_mm"].get<double>() > 0);
+    CHECK(row["alpha_mm"].get<double>() < 4);
+    before = row["rms_after_N"];
+  }
+  check_error(w.run("design --table T.json --budget-s 1"), "option --budget-s");
+  check_error(w.run("design --table T.json"), "--budget-s");
+  check_error(w.run("design --table T.json --budget-s 100 --target-rms-n -2"), "option --target-rms-n");
 }

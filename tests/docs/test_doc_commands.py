@@ -141,6 +141,9 @@ CHECKS = {
     "build/daemon/hystlab compare --table T12.json --data measured.csv": lambda rc, out, cwd: assert_(
         rc == 0 and re.search(r"^overall +253 +(\d+\.\d+)", out, re.M) and float(re.search(r"^overall +253 +(\d+\.\d+)", out, re.M)[1]) < 5,
         "the table against the model it was identified from, within 5 N RMS: " + out[:400]),
+    "build/daemon/hystlab design --table T12.json --budget-s 300": lambda rc, out, cwd: assert_(
+        rc == 0 and "row 1: up to " in out and re.search(r"^\d+ rows, [\d.e+]+ s of rig time; stopped: ", out, re.M),
+        "rows within the budget and why it stopped: " + out[:400]),
     # README's simulated frame polled with any Modbus client.
     "build/drivers/sim/hystlab-sim --port 1502 --time-scale 1 &": lambda rc, out, cwd: assert_(rc == 0, "exit status %d" % rc),
     "mbpoll -m tcp -0 -1 -t 3 -r 0 -c 12 -p 1502 127.0.0.1": lambda rc, out, cwd: assert_(rc == 0 and "[11]:" in out, "twelve registers: " + out[:300]),
