@@ -151,7 +151,6 @@ NodeGram::NodeGram(const PreisachOperator& op, std::span<const double> mask, std
   acc.flush();
   formed_ = !acc.over();
   g_ = acc.take();
-  if (!formed_) g_ = Sparse(static_cast<Eigen::Index>(op.nodes() + 1), static_cast<Eigen::Index>(op.nodes() + 1));
   g_.makeCompressed();
 }
 

@@ -4,15 +4,16 @@
 //
 // Why: a conjugate-gradient step through the operator costs two passes over every sample
 // (A v, then Aᵀ r); through G it costs one pass over G's non-zeros, and G is small where the
-// grid is: a node pairs only with the nodes it shares a sample's memory with. Measured on the
-// issue's random walk (bench_fit, 10^5 samples): see the benchmark's header for the figures.
-// Where G would hold more non-zeros than a step through the operator touches (fine grids on short
-// records), it is not formed and the operator is used, so memory stays O(samples + cells).
+// grid is: a node pairs only with the nodes it shares a sample's memory with. Measured on
+// bench_fit's random walk at 10^5 samples (stop 42): a product with G 0.019 ms at n = 24 and
+// 0.098 ms at n = 48 against 0.74 and 0.70 ms through the operator; the whole `auto` fit 8.35 ->
+// 0.30 s and 24.7 -> 2.4 s (docs/MODELS_IMPLEMENTATION.md has the rest). Where G would hold more
+// non-zeros than a step through the operator touches (fine grids on records rich in turning
+// points), it is not formed and the operator is used, so memory stays O(samples + cells).
 //
 // Only the lower triangle is stored (an entry below the diagonal serves its row and its column in
 // one read: the product is bound by memory traffic). The force offset is node `nodes()` (a column
-// of ones). Sample k's row of A is the held terms alive
-// at k plus its live stencil, so G = Σ_k M_k rowₖᵀ rowₖ splits into
+// of ones). Sample k's row of A is the held terms alive at k plus its live stencil, so G = Σ_k M_k rowₖᵀ rowₖ splits into
 //  - held × held: two terms alive at once have nested intervals (the memory is a stack), so the pair
 //    counts the inner one's training samples: one sweep over the terms sorted by start;
 //  - held × live and live × live: over runs of samples with the same stencil nodes and the same
