@@ -169,6 +169,12 @@ int print_preview(const nlohmann::json& p) {
   if (const double scale = p.value("time_scale", 1.0); scale > 1)  // a simulator faster than real time
     std::cout << "\n  the simulator runs " << round_g(scale) << "x faster than real time: " << round_g(p.value("wall_s", 0.0)) << " s of wall time, "
               << p.value("stored_samples", std::int64_t{0}) << " samples stored (" << round_g(p.value("stored_rate_hz", 0.0)) << " Hz of rig time)";
+  if (p.contains("design") && p["design"].is_object()) {
+    const nlohmann::json& d = p["design"];
+    std::cout << "\n  adaptive design: its rows take at most " << round_g(d.value("budget_s", 0.0)) << " s (the " << d.value("coarse_subdivisions", 0)
+              << " coarse rows first, tops on " << d.value("finest_subdivisions", 0) << " subdivisions)";
+    if (d.value("target_rms_N", 0.0) > 0) std::cout << ", until an estimated held-out RMS of " << round_g(d.value("target_rms_N", 0.0)) << " N";
+  }
   std::cout << "\n  peak speed " << round_g(p.value("peak_speed_mm_s", 0.0)) << " mm/s";
   if (p.contains("peak_force_N") && p["peak_force_N"].is_number())
     std::cout << ", peak force " << round_g(p["peak_force_N"].get<double>()) << " N (limit " << round_g(p.value("force_limit_N", 0.0)) << " N; from "

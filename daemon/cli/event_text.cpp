@@ -102,6 +102,13 @@ std::string say(const domain::RetakeEvent& d) {
   return "row(s) " + rows + " again (round " + (d.round ? n(*d.round) : "?") + "): " + d.why;
 }
 
+std::string say(const domain::DesignEvent& d) {
+  const std::string state = n(d.rows) + " rows, estimated held-out RMS " + n(d.estimated_rms_N) + " N (noise " + n(d.noise_N) + " N), " + n(d.spent_s) +
+                            " of " + n(d.budget_s) + " s";
+  if (!d.stopped.empty()) return state + ": design stops (" + d.stopped + ")";
+  return state + ": next row to " + n(d.alpha_mm) + " mm (" + n(d.next_s) + " s), " + d.why;
+}
+
 // How the step was reached from the one before (sine_step's change).
 std::string reached(const domain::SineStepEvent& d) {
   if (d.change == "glide") return ", glided to over " + n(d.glide_cycles) + " frequencies";

@@ -37,6 +37,12 @@ PlanPreview preview_plan(const domain::Plan& plan, models::HysteresisModel* mode
       }
       x = s.target_mm;
     }
+    if (plan.design.adaptive) {  // the coarse rows' ramps are the start of a budget the design may spend whole
+      for (const Segment& s : segs)
+        if (s.kind == SegmentKind::rise) v.duration_s -= domain::row_seconds(plan, s.target_mm - plan.lo_mm) - domain::kRowSettle_s;
+      v.duration_s += plan.design.budget_s;
+      v.design_budget_s = plan.design.budget_s;
+    }
     if (plan.kind == domain::CampaignKind::fot)
       v.nodes = static_cast<std::size_t>(plan.subdivisions) * static_cast<std::size_t>(plan.subdivisions + 1) / 2 *
                 static_cast<std::size_t>(std::max(plan.repeats, 1));

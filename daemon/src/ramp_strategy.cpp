@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "acquisition_loop.hpp"
+#include "adaptive_rows.hpp"
 #include "hystlab/daemon/online_fot.hpp"
 #include "hystlab/daemon/sequencer.hpp"
 #include "hystlab/daemon/shakedown.hpp"
@@ -29,7 +30,8 @@ class RampStrategy final : public Strategy {
     rows_begin_ = series_.size();
     halvings_seen_ = series_.halvings();
     if (plan_.kind != domain::CampaignKind::fot) return;
-    const models::Grid g = domain::fot_grid(plan_);
+    const models::Grid g = domain::node_grid(plan_);
+    if (plan_.design.adaptive) adaptive_.emplace(plan_);
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
     for (const models::FotNode& n : L.job.prior_nodes) (void)builder_->add(n);
     if (!L.job.prior_nodes.empty()) resume_rows_only(L);
@@ -47,7 +49,10 @@ class RampStrategy final : public Strategy {
   // validation run (or while finishing) resumes with every node measured, and its tables are scored
   // on a validation run of its own, driven whole now (the interrupted one's samples end where the
   // daemon stopped: a held-out score on part of the input would say less than it seems to).
-  [[nodiscard]] bool has_work() const override { return !(builder_ && builder_->complete()) || (builder_ && plan_.validation.enabled && validation_to_rerun_); }
+  // An adaptive campaign resumed always has work: its design decides at the first row's end.
+  [[nodiscard]] bool has_work() const override {
+    return adaptive_ || !(builder_ && builder_->complete()) || (builder_ && plan_.validation.enabled && validation_to_rerun_);
+  }
 
   [[nodiscard]] CampaignPhase phase() const override {
     const Segment* cur = seq_.current();
@@ -82,8 +87,9 @@ class RampStrategy final : public Strategy {
     if (fot_ && !validating_) {
       fot_->set_spacing(L.spacing);
       fot_->feed(s.time_s, s.displacement_mm, s.force_N, collecting());
-      if (fot_->take_descent_completed()) post_evaluation(L.ctx, L.job.id, *builder_, series_, L.ctx.now_iso());
+      if (fot_->take_descent_completed()) evaluate(L);
       if (seq_.done() && !validating_) retake_rows(L);
+      if (seq_.done() && !validating_) next_design_row(L, s);
     }
     return true;
   }
@@ -113,10 +119,10 @@ class RampStrategy final : public Strategy {
     if (shakedown_.cycles() > 0) fj.training_summary = shakedown_.summary();
     if (fot_) {
       fot_->finish();  // the last descent ends here: evaluate it like the others
-      if (fot_->take_descent_completed()) post_evaluation(L.ctx, L.job.id, *builder_, series_, L.ctx.now_iso());
+      if (fot_->take_descent_completed()) evaluate(L);
     }
     fj.series = std::move(series_);
-    if (builder_) fj.builder = std::move(builder_);
+    if (builder_) fj.builder = adaptive_ ? table_builder() : std::move(builder_);
   }
 
  private:
@@ -154,6 +160,7 @@ class RampStrategy final : public Strategy {
       if (builder_) retake_rows(L);
       if (seq_.index() != at || seq_.current() != cur || seq_.current()->kind != SegmentKind::validation)
         return seq_.step(s.time_s, s.displacement_mm);  // a retake was inserted before the validation
+      if (next_design_row(L, s)) return seq_.step(s.time_s, s.displacement_mm);
       start_validation(L, s);
     }
     return cmd;
@@ -188,7 +195,7 @@ class RampStrategy final : public Strategy {
       fot_->set_spacing(L.spacing);
       fot_->feed(s.time_s, s.displacement_mm, s.force_N, false);
       fot_->finish();
-      if (fot_->take_descent_completed()) post_evaluation(L.ctx, L.job.id, *builder_, series_, L.ctx.now_iso());
+      if (fot_->take_descent_completed()) evaluate(L);
     }
     validating_ = true;
     campaign_run_ = L.result.run_id;
@@ -229,7 +236,10 @@ class RampStrategy final : public Strategy {
     if (builder_->complete() || rounds_ >= kMaxRowRetakeRounds) return;
     std::vector<Segment> again;
     nlohmann::json rows = nlohmann::json::array();
-    for (const Segment& seg : schedule(plan_)) {
+    std::vector<Segment> all = schedule(plan_);
+    if (adaptive_)
+      for (int r : adaptive_->chosen()) all.push_back({builder_->grid().node(r), plan_.ramp_rate_mm_s, plan_.dwell_s, SegmentKind::rise, r});
+    for (const Segment& seg : all) {
       if (seg.kind != SegmentKind::rise || row_complete(seg.row) || std::find(rows.begin(), rows.end(), seg.row) != rows.end()) continue;
       rows.push_back(seg.row);
       again.push_back(seg);
@@ -242,6 +252,32 @@ class RampStrategy final : public Strategy {
     ev.rows.emplace(rows.begin(), rows.end()), ev.round = rounds_, ev.why = "a node of each was missing (a hole in the data)";
     L.event(ev);
   }
+
+  // An adaptive campaign's rows are queued: the design's next row, inserted before the validation
+  // (or at the end) once every row queued so far is measured. True when one was inserted.
+  bool next_design_row(Loop& L, const drivers::RigSample& s) {
+    if (!adaptive_ || adaptive_->over()) return false;
+    fot_->set_spacing(L.spacing);
+    fot_->feed(s.time_s, s.displacement_mm, s.force_N, false);
+    fot_->finish();  // the last descent's bottom (node (i, 0)) is the frame at δmin now
+    if (fot_->take_descent_completed()) evaluate(L);
+    domain::DesignEvent ev;
+    std::optional<std::vector<Segment>> row = adaptive_->next(*builder_, series_, rows_begin_, ev);
+    ev.rig_s = s.time_s - L.mark.t0;
+    L.event(ev);
+    if (!row) return false;
+    seq_.insert_before_current(*row);
+    return true;
+  }
+
+  // An adaptive campaign's table: the rows it measured, on their own grid (format v2); the fine
+  // builder itself while the top row is not measured (its table then fails as incomplete).
+  std::shared_ptr<models::OnlineTableBuilder> table_builder() const {
+    if (std::optional<models::OnlineTableBuilder> b = models::rows_builder(*builder_)) return std::make_shared<models::OnlineTableBuilder>(std::move(*b));
+    return builder_;
+  }
+
+  void evaluate(Loop& L) { post_evaluation(L.ctx, L.job.id, adaptive_ ? *table_builder() : *builder_, series_, L.ctx.now_iso()); }
 
   [[nodiscard]] bool row_complete(int row) const {
     for (int j = 0; j < row; ++j)  // the last descent's bottom comes when the next rise (or the end) turns it
@@ -259,6 +295,7 @@ class RampStrategy final : public Strategy {
   domain::SupervisionSettings settings_;
   std::shared_ptr<models::OnlineTableBuilder> builder_;
   std::unique_ptr<OnlineFot> fot_;
+  std::optional<AdaptiveRows> adaptive_;
   RunSeries series_, validation_;
   Columns cycle_;  // the training cycle being judged
   double time_scale_ = 1.0;

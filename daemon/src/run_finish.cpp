@@ -114,16 +114,19 @@ std::vector<db::Store::TableRecord> fot_tables(FinishJob& j, const Record& rec, 
   const domain::Plan& plan = j.plan;
   const models::DriftReport drift = models::drift_report(*j.builder);
   const std::string source = "campaign " + std::to_string(j.campaign), run = "run " + std::to_string(j.result.run_id);
-  const std::string fot_label = "fot n=" + std::to_string(plan.subdivisions);
+  // The table's own grid: the plan's, or the rows an adaptive design measured.
+  const models::Grid& grid = j.builder->grid();
+  const std::string fot_label = std::string(plan.design.adaptive ? "fot adaptive" : "fot") + " n=" + std::to_string(grid.n);
   std::vector<Candidate> cs;
-  cs.push_back(candidate(j, rec, fot_label, "fot", plan.subdivisions, j.builder->table(),
+  cs.push_back(candidate(j, rec, fot_label, "fot", grid.n, j.builder->table(),
                          {source, "fot", now, run, {{"drift_max_spread_N", drift.max_spread}, {"drift_pooled_std_N", drift.pooled_std}}}));
-  // At most n = 24, as before: the campaign's end (and a shutdown) waits for it, the fit cannot
-  // be cancelled yet, and its cross-validation costs O(samples) per solver step (bench_fit: n = 48
-  // on 10^5 samples 30 s).
-  // A grid of its own is fitted on its own nodes (up to n = 24; beyond, 24 uniform steps).
-  const int n = std::min(plan.subdivisions, 24);
-  const models::Grid lsq_grid = n == plan.subdivisions ? domain::fot_grid(plan) : models::Grid::make(plan.lo_mm, plan.hi_mm, n);
+  // At most n = 24 on a plan's grid, as before: the campaign's end (and a shutdown) waits for it
+  // and the fit cannot be cancelled yet. A grid of its own is fitted on its own nodes (beyond
+  // n = 24, 24 uniform steps). An adaptive design's grid is its point: fitted as it is up to
+  // n = 48 (bench_fit, stop 42: 2.4 s on 10^5 samples).
+  const int cap = plan.design.adaptive ? 48 : 24;
+  const int n = std::min(grid.n, cap);
+  const models::Grid lsq_grid = n == grid.n ? grid : models::Grid::make(plan.lo_mm, plan.hi_mm, n);
   try {
     const models::PreisachFitResult fit = models::fit_preisach(rec.series.x, rec.series.f, lsq_grid);
     cs.push_back(candidate(j, rec, "lsq " + std::string(models::to_string(fit.chosen.prior)) + " n=" + std::to_string(n), "lsq", n, fit.chosen.table,

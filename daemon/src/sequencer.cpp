@@ -14,11 +14,14 @@ std::vector<Segment> fot_schedule(const domain::Plan& p) {
     s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::training, 0});
   }
   const models::Grid g = domain::fot_grid(p);
+  // A row is numbered by its top's node on the grid its nodes are measured on (an adaptive
+  // design's finest grid: the coarse grid's node i is node i·stride there).
+  const int stride = p.design.adaptive ? p.design.finest_subdivisions / p.subdivisions : 1;
   for (int r = 0; r < p.repeats; ++r)
     for (int i = 1; i <= p.subdivisions; ++i) {
       const double top = g.node(i);
-      s.push_back({top, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::rise, i});
-      s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::descent, i});
+      s.push_back({top, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::rise, i * stride});
+      s.push_back({p.lo_mm, p.ramp_rate_mm_s, p.dwell_s, SegmentKind::descent, i * stride});
     }
   if (p.validation.enabled)
     for (const double x : validation_points(p.validation)) s.push_back({x, p.validation.rate_mm_s, 0.0, SegmentKind::validation, 0});

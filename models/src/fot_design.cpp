@@ -62,10 +62,11 @@ Band band_of(const EverettTable& t, std::span<const double> sigma, int k) {
   return b;
 }
 
-double rms(const std::vector<Band>& bands, double range) {
+// The estimated RMS error over the range: every band's, plus the noise no row removes.
+double rms(const std::vector<Band>& bands, double range, double noise) {
   double s = 0.0;
   for (const Band& b : bands) s += b.h * b.mse();
-  return std::sqrt(s / range);
+  return std::sqrt(s / range + noise * noise);
 }
 
 std::string why(const Band& b) {
@@ -84,6 +85,7 @@ void validate(const EverettTable& t, std::span<const double> sigma, const Design
   if (!(o.settle_s >= 0.0) || !std::isfinite(o.settle_s)) throw std::invalid_argument("design: settle_s must be 0 or more seconds");
   if (!(o.target_rms_N >= 0.0) || !std::isfinite(o.target_rms_N)) throw std::invalid_argument("design: target_rms_N must be 0 (none) or more newtons");
   if (!(o.min_gain >= 0.0 && o.min_gain < 1.0)) throw std::invalid_argument("design: min_gain must be from 0 to below 1 (a share of the error left)");
+  if (!(o.noise_N >= 0.0) || !std::isfinite(o.noise_N)) throw std::invalid_argument("design: noise_N must be 0 or more newtons");
   if (o.max_rows < 1) throw std::invalid_argument("design: max_rows must be at least 1");
   if (!sigma.empty() && sigma.size() != t.grid().cell_count())
     throw std::invalid_argument("design: the table's σ has " + std::to_string(sigma.size()) + " cells, its grid " + std::to_string(t.grid().cell_count()));
@@ -110,7 +112,7 @@ Design design_rows(const EverettTable& table, std::span<const double> cell_sigma
   for (double v : table.values()) scale = std::max(scale, std::fabs(v));
   const double negligible = 1e-9 * scale;
   Design d;
-  d.rms_before_N = rms(bands, range);
+  d.rms_before_N = rms(bands, range, o.noise_N);
   double left = d.rms_before_N;
   d.stopped = "max_rows: " + std::to_string(o.max_rows) + " rows chosen";
   while (static_cast<int>(d.rows.size()) < o.max_rows) {
@@ -118,8 +120,8 @@ Design design_rows(const EverettTable& table, std::span<const double> cell_sigma
       d.stopped = "target: the estimated RMS error is at or below target_rms_N";
       break;
     }
-    if (left <= negligible) {
-      d.stopped = "gain: the table's estimated error is already negligible";
+    if (left <= o.noise_N + negligible) {
+      d.stopped = "gain: the table's own estimated error is negligible (what is left is the noise)";
       break;
     }
     // The most squared error removed per second among the rows the budget still allows and that
@@ -146,7 +148,7 @@ Design design_rows(const EverettTable& table, std::span<const double> cell_sigma
     bands.erase(bands.begin() + (best - bands.data()));
     bands.push_back(b.half(b.lo));
     bands.push_back(b.half(b.lo + b.h / 2));
-    left = rms(bands, range);
+    left = rms(bands, range, o.noise_N);
     row.rms_after_N = left;
     d.seconds += row.seconds;
     d.rows.push_back(std::move(row));

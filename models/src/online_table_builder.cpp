@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 namespace hystlab::models {
@@ -53,6 +54,26 @@ std::error_code OnlineTableBuilder::add(const FotNode& node) noexcept {
   sum_[k] += node.everett();
   ++count_[k];
   return {};
+}
+
+OnlineTableBuilder OnlineTableBuilder::restricted(const std::vector<int>& nodes) const {
+  if (nodes.size() < 2 || nodes.front() != 0 || nodes.back() != grid_.n) throw std::invalid_argument("restricted: the nodes must run from 0 to the grid's n");
+  std::vector<double> at;
+  for (std::size_t a = 0; a < nodes.size(); ++a) {
+    if (a > 0 && !(nodes[a] > nodes[a - 1])) throw std::invalid_argument("restricted: the nodes must increase");
+    at.push_back(grid_.node(nodes[a]));
+  }
+  OnlineTableBuilder out(Grid::from_nodes(at), tolerance_);
+  out.force_offset_ = force_offset_;
+  for (std::size_t a = 0; a < nodes.size(); ++a) {
+    out.f_alpha_[a] = f_alpha_[static_cast<std::size_t>(nodes[a])];
+    for (std::size_t b = 0; b < a; ++b) {
+      const std::size_t from = Grid::index(nodes[a], nodes[b]), to = Grid::index(static_cast<int>(a), static_cast<int>(b));
+      out.sum_[to] = sum_[from];
+      out.count_[to] = count_[from];
+    }
+  }
+  return out;
 }
 
 bool OnlineTableBuilder::identified(int i, int j) const noexcept { return i == j || count_[Grid::index(i, j)] > 0; }

@@ -6,7 +6,8 @@
 // lsq table's prior as a field, the report's link, the address of the campaign and of its
 // validation run (a reload opens them), the specimen and notes changed under the plots (and
 // refused in the server's words), a limit beyond the rig's said in the preview, an error in a
-// pasted plan marked on the text box. Screenshots at 800x700, 1280x800 and 2560x1440 in OUT_DIR.
+// pasted plan marked on the text box; then an adaptive campaign's design panel. Screenshots at
+// 800x700, 1280x800 and 2560x1440 in OUT_DIR.
 // usage: node work_test.mjs HYSTLABD OUT_DIR
 import fs from 'node:fs';
 import path from 'node:path';
@@ -154,6 +155,30 @@ try {
   await page.click('#record button:text("Cancel")');
 
   await fetch(`${base}/api/campaigns/${other.id}/abort`, { method: 'POST', signal: AbortSignal.timeout(10000) });
+
+  // An adaptive campaign (issue 41): the preview gives its budget; as it runs, the design panel
+  // shows the estimated error against rig time and each row chosen with why, the heatmap the rows'
+  // own (non-uniform) grid.
+  const adaptive = { kind: 'fot', range_mm: [0, 4], subdivisions: 2, ramp_rate_mm_s: 1, specimen: 'NiTi spring S-08',
+    design: { kind: 'adaptive', budget_s: 60, finest_subdivisions: 16 } };
+  const preview = await (await postJSON('/api/plans/preview', { plan: adaptive })).json();
+  check(preview.design && preview.design.budget_s === 60 && preview.design.coarse_subdivisions === 2, `the preview gives the design's budget (${JSON.stringify(preview.design)})`);
+  const ad = await (await postJSON('/api/campaigns', { plan: adaptive })).json();
+  await page.goto(`${base}/#campaign/${ad.id}`);
+  check(await wait(c => window.hystlab.selected() === c && window.hystlab.state() === 'completed', ad.id, 120000), 'the adaptive campaign completes');
+  check(await wait(() => window.hystlab.designRows() >= 3 && window.hystlab.designPoints() >= 3, null, 20000),
+        `the design panel lists the rows chosen (${await page.evaluate(() => window.hystlab.designRows())}) and the error against rig time (${await page.evaluate(() => window.hystlab.designPoints())} points)`);
+  const adNodes = await getJSON(`/api/campaigns/${ad.id}/nodes`);
+  check(adNodes.grid.n > 2 && adNodes.identified === adNodes.required && adNodes.nodes.length === adNodes.required,
+        `the heatmap's grid is the rows measured (n = ${adNodes.grid.n}: ${adNodes.grid.nodes_mm.join(', ')}), every node of it shown`);
+  check(/^Adaptive design: \d+ rows, estimated held-out RMS/.test(await page.textContent('#design-caption')), `the design's caption ("${await page.textContent('#design-caption')}")`);
+  await shoot('adaptive', 1280, 800);
+  await page.evaluate(() => document.getElementById('design-fig').scrollIntoView());
+  await page.screenshot({ path: path.join(outDir, 'adaptive-design-1280x800.png') });
+  await page.setViewportSize({ width: 800, height: 700 });
+  await page.waitForTimeout(400);
+  await page.evaluate(() => document.getElementById('design-fig').scrollIntoView());
+  await page.screenshot({ path: path.join(outDir, 'adaptive-design-800x700.png') });
   check(pageErrors.length === 0, `no errors in the page (${pageErrors.join('; ')})`);
 } catch (e) {
   check(false, `the test ran to its end (${e.stack})`);

@@ -39,6 +39,7 @@ json base_plan(const PlanField& f) {
   if (f.path == "amplitude_mm") p.erase("amplitudes_mm");
   if (f.path == "settle_cycles") p.erase("settle");
   if (f.path.starts_with("validation.")) p["validation"] = json::object();
+  if (f.path.starts_with("design.")) p["design"] = {{"kind", "adaptive"}, {"budget_s", 1000}};
   return p;
 }
 

@@ -3,6 +3,7 @@
 
 #include "hystlab/db/campaign_record.hpp"
 #include "hystlab/domain/plan.hpp"
+#include "hystlab/models/adaptive_fot.hpp"
 #include "hystlab/models/online_table_builder.hpp"
 #include "request_guard.hpp"
 #include "routes.hpp"
@@ -68,9 +69,23 @@ json nodes_json(db::ReadSource& store, const db::CampaignRow& row) {
   if (row.kind != domain::CampaignKind::fot) return out;
   // The stored plan through the one parser; the coverage counted by the table builder the daemon
   // fits with (a resumed campaign's node measured twice counts once), at the daemon's snapping.
-  const models::Grid g = domain::fot_grid(domain::parse_plan(json::parse(row.plan)));
-  models::OnlineTableBuilder builder(g, 0.25 * g.step());
+  const domain::Plan plan = domain::parse_plan(json::parse(row.plan));
+  const models::Grid fine = domain::node_grid(plan);
+  models::OnlineTableBuilder builder(fine, 0.25 * fine.step());
   for (const db::NodeInfo& n : measured) (void)builder.add({n.alpha, n.beta, n.force_alpha, n.force_alpha_beta});
+  if (plan.design.adaptive) {  // the table is the rows measured whole (their own grid); the design's newest step
+    if (std::optional<models::OnlineTableBuilder> rows = models::rows_builder(builder)) builder = std::move(*rows);
+    json steps = json::array();
+    for (const domain::DesignEvent& e : db::events_of<domain::DesignEvent>(store, row.id)) steps.push_back(domain::detail_json(e));
+    out["design"] = {{"finest_subdivisions", fine.n}, {"budget_s", plan.design.budget_s}, {"target_rms_N", plan.design.target_rms_N}, {"steps", steps}};
+    // The nodes of its table only: those between its rows wait for a row there.
+    const models::Grid& g = builder.grid();
+    json on_grid = json::array();
+    for (const db::NodeInfo& n : measured)
+      if (g.node_near(n.alpha, 1e-6 * (g.hi - g.lo)) >= 0 && g.node_near(n.beta, 1e-6 * (g.hi - g.lo)) >= 0) on_grid.push_back(node_json(n));
+    out["nodes"] = std::move(on_grid);
+  }
+  const models::Grid& g = builder.grid();
   out["grid"] = {{"n", g.n}, {"lo_mm", g.lo}, {"hi_mm", g.hi}, {"nodes_mm", g.nodes()}};
   out["identified"] = builder.identified_nodes();
   out["required"] = builder.required_nodes();
@@ -139,6 +154,7 @@ json campaign_json(db::ReadSource& store, const db::CampaignRow& row, bool detai
   if (row.kind == domain::CampaignKind::fot) {
     const json nodes = nodes_json(store, row);
     j["progress"] = {{"nodes", nodes["identified"]}, {"required", nodes["required"]}};
+    if (nodes.contains("design")) j["design"] = nodes["design"];  // an adaptive campaign's steps: the page's design panel
   }
   return j;
 }

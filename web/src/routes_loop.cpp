@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 
+#include "hystlab/domain/plan.hpp"
 #include "hystlab/domain/plan_fields.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/preisach_model.hpp"
@@ -122,6 +123,15 @@ json preview_json(ApiContext& c, const PlanRequest& req) {
            {"stored_samples", std::llround(v.samples / v.time_scale)},
            {"stored_rate_hz", v.sample_rate_hz / v.time_scale},
            {"limits_applied", v.limits_applied}};
+  if (v.design_budget_s > 0) {  // the plan parsed once more for its design's defaults (preview checked it)
+    const domain::Plan p = domain::parse_plan(req.plan);
+    out["design"] = {{"kind", "adaptive"},
+                     {"budget_s", v.design_budget_s},
+                     {"coarse_subdivisions", p.subdivisions},
+                     {"finest_subdivisions", p.design.finest_subdivisions},
+                     {"target_rms_N", p.design.target_rms_N},
+                     {"min_gain", p.design.min_gain}};
+  }
   if (model)
     out["peak_force_N"] = v.peak_force_N, out["force_source"] = source, out["force_limit_N"] = v.force_limit_N;
   else

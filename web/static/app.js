@@ -11,6 +11,7 @@ import { RigPanel } from './rigs.js';
 import { PlanForm } from './form.js';
 import { showQuality } from './quality.js';
 import { tableLines, ShakedownPlot, shakedownCaption, loopRows } from './identification.js';
+import { DesignPanel } from './design.js';
 import { count, num, round2, roughly, localTime, el, plural } from './fmt.js';
 
 const $ = id => document.getElementById(id);
@@ -33,6 +34,7 @@ const sweep = new SweepView({ trans: $('trans-plot'), time: $('shaker-time-plot'
 $('time-mode').addEventListener('change', e => { sweep.time.setMode(e.target.value); sweep.time.redraw(); });
 const isSine = () => !!S.detail && S.detail.kind === 'sine';
 const shakedown = new ShakedownPlot($('shakedown-plot'));
+const design = new DesignPanel($('design-fig'), $('design-caption'), $('design-plot'), $('design-rows'));
 const rigPanel = ARCHIVE ? null : new RigPanel($('rigs'), { onChange: rigs => planForm.setRigs(rigs) });
 // In the chain with the stream's handlers: a select() running beside them would reset what
 // they just added (a sweep's first transmissibility point, say).
@@ -54,7 +56,7 @@ window.hystlab = {
   backbone: () => sweep.backbone.shown(),
   timeAxes: () => (isSine() ? sweep.time.axes() : timeplot.axes()),
   rigs: () => (rigPanel ? rigPanel.rigs() : []), archive: () => ARCHIVE, warnings: () => S.warnings.slice(),
-  shakedownPoints: () => shakedown.points(), shakedownTicks: () => shakedown.ticks(), loopRows: () => $('loops').querySelectorAll('tbody tr').length,
+  shakedownPoints: () => shakedown.points(), designPoints: () => design.points(), designRows: () => design.rows(), shakedownTicks: () => shakedown.ticks(), loopRows: () => $('loops').querySelectorAll('tbody tr').length,
   heldOut: () => [...document.querySelectorAll('#accuracy .heldout')].map(e => e.textContent),
   recommended: () => { const r = document.querySelector('#accuracy .recommended'); return r ? Number(r.dataset.table) : null; },
 };
@@ -137,6 +139,7 @@ async function refreshDetail() {
   const cycles = d.shakedown || [];
   $('shakedown-fig').hidden = !cycles.length;
   if (cycles.length) { shakedown.set(cycles); $('shakedown-caption').textContent = shakedownCaption(d); }
+  design.show(d.design);
   const shaker = d.kind === 'sine';
   for (const e of document.querySelectorAll('.sine-only')) e.hidden = !shaker;
   $('time-fig').hidden = shaker;  // a shaker's signals have a plot of their own (one displacement axis)
@@ -371,7 +374,7 @@ function connect() {
   on('campaign', serial(onCampaign));
   on('node', onNode);
   on('table', serial(onTable));
-  for (const k of ['fit', 'transmissibility', 'command', 'shakedown', 'training', 'validation', ...SINE_EVENTS]) on(k, serial(r => onRecord(k, r)));
+  for (const k of ['fit', 'transmissibility', 'command', 'shakedown', 'training', 'validation', 'design', ...SINE_EVENTS]) on(k, serial(r => onRecord(k, r)));
   es.onerror = () => {
     if (S.es !== es) return;  // replaced (a new rate): not an outage
     setOnline(false);

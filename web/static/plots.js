@@ -249,11 +249,13 @@ export class TriangleHeatmap {
     const g = this.grid;
     return Array.isArray(g.nodes_mm) && g.nodes_mm.length === g.n + 1 ? g.nodes_mm[i] : g.lo_mm + (g.hi_mm - g.lo_mm) * i / g.n;
   }
-  // A measured node: its (α, β) snapped to the grid.
+  // A measured node on the grid (an adaptive campaign measures between its rows too: those wait
+  // for a row there, when the grid is set again).
   add(alpha, beta, F) {
     if (!this.grid) return;
-    const i = this.nearest(alpha), j = this.nearest(beta);
+    const i = this.nearest(alpha), j = this.nearest(beta), tol = 1e-6 * (this.grid.hi_mm - this.grid.lo_mm);
     if (i < 1 || i > this.grid.n || j < 0 || j >= i) return;
+    if (Math.abs(this.node(i) - alpha) > tol || Math.abs(this.node(j) - beta) > tol) return;
     this.values.set(`${i},${j}`, F);
     this.extend(F);
   }

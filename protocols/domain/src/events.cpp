@@ -108,6 +108,7 @@ HYSTLAB_EVENT(ShakedownEvent, "shakedown", cycle, peak_force_N, energy_Nmm, cons
 HYSTLAB_EVENT(TrainingEvent, "training", cycles, stable, until, why)
 HYSTLAB_EVENT(ValidationEvent, "validation", run, reversals, seed, points_mm, why)
 HYSTLAB_EVENT(RetakeEvent, "retake", rows, round, frequency_hz, attempt, why)
+HYSTLAB_EVENT(DesignEvent, "design", rows, alpha_mm, estimated_rms_N, noise_N, spent_s, next_s, budget_s, target_rms_N, rig_s, why, stopped, nodes_mm)
 HYSTLAB_EVENT(SineStepEvent, "sine_step", k, of, pass, passes, frequency_hz, amplitude_mm, direction, drive_mm, eta_s, change, shift_deg, glide_cycles)
 HYSTLAB_EVENT(TransmissibilityEvent, "transmissibility", k, of, pass, frequency_hz, amplitude_mm, direction, drive_mm, base_amplitude_mm, base_phase_rad,
               mass_amplitude_mm, mass_phase_rad, ratio, phase_rad, thd, harmonics, control_error_pct, band, control_windows, settle_cycles, t_s, eta_s)

@@ -129,6 +129,48 @@ void parse_nodes(const json& j, Plan& p) {
   if (models::Grid::from_nodes(p.nodes_mm).uniform()) p.nodes_mm.clear();  // the uniform grid, written out
 }
 
+// An adaptive design on a fot plan with range_mm and subdivisions (its coarse rows).
+Design parse_design(const json& j, const Plan& p) {
+  Design d;
+  if (!j.contains("design")) return d;
+  const json& o = j["design"];
+  if (!o.is_object()) fail("design", "must be an object: {\"kind\": \"adaptive\", \"budget_s\": 600, ...}");
+  fields::only(o, "design.", {"kind", "budget_s", "target_rms_N", "min_gain", "finest_subdivisions"});
+  if (!o.contains("kind") || !o["kind"].is_string()) fail("design.kind", "is required: \"adaptive\" or \"uniform\"");
+  const std::string kind = o["kind"].get<std::string>();
+  if (kind != "adaptive" && kind != "uniform") fail("design.kind", "must be \"adaptive\" or \"uniform\" (got \"" + kind + "\")");
+  if (kind == "uniform") {
+    if (o.size() > 1) fail("design", "of kind \"uniform\" takes no other field (every row of the grid is driven)");
+    return d;
+  }
+  d.adaptive = true;
+  if (!p.nodes_mm.empty()) fail("design", "needs range_mm and subdivisions (its coarse rows), not nodes_mm: it places the other rows itself");
+  if (p.repeats != 1) fail("repeats", "must be 1 with an adaptive design (it drives each row it chooses once)");
+  int finest = p.subdivisions;
+  while (finest * 2 <= 96 && finest < 8 * p.subdivisions) finest *= 2;
+  d.finest_subdivisions = fields::integer(o, "finest_subdivisions", std::max(finest, 2 * p.subdivisions), "design.");
+  int halved = p.subdivisions;
+  while (halved < d.finest_subdivisions) halved *= 2;
+  if (halved != d.finest_subdivisions || d.finest_subdivisions == p.subdivisions)
+    fail("design.finest_subdivisions",
+         "must be subdivisions (" + std::to_string(p.subdivisions) + ") doubled once or more: a row halves a band of the grid, so its top lies on it");
+  if (!o.contains("budget_s")) fail("design.budget_s", "is required: the rig seconds the rows may take");
+  d.budget_s = number(o, "budget_s", 0.0, "design.");
+  d.target_rms_N = number(o, "target_rms_N", 0.0, "design.");
+  d.min_gain = number(o, "min_gain", d.min_gain, "design.");
+  const models::Grid g = fot_grid(p);
+  double coarse = 0;
+  for (int i = 1; i <= g.n; ++i) coarse += row_seconds(p, g.node(i) - p.lo_mm);
+  const double first = row_seconds(p, 0.5 * (g.node(1) + g.node(0)) - p.lo_mm);
+  if (d.budget_s < coarse + first) {
+    char buf[240];
+    std::snprintf(buf, sizeof buf, "%.4g s is below the coarse rows (%.4g s for %d) and one row more (%.4g s): nothing left to choose", d.budget_s, coarse, g.n,
+                  first);
+    fail("design.budget_s", buf);
+  }
+  return d;
+}
+
 void parse_sine(const json& j, Plan& p) {
   p.sine = parse_sine_plan(j, p.sample_rate_hz);
   const double a = p.sine.max_amplitude_mm();
@@ -165,7 +207,7 @@ Plan parse_plan(const json& j) {
   p.dwell_s = number(j, "dwell_s", 0.0);
   p.sample_rate_hz = number(j, "sample_rate_hz", 1000.0);
   if (p.kind == domain::CampaignKind::fot) {
-    known({"range_mm", "subdivisions", "nodes_mm", "repeats", "training_cycles", "training", "validation", "plateaus_mm"});
+    known({"range_mm", "subdivisions", "nodes_mm", "repeats", "training_cycles", "training", "validation", "plateaus_mm", "design"});
     if (j.contains("nodes_mm")) {
       parse_nodes(j, p);
     } else {
@@ -180,6 +222,7 @@ Plan parse_plan(const json& j) {
     if (p.lo_mm < p.limits.displacement_min_mm || p.hi_mm > p.limits.displacement_max_mm) fail("range_mm", "must lie inside limits.displacement_mm");
     p.validation = parse_validation(j, p);
     p.plateaus_mm = parse_plateaus(j, p);
+    p.design = parse_design(j, p);
   } else if (p.kind == domain::CampaignKind::waveform) {
     known({"points_mm"});
     if (!j.contains("points_mm") || !j["points_mm"].is_array() || j["points_mm"].size() < 2)
@@ -212,5 +255,9 @@ Plan parse_plan(const json& j) {
 models::Grid fot_grid(const Plan& p) {
   return p.nodes_mm.empty() ? models::Grid::make(p.lo_mm, p.hi_mm, p.subdivisions) : models::Grid::from_nodes(p.nodes_mm);
 }
+
+models::Grid node_grid(const Plan& p) { return p.design.adaptive ? models::Grid::make(p.lo_mm, p.hi_mm, p.design.finest_subdivisions) : fot_grid(p); }
+
+double row_seconds(const Plan& p, double above_mm) { return 2.0 * (above_mm / p.ramp_rate_mm_s + p.dwell_s) + kRowSettle_s; }
 
 }  // namespace hystlab::domain

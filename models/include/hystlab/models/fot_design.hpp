@@ -33,6 +33,10 @@ struct DesignOptions {
   double min_gain = 0.02;     // stop when a row would remove less than this share of what is left
   double min_band_mm = 0.0;   // bands narrower than this are not split (0: 1/1000 of the range)
   int max_rows = 200;
+  // The force noise (1 σ, N) of the record the table will be scored on: no row removes it, so it
+  // counts in the estimated RMS error (the target and the stops) and in what a row's gain is a
+  // share of. 0: the table's own error alone.
+  double noise_N = 0.0;
 };
 
 struct DesignRow {
@@ -45,7 +49,7 @@ struct DesignRow {
 
 struct Design {
   std::vector<DesignRow> rows;  // in the order chosen
-  double rms_before_N = 0.0;    // the table's estimated RMS error as it is
+  double rms_before_N = 0.0;    // the table's estimated RMS error as it is (with the noise)
   double seconds = 0.0;         // all rows' rig time
   std::vector<double> nodes;    // the grid with the rows' nodes added
   std::string stopped;          // "target", "budget", "gain" or "rows", said in words

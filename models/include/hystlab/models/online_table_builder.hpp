@@ -38,6 +38,12 @@ class OnlineTableBuilder {
   // Per-node count of measurements (lower triangle order).
   [[nodiscard]] const std::vector<int>& counts() const noexcept { return count_; }
 
+  // The builder of a coarser grid made of some of these nodes (indices into this grid, increasing,
+  // from 0 to n): their measurements, sums and counts carried over (an adaptive campaign's table is
+  // that of the rows it measured, each descent having passed every node of the fine grid below its
+  // top). Throws std::invalid_argument for indices that are not such a subset.
+  [[nodiscard]] OnlineTableBuilder restricted(const std::vector<int>& nodes) const;
+
   // The table so far: measured means, F(α,α) = 0, zero-weight fill elsewhere.
   [[nodiscard]] EverettTable table() const;
 

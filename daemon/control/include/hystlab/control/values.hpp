@@ -141,6 +141,9 @@ struct PlanPreview {
   double peak_accel_m_s2 = 0;                    // of the base (shakers)
   double samples = 0;                            // duration × sample rate
   double sample_rate_hz = 0, force_limit_N = 0;  // the plan's
+  // An adaptive FOT design's budget for its rows (0: none): duration_s counts the coarse rows'
+  // ramps as the whole budget spent, the most the design may take.
+  double design_budget_s = 0;
   // Rig seconds per wall second (a simulator faster than real time): the campaign then takes
   // duration_s / time_scale of wall time, and the host, sampling at sample_rate_hz of wall time,
   // stores sample_rate_hz / time_scale of rig time.

@@ -70,6 +70,15 @@ struct RetakeEvent {
   std::optional<double> frequency_hz;
   std::string why;
 };
+// An adaptive FOT campaign's design after a row (models/adaptive_fot.hpp): the next row's top and
+// why, or why it stops (stopped), with the table's estimated held-out RMS and the rig time spent.
+struct DesignEvent {
+  std::int64_t rows = 0;  // rows measured whole
+  double alpha_mm = NAN, estimated_rms_N = NAN, noise_N = NAN, spent_s = NAN, next_s = NAN, budget_s = NAN, target_rms_N = NAN;
+  double rig_s = NAN;  // rig seconds since the campaign's run began (its preamble and training included)
+  std::string why, stopped;
+  std::vector<double> nodes_mm;  // the grid of the rows measured
+};
 // A sine step (or a continuous pass) begins.
 struct SineStepEvent {
   std::int64_t k = 0, of = 0, pass = 0, passes = 0;
@@ -161,9 +170,9 @@ struct CommandEvent {
 };
 
 using CampaignEvent =
-    std::variant<GapEvent, GapsEvent, SafeEvent, LimitsEvent, QualityEvent, ShakedownEvent, TrainingEvent, ValidationEvent, RetakeEvent, SineStepEvent,
-                 TransmissibilityEvent, SweepDoneEvent, ControlAbortEvent, ControlWarningEvent, ControlUnreachedEvent, UnsettledEvent, ResonanceUnresolvedEvent,
-                 DwellEvent, PretestEvent, FitEvent, EnvelopeEvent, RecordEvent, RecommendationEvent, CommandEvent>;
+    std::variant<GapEvent, GapsEvent, SafeEvent, LimitsEvent, QualityEvent, ShakedownEvent, TrainingEvent, ValidationEvent, RetakeEvent, DesignEvent,
+                 SineStepEvent, TransmissibilityEvent, SweepDoneEvent, ControlAbortEvent, ControlWarningEvent, ControlUnreachedEvent, UnsettledEvent,
+                 ResonanceUnresolvedEvent, DwellEvent, PretestEvent, FitEvent, EnvelopeEvent, RecordEvent, RecommendationEvent, CommandEvent>;
 
 // Its stored kind ("gap", "control_unreached").
 [[nodiscard]] std::string_view kind_of(const CampaignEvent& e) noexcept;

@@ -14,6 +14,10 @@
 //    "plateaus_mm": [1, 3] (the loop figures' plateau forces are read at these displacements)
 //    "nodes_mm": [0, 1, 1.5, 1.75, 2, 2.25, 2.5, 3, 4] instead of range_mm and subdivisions: a grid
 //      of its own, refined where accuracy is needed (table format version 2)
+//    "design": {"kind": "adaptive", "budget_s": 400, "target_rms_N": 0.3, "min_gain": 0.02,
+//      "finest_subdivisions": 48}: subdivisions are the coarse rows; after them the daemon chooses
+//      each next row where the table is least certain (models/adaptive_fot.hpp) until the target,
+//      the budget or diminishing returns; the tops lie on the finest grid ("uniform": no design)
 //   {"kind": "waveform", "points_mm": [0, 2, 1, 3, 0], "ramp_rate_mm_s": 0.5, ...}
 //   {"kind": "sine", "sweep": {"from_hz": 5, "to_hz": 80, "steps": 24}, "direction": "up-down", "amplitudes_mm": [0.01, 0.1]}
 //     (the whole form in sine_plan.hpp)
@@ -53,6 +57,15 @@ struct Validation {
   std::uint64_t seed = 1;
 };
 
+// An adaptive FOT campaign's design (issue 41); adaptive false: every row of the plan's grid.
+struct Design {
+  bool adaptive = false;
+  int finest_subdivisions = 0;  // the rows' tops lie on this grid: the coarse one halved 1 or more times
+  double budget_s = 0;          // rig seconds for the rows, the coarse ones included (training, validation not)
+  double target_rms_N = 0;      // stop at this estimated held-out RMS (0: none)
+  double min_gain = 0.02;       // stop when no row would remove this share of the estimated error left
+};
+
 struct Plan {
   domain::CampaignKind kind = domain::CampaignKind::fot;
   // fot
@@ -62,6 +75,7 @@ struct Plan {
   Training training;
   Validation validation;
   std::vector<double> plateaus_mm;
+  Design design;
   // waveform
   std::vector<double> points_mm;
   // sine (shaker: stepped or continuous sweeps, closed-loop base amplitude)
@@ -76,5 +90,12 @@ struct Plan {
 
 // A fot plan's grid: subdivisions equal steps of range_mm, or its nodes_mm.
 [[nodiscard]] models::Grid fot_grid(const Plan& p);
+// The grid a fot campaign's nodes are measured on: fot_grid, or an adaptive design's finest grid.
+[[nodiscard]] models::Grid node_grid(const Plan& p);
+// The rig seconds the design's cost model gives a row with its top `above_mm` over δmin: up and
+// down at the plan's rate, the dwell at each end and kRowSettle_s (the servo's arrival in position
+// at both ends; models/adaptive_fot.hpp).
+[[nodiscard]] double row_seconds(const Plan& p, double above_mm);
+inline constexpr double kRowSettle_s = 1.0;
 
 }  // namespace hystlab::domain
