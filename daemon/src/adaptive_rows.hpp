@@ -21,8 +21,7 @@ class AdaptiveRows {
   explicit AdaptiveRows(const domain::Plan& plan);
   // The next row's two segments (rise, descent), or nullopt when the design stops (then over()).
   // The force noise is estimated once, from the last samples of the rows (series from rows_begin).
-  std::optional<std::vector<Segment>> next(const models::OnlineTableBuilder& fine, const RunSeries& series, std::size_t rows_begin,
-                                           domain::DesignEvent& event);
+  std::optional<std::vector<Segment>> next(const models::OnlineTableBuilder& fine, const RunSeries& series, std::size_t rows_begin, domain::DesignEvent& event);
   [[nodiscard]] bool over() const noexcept { return over_; }
   // The rows the design chose in this attempt (fine-grid nodes), for their retakes.
   [[nodiscard]] const std::vector<int>& chosen() const noexcept { return chosen_; }

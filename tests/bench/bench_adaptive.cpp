@@ -80,9 +80,9 @@ int main() {
     std::printf("the suggested design's campaign did not complete: %s\n", so.result.reason.c_str());
     return 1;
   }
-  const double held = models::score_table(s.table(so.result), v.x, v.f).overall.rms;
+  const double suggested_held = models::score_table(s.table(so.result), v.x, v.f).overall.rms;
   std::printf("\nhystlab design on the n=12 table (%.4f N), target 1.0 N: %zu rows more (%s), estimated %.4f N; driven: %.1f s, held-out %.4f N%s\n",
-              uniform[1].heldout_N, d.rows.size(), d.stopped.c_str(), d.rows.empty() ? d.rms_before_N : d.rows.back().rms_after_N, so.rig_s, held,
-              held <= o.target_rms_N ? "  (target reached)" : "  (target NOT reached)");
+              uniform[1].heldout_N, d.rows.size(), d.stopped.c_str(), d.rows.empty() ? d.rms_before_N : d.rows.back().rms_after_N, so.rig_s, suggested_held,
+              suggested_held <= o.target_rms_N ? "  (target reached)" : "  (target NOT reached)");
   return 0;
 }

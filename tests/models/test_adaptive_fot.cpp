@@ -141,7 +141,9 @@ TEST_CASE("the design stops on its target, its budget and its gain, and says whi
     OnlineTableBuilder b = coarse(32, 8, [](double x) { return 10 * x; });  // flat: nothing to gain
     o.budget_s = 1e6;
     AdaptiveStep last;
-    CHECK(run(b, o, [](double x) { return 10 * x; }, last).empty());
+    CHECK(run(
+              b, o, [](double x) { return 10 * x; }, last)
+              .empty());
     CHECK(last.stopped.rfind("gain", 0) == 0);
     CHECK(last.estimated_rms_N == doctest::Approx(o.noise_N));
   }

@@ -12,7 +12,7 @@ export class DesignPanel {
     this.u = new uPlot({
       width: Math.max(200, plotBox.clientWidth), height: 200, legend: { show: false },
       scales: { x: { time: false }, y: { range: (u, lo, hi) => [0, hi > 0 ? hi * 1.05 : 1] } },
-      axes: [{ label: 'rig time (s)' }, { label: 'estimated held-out RMS (N)', values: tickLabels, size: axisSize }],
+      axes: [{ label: 'rig time (s)' }, { label: 'est. held-out RMS (N)', values: tickLabels, size: axisSize }],
       series: [{}, { stroke: '#1565c0', width: 2, points: { show: true, size: 6 } }],
     }, this.data, plotBox);
     onWidth(plotBox, w => this.u.setSize({ width: Math.max(200, w), height: 200 }));
@@ -30,7 +30,7 @@ export class DesignPanel {
       : `Adaptive design: ${last.rows} rows, estimated held-out RMS ${round2(last.estimated_rms_N)} N (noise ${round2(last.noise_N)} N), ` +
         `${num(last.spent_s)} of ${num(design.budget_s)} s${target}` + (last.stopped ? ' — stopped' : '');
     const items = steps.filter(s => !s.stopped).map(s => el('li', { text: `${num(s.alpha_mm)} mm: ${s.why}` }));
-    if (last && last.stopped) items.push(el('li', { class: 'why', text: `stopped: ${last.stopped}` }));
+    if (last && last.stopped) items.push(el('li', { class: 'stopped', text: `stopped: ${last.stopped}` }));
     this.list.replaceChildren(...items);
   }
   points() { return this.data[0].length; }  // for the tests

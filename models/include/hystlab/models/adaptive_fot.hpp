@@ -40,14 +40,14 @@ struct AdaptiveOptions {
 };
 
 struct AdaptiveStep {
-  std::optional<int> row;         // the next row's top as a fine-grid node; none: the design stops
-  double alpha_mm = 0;            // its top (mm)
-  double estimated_rms_N = 0;     // the table's estimated held-out RMS now (noise included)
-  double spent_s = 0;             // the measured rows' rig time by the cost model
-  double next_s = 0;              // the next row's (0: none)
-  std::string why;                // why this row: which term of which band
-  std::string stopped;            // why the design stops (empty when a row is chosen)
-  std::vector<double> nodes_mm;   // the grid of the rows measured
+  std::optional<int> row;        // the next row's top as a fine-grid node; none: the design stops
+  double alpha_mm = 0;           // its top (mm)
+  double estimated_rms_N = 0;    // the table's estimated held-out RMS now (noise included)
+  double spent_s = 0;            // the measured rows' rig time by the cost model
+  double next_s = 0;             // the next row's (0: none)
+  std::string why;               // why this row: which term of which band
+  std::string stopped;           // why the design stops (empty when a row is chosen)
+  std::vector<double> nodes_mm;  // the grid of the rows measured
 };
 
 // The fine rows i (1..n) with every node (i, j < i) measured, and 0 first.
