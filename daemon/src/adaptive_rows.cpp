@@ -12,13 +12,19 @@ AdaptiveRows::AdaptiveRows(const domain::Plan& plan) : plan_(plan) {
   options_.min_gain = plan.design.min_gain;
 }
 
-std::optional<std::vector<Segment>> AdaptiveRows::next(const models::OnlineTableBuilder& fine, const RunSeries& series, std::size_t rows_begin,
-                                                       domain::DesignEvent& event) {
+bool AdaptiveRows::stopped_before(const models::OnlineTableBuilder& fine) const {
+  const std::vector<int> rows = models::measured_rows(fine);
+  for (int i = 1; i <= plan_.subdivisions; ++i)  // a coarse row missing: the design has not begun
+    if (std::find(rows.begin(), rows.end(), i * (plan_.design.finest_subdivisions / plan_.subdivisions)) == rows.end()) return false;
+  return !models::next_row(fine, options_).row;
+}
+
+std::optional<std::vector<Segment>> AdaptiveRows::next(const models::OnlineTableBuilder& fine, const RunSeries& series, domain::DesignEvent& event) {
   if (over_) return std::nullopt;
   if (!noise_) {
-    // The last 20,000 samples of the rows (20 s at 1 kHz: a descent or more), copied once.
+    // The last 20,000 samples (20 s at 1 kHz: a descent or more), copied once.
     constexpr std::size_t kNoiseSamples = 20'000;
-    const std::size_t e = series.size(), b = std::max(rows_begin, e > kNoiseSamples ? e - kNoiseSamples : 0);
+    const std::size_t e = series.size(), b = e > kNoiseSamples ? e - kNoiseSamples : 0;
     Columns c;
     if (e > b) series.copy(b, e, c);
     noise_ = models::force_noise(c.f);
@@ -33,6 +39,11 @@ std::optional<std::vector<Segment>> AdaptiveRows::next(const models::OnlineTable
   if (!st.row) {
     over_ = true;
     event.stopped = st.stopped;
+    return std::nullopt;
+  }
+  if (std::find(chosen_.begin(), chosen_.end(), *st.row) != chosen_.end()) {
+    over_ = true;
+    event.stopped = "the row to " + std::to_string(st.alpha_mm) + " mm was driven and could not be measured whole (a node missing after its retakes)";
     return std::nullopt;
   }
   event.alpha_mm = st.alpha_mm, event.next_s = st.next_s, event.why = st.why;

@@ -35,8 +35,11 @@ class RampStrategy final : public Strategy {
     builder_ = std::make_shared<models::OnlineTableBuilder>(g);
     for (const models::FotNode& n : L.job.prior_nodes) (void)builder_->add(n);
     if (!L.job.prior_nodes.empty()) resume_rows_only(L);
+    if (adaptive_ && !L.job.prior_nodes.empty()) design_done_at_start_ = adaptive_->stopped_before(*builder_);
     validation_to_rerun_ = !L.job.prior_nodes.empty();
-    const double band = std::min(0.05 * g.step(), 0.02);
+    // The reversal dead band: the plan grid's, and for an adaptive design below a tenth of its
+    // finest step (a reversal inside a fine cell must not pass one of its nodes).
+    const double band = std::min({0.05 * domain::fot_grid(plan_).step(), 0.02, 0.1 * g.step()});
     fot_ = std::make_unique<OnlineFot>(g, band, [this, &L](const models::FotNode& n, double t) {
       if (builder_->add(n)) return;
       ++L.result.nodes;
@@ -49,9 +52,11 @@ class RampStrategy final : public Strategy {
   // validation run (or while finishing) resumes with every node measured, and its tables are scored
   // on a validation run of its own, driven whole now (the interrupted one's samples end where the
   // daemon stopped: a held-out score on part of the input would say less than it seems to).
-  // An adaptive campaign resumed always has work: its design decides at the first row's end.
+  // An adaptive campaign resumed has work unless its design had stopped (its rows measured, the
+  // next row past the budget or the gain, judged without the noise: more work, never less).
   [[nodiscard]] bool has_work() const override {
-    return adaptive_ || !(builder_ && builder_->complete()) || (builder_ && plan_.validation.enabled && validation_to_rerun_);
+    if (adaptive_) return !design_done_at_start_ || (plan_.validation.enabled && validation_to_rerun_);
+    return !(builder_ && builder_->complete()) || (builder_ && plan_.validation.enabled && validation_to_rerun_);
   }
 
   [[nodiscard]] CampaignPhase phase() const override {
@@ -262,7 +267,12 @@ class RampStrategy final : public Strategy {
     fot_->finish();  // the last descent's bottom (node (i, 0)) is the frame at δmin now
     if (fot_->take_descent_completed()) evaluate(L);
     domain::DesignEvent ev;
-    std::optional<std::vector<Segment>> row = adaptive_->next(*builder_, series_, rows_begin_, ev);
+    std::optional<std::vector<Segment>> row;
+    try {  // a design that fails ends the design, not the campaign: the rows measured keep their table
+      row = adaptive_->next(*builder_, series_, ev);
+    } catch (const std::exception& e) {
+      ev = {}, ev.stopped = std::string("the design failed: ") + e.what();
+    }
     ev.rig_s = s.time_s - L.mark.t0;
     L.event(ev);
     if (!row) return false;
@@ -296,6 +306,7 @@ class RampStrategy final : public Strategy {
   std::shared_ptr<models::OnlineTableBuilder> builder_;
   std::unique_ptr<OnlineFot> fot_;
   std::optional<AdaptiveRows> adaptive_;
+  bool design_done_at_start_ = false;  // a resumed adaptive campaign whose design had stopped
   RunSeries series_, validation_;
   Columns cycle_;  // the training cycle being judged
   double time_scale_ = 1.0;

@@ -22,7 +22,7 @@ int main() {
   constexpr double kRate = 1000;
   struct Point {
     int n;
-    double rig_s, heldout_N;
+    double rig_s, heldout_N, lsq_N;
   };
   std::vector<Point> uniform;
   daemon::Columns v;
@@ -36,7 +36,8 @@ int main() {
     }
     if (n == 24) v = w.samples(o.result.validation_run_id);
     if (n == 12) t12 = w.table(o.result);
-    uniform.push_back({n, o.rig_s, models::score_table(w.table(o.result), v.x, v.f).overall.rms});
+    uniform.push_back(
+        {n, o.rig_s, models::score_table(w.table(o.result), v.x, v.f).overall.rms, models::score_table(w.table(o.result, true), v.x, v.f).overall.rms});
   }
   const json plan = adaptive_plan(6, 400, 0, 0.01, kRate);
   World a(kRate);
@@ -53,8 +54,9 @@ int main() {
     std::printf("%5lld %9.1f %13.4f %13.4f %9.3f  %s\n", static_cast<long long>(e.rows), e.rig_s, held[k], e.estimated_rms_N, e.alpha_mm,
                 e.stopped.empty() ? e.why.c_str() : ("stopped: " + e.stopped).c_str());
   }
-  std::printf("force noise read from the rows: %.4f N; rig time %.1f s for %zu rows\n", ad.design.front().noise_N, ad.rig_s, tops(ad).size());
-  std::printf("\n%-18s %9s %13s %26s %8s\n", "uniform", "rig s", "held-out N", "adaptive reached it at s", "ratio");
+  std::printf("force noise read from the rows: %.4f N; rig time %.1f s for %zu rows; its least-squares table (on the rows' grid): held-out %.4f N\n",
+              ad.design.front().noise_N, ad.rig_s, tops(ad).size(), models::score_table(a.table(ad.result, true), v.x, v.f).overall.rms);
+  std::printf("\n%-18s %9s %13s %26s %8s\n", "uniform (fot table)", "rig s", "held-out N", "adaptive reached it at s", "ratio");
   for (const Point& p : uniform) {
     double at = -1;
     for (std::size_t k = 0; k < held.size() && at < 0; ++k)
@@ -65,6 +67,9 @@ int main() {
       std::printf("fot n=%-12d %9.1f %13.4f %26.1f %8.2f%s\n", p.n, p.rig_s, p.heldout_N, at, at / p.rig_s,
                   p.n == 12 ? "" : (at / p.rig_s <= 0.5 ? "  (target <= 0.5: met)" : "  (target <= 0.5: NOT met)"));
   }
+  std::printf("uniform campaigns' least-squares tables, held-out:");
+  for (const Point& p : uniform) std::printf("  n=%d %.4f N", p.n, p.lsq_N);
+  std::printf("\n");
   // `hystlab design --table T12.json --budget-s 300 --target-rms-n 1.0 --ramp-mm-s 0.5 --settle-s 1`
   // on the uniform n = 12 table, driven as a plan of its nodes on a fresh specimen.
   models::DesignOptions o;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <utility>
 
 #include "campaign_bench.hpp"
 #include "hystlab/db/store.hpp"
@@ -39,9 +40,10 @@ class World {
             rate_hz) {
     b.sup = std::make_unique<daemon::Supervisor>(rig, domain::SupervisionSettings{}, false, [](const daemon::RigTransition&) {});
   }
-  // Runs the plan (or resumes campaign `id` with what it measured); stop_after_rows: the daemon
-  // stops (an interrupted campaign) once that many design events were stored.
-  Outcome run(const json& plan_json, std::int64_t resume = 0, std::size_t stop_after_design = 0) {
+  // Runs the plan (or resumes campaign `id` with what it measured); stop_after_design: once that
+  // many design events were stored, the daemon stops (an interrupted campaign), or the operator's
+  // `command` is given instead (once).
+  Outcome run(const json& plan_json, std::int64_t resume = 0, std::size_t stop_after_design = 0, std::optional<daemon::Control> command = std::nullopt) {
     const domain::Plan plan = domain::parse_plan(plan_json);
     daemon::CampaignJob job;
     job.id = resume > 0 ? resume : b.submit(plan_json);
@@ -64,7 +66,8 @@ class World {
       if (stop_after_design > 0 && polls % 1000 == 0) {
         b.writer->flush();
         designs = b.store->event_details(job.id, "design").size();
-        if (designs >= stop_after_design) stopping = true;
+        if (designs >= stop_after_design && !command) stopping = true;
+        if (designs >= stop_after_design && command) return std::exchange(command, std::nullopt);
       }
       return std::nullopt;
     };
@@ -83,10 +86,11 @@ class World {
     if (static_cast<std::int64_t>(x.size()) != b.store->sample_count(run)) throw std::runtime_error("a run's samples were not all stored");
     return {std::vector<double>(x.begin(), x.end()), std::vector<double>(f.begin(), f.end())};
   }
-  // The campaign's fot table.
-  models::EverettTable table(const daemon::RunnerResult& r) {
-    if (!r.table_id) throw std::runtime_error("the campaign has no table: " + r.reason);
-    const auto doc = b.store->table_document(*r.table_id);
+  // The campaign's fot table (lsq: its least-squares table).
+  models::EverettTable table(const daemon::RunnerResult& r, bool lsq = false) {
+    const std::optional<std::int64_t> which = lsq ? r.lsq_table_id : r.table_id;
+    if (!which) throw std::runtime_error("the campaign has no table: " + r.reason);
+    const auto doc = b.store->table_document(*which);
     if (!doc) throw std::runtime_error("the campaign's table is not stored");
     return models::table_from_json(*doc).table;
   }

@@ -35,6 +35,9 @@ TEST_CASE("an adaptive campaign reaches a uniform n = 24 campaign's held-out RMS
   REQUIRE(!ad.design.empty());
   CHECK(ad.design.back().stopped.rfind("budget", 0) == 0);
   CHECK(ad.design.back().spent_s <= 400.0);
+  // The rig time itself within the budget: the cost model's second per row is more than the
+  // servo's arrival takes (measured 354 s of rig time for 400 s of the model).
+  CHECK(ad.rig_s <= 400.0);
   // The estimate falls as rows are added.
   CHECK(ad.design.back().estimated_rms_N < 0.2 * ad.design.front().estimated_rms_N);
   // Table 1's spring at 25 °C transforms from about 1 mm on (KA·δ reaches C·(T − Ms0) = 40.5 N at
@@ -68,6 +71,19 @@ TEST_CASE("an adaptive campaign stops at its target and on diminishing returns, 
     CAPTURE(o.design.back().stopped);
     CHECK(o.design.back().stopped.rfind("gain", 0) == 0);
     CHECK(o.design.back().spent_s < 1000 / 2.0);
+  }
+  SUBCASE("without a validation run: the design runs at the end of the queued rows") {
+    World a;
+    json plan = adaptive_plan(6, 100, 0, 1e-4);
+    plan["validation"] = false;
+    const Outcome o = a.run(plan);
+    CAPTURE(o.result.reason);
+    REQUIRE(end_of(o.result) == "completed");
+    CHECK(o.result.validation_run_id == 0);
+    REQUIRE(o.design.size() >= 2);
+    CAPTURE(o.design.back().stopped);
+    CHECK(o.design.back().stopped.rfind("budget", 0) == 0);
+    CHECK(a.table(o.result).grid().n == static_cast<int>(tops(o).size()));
   }
   SUBCASE("a target below the noise: no row is added, the campaign validates what it has") {
     World a;
@@ -113,6 +129,23 @@ TEST_CASE("an adaptive campaign stopped by a shutdown mid-design resumes the des
   CHECK(w.table(second.result).grid().n + 1 == static_cast<int>(rows_after.size()));
 }
 
+TEST_CASE("an abort or an e-stop while the design's rows run ends the campaign there: no row chosen after it, no validation run driven") {
+  for (const daemon::Control c : {daemon::Control::abort, daemon::Control::estop}) {
+    const std::string command = domain::to_string(c);
+    CAPTURE(command);
+    World w;
+    const Outcome o = w.run(adaptive_plan(6, 400), 0, 4, c);
+    CAPTURE(o.result.reason);
+    CHECK(end_of(o.result) == std::string("aborted"));
+    CHECK(o.result.reason.find(c == daemon::Control::abort ? "aborted by the operator" : "e-stop by the operator") != std::string::npos);
+    // The command is taken within a poll of the 4th design step (1000 periods at most): that row,
+    // at most, was started; no design step after it.
+    CHECK(o.design.size() >= 4);
+    CHECK(o.design.size() <= 5);
+    CHECK(w.b.store->sample_count(o.result.validation_run_id) == 0);
+  }
+}
+
 TEST_CASE("bad designs are refused with the field named: a budget below one row, unknown kinds and fields, a grid that rows cannot halve") {
   auto bad = [](json design, const char* needle, json extra = json::object()) {
     json p = fot_plan(6, 0.5);
@@ -135,6 +168,8 @@ TEST_CASE("bad designs are refused with the field named: a budget below one row,
   bad({{"kind", "adaptive"}, {"budget_s", 400}}, "repeats must be 1 with an adaptive design", {{"repeats", 2}});
   bad({{"kind", "uniform"}, {"budget_s", 400}}, "design of kind \"uniform\" takes no other field");
   bad("adaptive", "design must be an object");
+  bad({{"kind", "adaptive"}, {"budget_s", 400}, {"finest_subdivisions", 96}}, "design.finest_subdivisions gives a step of 0.04167 mm, below 0.05 mm");
+  bad({{"kind", "adaptive"}, {"budget_s", 400}}, "subdivisions must be from 2 to 96 with an adaptive design", {{"subdivisions", 1}});
   // Good ones: the defaults, and "uniform" as no design.
   json p = fot_plan(6, 0.5);
   p["design"] = {{"kind", "adaptive"}, {"budget_s", 400}};

@@ -146,14 +146,26 @@ Design parse_design(const json& j, const Plan& p) {
   d.adaptive = true;
   if (!p.nodes_mm.empty()) fail("design", "needs range_mm and subdivisions (its coarse rows), not nodes_mm: it places the other rows itself");
   if (p.repeats != 1) fail("repeats", "must be 1 with an adaptive design (it drives each row it chooses once)");
-  int finest = p.subdivisions;
-  while (finest * 2 <= 96 && finest < 8 * p.subdivisions) finest *= 2;
-  d.finest_subdivisions = fields::integer(o, "finest_subdivisions", std::max(finest, 2 * p.subdivisions), "design.");
+  if (p.subdivisions < 2 || p.subdivisions > 96)
+    fail("subdivisions", "must be from 2 to 96 with an adaptive design (the coarse rows: the curvature needs 3 nodes, the finest grid doubles them)");
+  // A row's top and its bottom are read within a quarter of the finest step (OnlineFot), and the
+  // frame arrives within the in-position tolerance (0.01 mm by default): a step of at least
+  // kMinFineStep_mm keeps both readable.
+  const double span = p.hi_mm - p.lo_mm;
+  int finest = 2 * p.subdivisions;
+  while (finest * 2 <= 96 && finest < 8 * p.subdivisions && span / (finest * 2) >= kMinFineStep_mm) finest *= 2;
+  d.finest_subdivisions = fields::integer(o, "finest_subdivisions", finest, "design.");
   int halved = p.subdivisions;
   while (halved < d.finest_subdivisions) halved *= 2;
   if (halved != d.finest_subdivisions || d.finest_subdivisions == p.subdivisions)
     fail("design.finest_subdivisions",
          "must be subdivisions (" + std::to_string(p.subdivisions) + ") doubled once or more: a row halves a band of the grid, so its top lies on it");
+  if (span / d.finest_subdivisions < kMinFineStep_mm) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "gives a step of %.4g mm, below %.3g mm: a row's top and bottom are read within a quarter step of their node",
+                  span / d.finest_subdivisions, kMinFineStep_mm);
+    fail("design.finest_subdivisions", buf);
+  }
   if (!o.contains("budget_s")) fail("design.budget_s", "is required: the rig seconds the rows may take");
   d.budget_s = number(o, "budget_s", 0.0, "design.");
   d.target_rms_N = number(o, "target_rms_N", 0.0, "design.");

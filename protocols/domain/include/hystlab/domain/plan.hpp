@@ -97,5 +97,8 @@ struct Plan {
 // at both ends; models/adaptive_fot.hpp).
 [[nodiscard]] double row_seconds(const Plan& p, double above_mm);
 inline constexpr double kRowSettle_s = 1.0;
+// An adaptive design's finest step at least (mm): a quarter of it above the default in-position
+// tolerance (0.01 mm), within which a row's top and bottom are read.
+inline constexpr double kMinFineStep_mm = 0.05;
 
 }  // namespace hystlab::domain
