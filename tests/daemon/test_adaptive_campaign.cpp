@@ -27,7 +27,7 @@ TEST_CASE("an adaptive campaign reaches a uniform n = 24 campaign's held-out RMS
   CAPTURE(held);
   CAPTURE(uni.rig_s);
   CAPTURE(ad.rig_s);
-  // Measured (stop 43): uniform n = 24 0.772 N in 199 s of rig time; adaptive 0.705 N in 354 s,
+  // Measured at 1 kHz (bench_adaptive, stop 43): uniform n = 24 0.772 N in 199 s of rig time; adaptive 0.705 N in 354 s,
   // 43 rows (it passed 0.772 after 24 rows, in 208 s: the FOT table's floor here is the
   // simulator's departure from a Preisach model, 0.71 N at n = 48 uniform, not the rows).
   CHECK(held <= u24);
@@ -41,7 +41,7 @@ TEST_CASE("an adaptive campaign reaches a uniform n = 24 campaign's held-out RMS
   // The estimate falls as rows are added.
   CHECK(ad.design.back().estimated_rms_N < 0.2 * ad.design.front().estimated_rms_N);
   // Table 1's spring at 25 °C transforms from about 1 mm on (KA·δ reaches C·(T − Ms0) = 40.5 N at
-  // 1.01 mm): its elastic part is 0..1 mm, its plateaus 1..4 mm. Measured: 8 rows a mm below 1 mm
+  // 1.01 mm): its elastic part is 0..1 mm, its plateaus 1..4 mm. Measured at 1 kHz: 8 rows a mm below 1 mm
   // (the descents bend there too: the reverse transformation ends near 0.5 mm), 11.7 above.
   const std::vector<double> rows = tops(ad);
   CHECK(rows.size() == static_cast<std::size_t>(t.grid().n));
