@@ -22,15 +22,13 @@ std::optional<OnlineTableBuilder> rows_builder(const OnlineTableBuilder& fine) {
   return fine.restricted(rows);
 }
 
-double row_cost(const AdaptiveOptions& o, double above_lo_mm) noexcept { return 2.0 * above_lo_mm / o.ramp_mm_s + o.settle_s; }
-
 AdaptiveStep next_row(const OnlineTableBuilder& fine, const AdaptiveOptions& o) {
   AdaptiveStep st;
   const Grid& g = fine.grid();
   const std::vector<int> rows = measured_rows(fine);
   for (int i : rows) {
     st.nodes_mm.push_back(g.node(i));
-    if (i > 0) st.spent_s += row_cost(o, g.node(i) - g.lo);
+    if (i > 0) st.spent_s += row_seconds(g.node(i) - g.lo, o.ramp_mm_s, o.settle_s);
   }
   if (rows.back() != g.n) {
     st.stopped = "the top row is not measured yet";
@@ -53,7 +51,7 @@ AdaptiveStep next_row(const OnlineTableBuilder& fine, const AdaptiveOptions& o) 
   d.min_band_mm = 0.999 * g.step();  // a band one fine step wide has no fine node inside
   // The cheapest row the table allows (its lowest band halved): below it, the budget is spent.
   const Grid& tg = table.grid();
-  const double cheapest = row_cost(o, 0.5 * (tg.node(0) + tg.node(1)) - g.lo);
+  const double cheapest = row_seconds(0.5 * (tg.node(0) + tg.node(1)) - g.lo, o.ramp_mm_s, o.settle_s);
   d.budget_s = std::max(o.budget_s - st.spent_s, cheapest);
   const Design plan = design_rows(table, {}, d);
   st.estimated_rms_N = plan.rms_before_N;

@@ -90,7 +90,7 @@ void validate(const EverettTable& t, std::span<const double> sigma, const Design
   if (!sigma.empty() && sigma.size() != t.grid().cell_count())
     throw std::invalid_argument("design: the table's σ has " + std::to_string(sigma.size()) + " cells, its grid " + std::to_string(t.grid().cell_count()));
   const Grid& g = t.grid();
-  const double cheapest = 2.0 * (0.5 * (g.node(0) + g.node(1)) - g.lo) / o.ramp_mm_s + o.settle_s;
+  const double cheapest = row_seconds(0.5 * (g.node(0) + g.node(1)) - g.lo, o.ramp_mm_s, o.settle_s);
   if (!(o.budget_s >= cheapest) || !std::isfinite(o.budget_s)) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "design: budget_s %.4g s is below one row (the cheapest, up to %.4g mm and back at %.4g mm/s, takes %.4g s)", o.budget_s,
@@ -107,7 +107,7 @@ Design design_rows(const EverettTable& table, std::span<const double> cell_sigma
   const double range = g.hi - g.lo, min_band = o.min_band_mm > 0 ? o.min_band_mm : range / 1000;
   std::vector<Band> bands;
   for (int k = 0; k < g.n; ++k) bands.push_back(band_of(table, cell_sigma, k));
-  auto cost = [&](const Band& b) { return 2.0 * (b.lo + b.h / 2 - g.lo) / o.ramp_mm_s + o.settle_s; };
+  auto cost = [&](const Band& b) { return row_seconds(b.lo + b.h / 2 - g.lo, o.ramp_mm_s, o.settle_s); };
   double scale = 1.0;  // rounding in the divided differences is not an error to chase
   for (double v : table.values()) scale = std::max(scale, std::fabs(v));
   const double negligible = 1e-9 * scale;

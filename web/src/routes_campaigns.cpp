@@ -62,30 +62,29 @@ json last_fit(db::ReadSource& store, std::int64_t campaign) {
 }  // namespace
 
 json nodes_json(db::ReadSource& store, const db::CampaignRow& row) {
-  json nodes = json::array();
   const std::vector<db::NodeInfo> measured = store.nodes(row.id);
-  for (const db::NodeInfo& n : measured) nodes.push_back(node_json(n));
-  json out{{"campaign", row.id}, {"nodes", nodes}};
-  if (row.kind != domain::CampaignKind::fot) return out;
+  json out{{"campaign", row.id}, {"nodes", json::array()}};
+  if (row.kind != domain::CampaignKind::fot) {
+    for (const db::NodeInfo& n : measured) out["nodes"].push_back(node_json(n));
+    return out;
+  }
   // The stored plan through the one parser; the coverage counted by the table builder the daemon
   // fits with (a resumed campaign's node measured twice counts once), at the daemon's snapping.
   const domain::Plan plan = domain::parse_plan(json::parse(row.plan));
   const models::Grid fine = domain::node_grid(plan);
   models::OnlineTableBuilder builder(fine, 0.25 * fine.step());
   for (const db::NodeInfo& n : measured) (void)builder.add({n.alpha, n.beta, n.force_alpha, n.force_alpha_beta});
-  if (plan.design.adaptive) {  // the table is the rows measured whole (their own grid); the design's newest step
+  if (plan.design.adaptive) {  // the table is the rows measured whole (their own grid); the design's steps
     if (std::optional<models::OnlineTableBuilder> rows = models::rows_builder(builder)) builder = std::move(*rows);
     json steps = json::array();
     for (const domain::DesignEvent& e : db::events_of<domain::DesignEvent>(store, row.id)) steps.push_back(domain::detail_json(e));
     out["design"] = {{"finest_subdivisions", fine.n}, {"budget_s", plan.design.budget_s}, {"target_rms_N", plan.design.target_rms_N}, {"steps", steps}};
-    // The nodes of its table only: those between its rows wait for a row there.
-    const models::Grid& g = builder.grid();
-    json on_grid = json::array();
-    for (const db::NodeInfo& n : measured)
-      if (g.node_near(n.alpha, 1e-6 * (g.hi - g.lo)) >= 0 && g.node_near(n.beta, 1e-6 * (g.hi - g.lo)) >= 0) on_grid.push_back(node_json(n));
-    out["nodes"] = std::move(on_grid);
   }
   const models::Grid& g = builder.grid();
+  // An adaptive campaign's nodes of its table only: those between its rows wait for a row there.
+  const double tol = 1e-6 * (g.hi - g.lo);
+  for (const db::NodeInfo& n : measured)
+    if (!plan.design.adaptive || (g.node_near(n.alpha, tol) >= 0 && g.node_near(n.beta, tol) >= 0)) out["nodes"].push_back(node_json(n));
   out["grid"] = {{"n", g.n}, {"lo_mm", g.lo}, {"hi_mm", g.hi}, {"nodes_mm", g.nodes()}};
   out["identified"] = builder.identified_nodes();
   out["required"] = builder.required_nodes();

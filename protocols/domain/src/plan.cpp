@@ -2,6 +2,7 @@
 
 #include "field_reader.hpp"
 #include "hystlab/domain/record.hpp"
+#include "hystlab/models/fot_design.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -270,6 +271,6 @@ models::Grid fot_grid(const Plan& p) {
 
 models::Grid node_grid(const Plan& p) { return p.design.adaptive ? models::Grid::make(p.lo_mm, p.hi_mm, p.design.finest_subdivisions) : fot_grid(p); }
 
-double row_seconds(const Plan& p, double above_mm) { return 2.0 * (above_mm / p.ramp_rate_mm_s + p.dwell_s) + kRowSettle_s; }
+double row_seconds(const Plan& p, double above_mm) { return models::row_seconds(above_mm, p.ramp_rate_mm_s, 2.0 * p.dwell_s + kRowSettle_s); }
 
 }  // namespace hystlab::domain

@@ -54,8 +54,6 @@ struct AdaptiveStep {
 [[nodiscard]] std::vector<int> measured_rows(const OnlineTableBuilder& fine);
 // The table's builder: the measured rows on their own grid; empty when the top row (n) is not measured.
 [[nodiscard]] std::optional<OnlineTableBuilder> rows_builder(const OnlineTableBuilder& fine);
-// The rig seconds of a row with its top `alpha` (the cost model of the options).
-[[nodiscard]] double row_cost(const AdaptiveOptions& o, double above_lo_mm) noexcept;
 // The next row; the design's rule above. The fine grid's top row must be measured (the coarse rows
 // come first): before that the step says so and chooses none.
 [[nodiscard]] AdaptiveStep next_row(const OnlineTableBuilder& fine, const AdaptiveOptions& o);

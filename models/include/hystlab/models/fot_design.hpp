@@ -55,6 +55,11 @@ struct Design {
   std::string stopped;          // "target", "budget", "gain" or "rows", said in words
 };
 
+// A row's rig time, the one cost model of the design (and of an adaptive campaign's budget): up
+// from δmin to its top and down again at the ramp rate, plus a settle (its dwells and the servo's
+// arrival at both ends).
+[[nodiscard]] inline double row_seconds(double above_lo_mm, double ramp_mm_s, double settle_s) noexcept { return 2.0 * above_lo_mm / ramp_mm_s + settle_s; }
+
 // cell_sigma: Grid::cell_index order (PreisachFitResult's), or empty. Throws std::invalid_argument
 // naming the option for a budget below one row, a negative target or rate, or a σ of the wrong size.
 [[nodiscard]] Design design_rows(const EverettTable& table, std::span<const double> cell_sigma, const DesignOptions& options);
