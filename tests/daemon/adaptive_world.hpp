@@ -36,9 +36,10 @@ constexpr double kTestRateHz = 250;
 
 class World {
  public:
-  explicit World(double rate_hz = kTestRateHz)
-      : rig(sim::SimRig(std::make_unique<sim::LoadFrameSim>(std::make_unique<models::SimplifiedSmaModel>(models::table1_parameters()), sim::LoadFrameParams{})),
-            rate_hz) {
+  explicit World(double rate_hz = kTestRateHz) : World(rate_hz, std::make_unique<models::SimplifiedSmaModel>(models::table1_parameters())) {}
+  // Another specimen (an untrained one, a table) or frame (sharp corners) at the controller's rate.
+  World(double rate_hz, std::unique_ptr<models::HysteresisModel> specimen, const sim::LoadFrameParams& frame = {})
+      : rig(sim::SimRig(std::make_unique<sim::LoadFrameSim>(std::move(specimen), frame)), rate_hz) {
     b.sup = std::make_unique<daemon::Supervisor>(rig, domain::SupervisionSettings{}, false, [](const daemon::RigTransition&) {});
   }
   // Runs the plan (or resumes campaign `id` with what it measured); stop_after_design: once that
