@@ -56,4 +56,12 @@ InterpolationStencil EverettTable::stencil(double a, double b) const noexcept {
   return st;
 }
 
+void EverettTable::assign_blend(const EverettTable& a, const EverettTable& b, double w) {
+  if (a.values_.size() != values_.size() || b.values_.size() != values_.size())
+    throw std::invalid_argument("everett table: a blend of tables with " + std::to_string(a.values_.size()) + " and " + std::to_string(b.values_.size()) +
+                                " nodes into one with " + std::to_string(values_.size()));
+  for (std::size_t k = 0; k < values_.size(); ++k) values_[k] = (1.0 - w) * a.values_[k] + w * b.values_[k];
+  force_offset_ = (1.0 - w) * a.force_offset_ + w * b.force_offset_;
+}
+
 }  // namespace hystlab::models

@@ -14,7 +14,27 @@ PreisachModel::PreisachModel(std::shared_ptr<const EverettTable> table, Preisach
   if (!(options_.merge_tolerance >= 0.0)) throw std::invalid_argument("preisach: merge_tolerance must be >= 0");
   turning_.assign(options_.max_turning_points + 1, 0.0);     // + 1 spare slot
   closed_.assign(options_.max_turning_points / 2 + 2, 0.0);  // + 1 scratch slot
+  replay_.assign(options_.max_turning_points + 1, 0.0);
   reset();
+}
+
+void PreisachModel::replace_table(std::shared_ptr<const EverettTable> table) {
+  if (!table || !table->grid().same_nodes(table_->grid())) throw std::invalid_argument("preisach: the new table is not on the nodes of the model's table");
+  replace_table_on_same_nodes(std::move(table));
+}
+
+void PreisachModel::replace_table_on_same_nodes(std::shared_ptr<const EverettTable> table) noexcept {
+  const std::size_t len = now_.len;
+  const double x = now_.x;
+  const std::uint64_t saturations = saturations_, merges = merges_, invalid = invalid_;
+  std::copy(turning_.begin(), turning_.begin() + static_cast<std::ptrdiff_t>(len), replay_.begin());
+  table_ = std::move(table);
+  // The stored turning points alternate and nest (what the wiping-out rule left), so driving
+  // them again stores the same ones, and the sums of the closed pairs with the new table's values.
+  reset();
+  for (std::size_t k = 1; k < len; ++k) (void)step(replay_[k]);
+  (void)step(x);
+  saturations_ = saturations, merges_ = merges, invalid_ = invalid;
 }
 
 void PreisachModel::reset() noexcept {

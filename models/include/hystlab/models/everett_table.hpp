@@ -96,6 +96,11 @@ class EverettTable {
     return read<true>(a, b, rising, keep);
   }
 
+  // This table's values and offset become (1 - w)·a + w·b (a and b on this table's grid; the
+  // thermal model's blend, which allocates nothing). Throws std::invalid_argument when a or b has
+  // another number of nodes.
+  void assign_blend(const EverettTable& a, const EverettTable& b, double w);
+
   // The same interpolation as value(), as weights on nodes (for linear identification).
   [[nodiscard]] InterpolationStencil stencil(double a, double b) const noexcept;
 

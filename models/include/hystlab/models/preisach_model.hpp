@@ -46,6 +46,14 @@ class PreisachModel final : public HysteresisModel {
   [[nodiscard]] std::vector<double> save_state() const override;
   void restore_state(std::span<const double> state) override;
 
+  // The same memory read with another table on the same nodes (the thermal model's new
+  // temperature): the turning points and the input are driven again through it, O(depth), no
+  // allocation; the counters are kept. Throws std::invalid_argument for a table on other nodes.
+  void replace_table(std::shared_ptr<const EverettTable> table);
+  // The same for a table known to be on the model's nodes (unchecked: the thermal model's tables
+  // were checked once, when it was made).
+  void replace_table_on_same_nodes(std::shared_ptr<const EverettTable> table) noexcept;
+
   [[nodiscard]] std::uint64_t merge_count() const noexcept { return merges_; }
   [[nodiscard]] std::uint64_t invalid_input_count() const noexcept { return invalid_; }
   [[nodiscard]] std::size_t depth() const noexcept { return now_.len; }
@@ -71,6 +79,7 @@ class PreisachModel final : public HysteresisModel {
   PreisachOptions options_;
   std::vector<double> turning_;  // capacity max_turning_points + 1, first now_.len valid
   std::vector<double> closed_;   // closed_[k]: sum over the first k closed pairs
+  std::vector<double> replay_;   // replace_table's copy of the turning points (same capacity)
   // The state a step moves: stepped in place, peeked in a copy (advance).
   struct Now {
     std::size_t len = 1;  // turning points stored
