@@ -29,8 +29,9 @@ SmaThermalFit fit_sma_across_temperature(std::span<const SmaIsotherm> iso) {
     temps.insert(i.temperature_C);
   }
   if (iso.size() < 3 || temps.size() < 3)
-    throw std::invalid_argument("sma across temperature: loops at three different temperatures at least are needed (the lines' uncertainty needs residuals), got " +
-                                std::to_string(temps.size()));
+    throw std::invalid_argument(
+        "sma across temperature: loops at three different temperatures at least are needed (the lines' uncertainty needs residuals), got " +
+        std::to_string(temps.size()));
   // Unknowns [C, b_Ms, b_Mf, b_As, b_Af]; a row per isotherm and force.
   const Eigen::Index m = static_cast<Eigen::Index>(iso.size()) * 4;
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(m, 5);
@@ -52,7 +53,8 @@ SmaThermalFit fit_sma_across_temperature(std::span<const SmaIsotherm> iso) {
   const Eigen::MatrixXd cov = s2 * ldlt.solve(Eigen::MatrixXd::Identity(5, 5));
   SmaThermalFit out;
   const double C = theta(0);
-  if (!(C > 0)) throw std::invalid_argument("sma across temperature: the transformation forces do not rise with temperature (slope " + std::to_string(C) + " N/°C)");
+  if (!(C > 0))
+    throw std::invalid_argument("sma across temperature: the transformation forces do not rise with temperature (slope " + std::to_string(C) + " N/°C)");
   out.C = {C, std::sqrt(cov(0, 0))};
   // k0 = −b/C: gradient (b/C², −1/C) over (C, b).
   Estimate* zero[4] = {&out.Ms0, &out.Mf0, &out.As0, &out.Af0};

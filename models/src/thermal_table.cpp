@@ -44,8 +44,8 @@ ThermalTable make_thermal_table(std::vector<double> temperatures_C, std::vector<
       throw std::invalid_argument("thermal table: the temperatures must increase: " + degrees_text(T) + " °C follows " + degrees_text(temperatures_C[k - 1]) +
                                   " °C");
     if (k > 0 && !tables[k].grid().same_nodes(tables[0].grid()))
-      throw std::invalid_argument("thermal table: the table at " + degrees_text(T) + " °C is not on the nodes of the table at " + degrees_text(temperatures_C[0]) +
-                                  " °C (identify every temperature on one grid)");
+      throw std::invalid_argument("thermal table: the table at " + degrees_text(T) + " °C is not on the nodes of the table at " +
+                                  degrees_text(temperatures_C[0]) + " °C (identify every temperature on one grid)");
     out.tables.push_back(std::make_shared<const EverettTable>(std::move(tables[k])));
   }
   out.temperatures_C = std::move(temperatures_C);
@@ -93,7 +93,7 @@ void ThermalPreisachModel::retemper(double temperature_C) noexcept {
   double w = 0;
   neighbours(thermal_, temperature_, lo, w);
   next_->assign_blend(*thermal_.tables[lo], *thermal_.tables[lo + 1], w);  // same grid: cannot throw
-  inner_.replace_table_on_same_nodes(next_);                                // checked in make_thermal_table
+  inner_.replace_table_on_same_nodes(next_);                               // checked in make_thermal_table
   std::swap(now_, next_);
   blended_for_ = temperature_;
   ++reblends_;

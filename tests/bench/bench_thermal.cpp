@@ -39,7 +39,8 @@ std::vector<double> reversal_input(int reversals, unsigned seed, double step) {
   double cur = 0;
   for (int r = 0; r < reversals; ++r) {
     const bool up = r % 2 == 0;
-    const double target = up ? std::uniform_real_distribution<double>(cur + 0.2 * (4 - cur), 4)(rng) : std::uniform_real_distribution<double>(0, 0.8 * cur)(rng);
+    const double target =
+        up ? std::uniform_real_distribution<double>(cur + 0.2 * (4 - cur), 4)(rng) : std::uniform_real_distribution<double>(0, 0.8 * cur)(rng);
     const int n = std::max(1, static_cast<int>(std::fabs(target - cur) / step));
     for (int k = 1; k <= n; ++k) x.push_back(cur + (target - cur) * k / n);
     cur = target;
@@ -98,8 +99,8 @@ int main() {
       tabs.push_back(identify_virtual(s, g));
     }
     const ThermalTable series = make_thermal_table(ts, tabs);
-    std::printf("held-out RMS on a 12-reversal input over 0-4 mm (n = 24), tables every %.0f K from 22 to 38 °C (%zu temperatures), held out midway:\n", spacing,
-                ts.size());
+    std::printf("held-out RMS on a 12-reversal input over 0-4 mm (n = 24), tables every %.0f K from 22 to 38 °C (%zu temperatures), held out midway:\n",
+                spacing, ts.size());
     std::printf("  T °C | thermal Preisach | calibrated simplified | nearest table as is | identified there (floor) | thermal / floor | nearest / thermal\n");
     for (std::size_t k = 0; k + 1 < ts.size(); k += spacing > 3 ? 1 : 2) {
       const double Tv = 0.5 * (ts[k] + ts[k + 1]);
@@ -147,8 +148,8 @@ int main() {
     r_chamber.push_back(t_one / t_chamber);
     r_fast.push_back(t_one / t_fast);
     if (rep == 0)
-      std::printf("steps: %zu; one temperature %.1f Msteps/s; thermal: constant %.1f, 5 K/min %.1f (%llu blends), 1 K/s %.1f Msteps/s (%llu blends)\n", u.size(),
-                  static_cast<double>(u.size()) / t_one * 1e-6, static_cast<double>(u.size()) / t_const * 1e-6,
+      std::printf("steps: %zu; one temperature %.1f Msteps/s; thermal: constant %.1f, 5 K/min %.1f (%llu blends), 1 K/s %.1f Msteps/s (%llu blends)\n",
+                  u.size(), static_cast<double>(u.size()) / t_one * 1e-6, static_cast<double>(u.size()) / t_const * 1e-6,
                   static_cast<double>(u.size()) / t_chamber * 1e-6, static_cast<unsigned long long>(b_chamber), static_cast<double>(u.size()) / t_fast * 1e-6,
                   static_cast<unsigned long long>(b_fast));
   }

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <condition_variable>
 #include <deque>
 #include <filesystem>
 #include <future>
@@ -64,26 +65,31 @@ daemon::RunnerResult run_with_faults(std::int64_t id, const domain::Plan& plan, 
 }
 }  // namespace
 
-TEST_CASE("fot campaign n = 12: the online table equals the offline one and the specimen's") {
-  SimProcess sim({"--port", "0", "--time-scale", "200", "--noise", "0.05", "--corner-width", "0"});
+// Over Modbus TCP to hystlab-sim in real time at 20 times: the table made online is the one the
+// stored samples make offline, and everything is stored. At 0.5 mm/s a host stall's hole moves the
+// frame at most 0.2 mm (the simulator catches up 20 ms at most), under half a step of 1 mm, so no
+// node falls into one; at 200 times (until stop 44) one did, and rows were taken again. How close
+// the table is to the specimen's is measured on the fake clock (test_campaign_quality.cpp).
+TEST_CASE("fot campaign n = 4 over Modbus: the online table equals the offline one, every sample stored") {
+  SimProcess sim({"--port", "0", "--time-scale", "20", "--noise", "0.05", "--corner-width", "0"});
   Bench b;
   auto rig = tcp_rig(sim.modbus_port);
-  const auto plan = domain::parse_plan(fot_plan(12));
+  const auto plan = domain::parse_plan(fot_plan(4, 0.5));
   const auto id = b.submit(plan.source);
-  auto ctx = context(*rig, b, nullptr, 200);
+  auto ctx = context(*rig, b, nullptr, 20);
   const daemon::RunnerResult r = run(id, plan, ctx);
   b.writer->flush();
   CAPTURE(r.reason);
   REQUIRE(end_of(r) == "completed");
-  CHECK(r.nodes >= 78);  // 78 nodes, and the nodes of rows taken again after a hole in the data
+  CHECK(r.nodes >= 10);  // 10 nodes (and the nodes of a row taken again, were there a hole)
   REQUIRE(r.table_id);
   CHECK(r.lsq_table_id);
   CHECK(b.store->campaign(id)->state == domain::CampaignState::completed);
   // Offline: the same identification over the samples as stored.
-  const models::Grid g = models::Grid::make(0, 4, 12);
+  const models::Grid g = models::Grid::make(0, 4, 4);
   models::OnlineTableBuilder offline(g);
   daemon::OnlineFot fot(g, std::min(0.05 * g.step(), 0.02), [&](const models::FotNode& n, double) { (void)offline.add(n); });
-  fot.set_spacing(0.001 * 200);  // as online: 1 ms polls at time scale 200
+  fot.set_spacing(0.001 * 20);  // as online: 1 ms polls at time scale 20
   b.store->for_each_sample(r.run_id, 0, 1LL << 40, [&](const db::SampleRow& s) { fot.feed(s.t, s.disp, s.force, true); });
   fot.finish();
   REQUIRE(offline.complete());
@@ -93,12 +99,6 @@ TEST_CASE("fot campaign n = 12: the online table equals the offline one and the 
   const models::EverettTable online = models::table_from_json(st.column_text(0)).table;
   const models::EverettTable off = offline.table();
   for (std::size_t k = 0; k < online.values().size(); ++k) CHECK(online.values()[k] == doctest::Approx(off.values()[k]).epsilon(1e-12));
-  // Against the virtual identification of the simulator's specimen (Table 1): within the noise.
-  models::SimplifiedSmaModel sma(models::table1_parameters());
-  const models::EverettTable virt = models::identify_virtual(sma, g);
-  double worst = 0;
-  for (std::size_t k = 0; k < virt.values().size(); ++k) worst = std::max(worst, std::fabs(online.values()[k] - virt.values()[k]));
-  CHECK(worst < 3.0);  // N, on a 157 N range (noise 0.05 N, a sample every ~0.02 mm; host load can double it)
   // Every sample stored: the campaign's run, then the validation run after the rows.
   REQUIRE(r.validation_run_id > 0);
   CHECK(b.store->sample_count(r.validation_run_id) > 0);
@@ -111,7 +111,7 @@ TEST_CASE("fot campaign n = 12: the online table equals the offline one and the 
   CHECK(states == std::vector<std::string>{"queued", "arming", "running", "completed"});
   std::size_t fits = 0;
   for (const auto& e : ev) fits += e.kind == "fit" ? 1U : 0U;
-  CHECK(fits >= 12);  // one evaluation after each descent
+  CHECK(fits >= 4);  // one evaluation after each descent
 }
 
 TEST_CASE("safety: a force-limit trip aborts to the safe position, with the reason stored") {
@@ -143,16 +143,28 @@ TEST_CASE("operator: pause, a long pause's memory-aware resume, then abort") {
   auto ctx = context(*rig, b, &c, 200);
   std::vector<std::string> seen;
   std::mutex mu;
+  std::condition_variable cv;
   ctx.on_state = [&](const std::string& s) {
     std::lock_guard lk(mu);
     seen.push_back(s);
+    cv.notify_all();
+  };
+  // Each control once the loop has taken the one before (the states it reports), so that a stalled
+  // loop cannot take a pause and its resume in one tick: the pause lasts 100 ms of wall time after
+  // the loop took it, 20 rig-seconds at 200 times, longer than the 2 s threshold.
+  auto after = [&](std::size_t states) {
+    std::unique_lock lk(mu);
+    return cv.wait_for(lk, std::chrono::seconds(30), [&] { return seen.size() >= states; });
   };
   std::thread operator_thread([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    if (!after(2)) return;  // arming, running
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
     c.push(daemon::Control::pause);
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // 20 rig-seconds: longer than the threshold
+    if (!after(3)) return;  // paused
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
     c.push(daemon::Control::resume);
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    if (!after(4)) return;  // running
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
     c.push(daemon::Control::abort);
   });
   const auto r = run(id, plan, ctx);
@@ -173,8 +185,11 @@ TEST_CASE("operator e-stop: passed to the rig at once, the campaign aborted") {
   const auto id = b.submit(plan.source);
   Controls c;
   auto ctx = context(*rig, b, &c, 200);
-  std::thread op([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  std::atomic<bool> running{false};
+  ctx.on_state = [&](const std::string& s) { running = running || s == "running"; };
+  std::thread op([&] {  // 100 ms into the running campaign (of 1.4 s at least)
+    for (int k = 0; k < 30000 && !running; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
     c.push(daemon::Control::estop);
   });
   const auto r = run(id, plan, ctx);

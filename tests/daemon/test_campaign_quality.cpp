@@ -103,6 +103,23 @@ TEST_CASE("training until stable: at its maximum the campaign says the loop did 
   CHECK(s.event_details(w.id, "recommendation").empty());  // nothing held out: nothing recommended
 }
 
+TEST_CASE("fot campaign n = 12: the table within the noise of the specimen's") {
+  sim::LoadFrameParams sharp;
+  sharp.corner_width_mm = 0;  // the specimen's own corners, as identify_virtual sees them
+  World w(kTestRateHz, std::make_unique<models::SimplifiedSmaModel>(models::table1_parameters()), sharp);
+  const Outcome o = w.run(plan_at_rate(12));
+  CAPTURE(o.result.reason);
+  REQUIRE(end_of(o.result) == "completed");
+  CHECK(o.result.nodes == 78);  // no hole in the data on the fake clock: no row taken again
+  const models::EverettTable online = w.table(o.result);
+  models::SimplifiedSmaModel sma(models::table1_parameters());
+  const models::EverettTable virt = models::identify_virtual(sma, models::Grid::make(0, 4, 12));
+  double worst = 0;
+  for (std::size_t k = 0; k < virt.values().size(); ++k) worst = std::max(worst, std::fabs(online.values()[k] - virt.values()[k]));
+  MESSAGE("n = 12: worst node against the specimen's " << worst << " N");
+  CHECK(worst < 3.0);  // N, on a 157 N range (noise 0.05 N, a sample every 2 µm of travel)
+}
+
 TEST_CASE("fot campaign on a grid of its own: the rows go to its nodes, the table keeps them (format v2)") {
   sim::LoadFrameParams sharp;
   sharp.corner_width_mm = 0;  // the specimen's own corners, as identify_virtual sees them

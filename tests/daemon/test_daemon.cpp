@@ -103,7 +103,7 @@ bool eventually(F pred, int ms = 60000) {  // generous: a sanitizer build on a l
   return false;
 }
 
-const char* kConfig = R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 100, "noise_N": 0.05, "corner_width_mm": 0}}]})";
+const char* kConfig = R"({"rigs": [{"name": "sim frame", "simulate": {"time_scale": 50, "noise_N": 0.05, "corner_width_mm": 0}}]})";
 const char* kPlan = R"({"kind": "fot", "range_mm": [0, 4], "subdivisions": 12, "ramp_rate_mm_s": 0.1, "sample_rate_hz": 1000,
                         "limits": {"displacement_mm": [-0.5, 4.5], "force_N": 400, "rate_mm_s": 50}})";
 }  // namespace

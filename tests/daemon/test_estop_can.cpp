@@ -110,13 +110,20 @@ TEST_CASE("operator e-stop over CAN in every phase: written within two periods, 
       moved = std::max(moved, std::fabs(s.frame().displacement_mm - x0));
       if (seen < 0 && (s.status & protocols::status::estop)) seen = s.mono_s - pressed;
     }
+    const double x0_age = pressed - after.front().mono_s;
     MESSAGE(phase << ": e-stop in the status word " << seen * 1e3 << " ms after the press; moved " << moved << " mm");
     CHECK(seen >= 0);
-    CHECK(seen < 0.2);
-    CHECK(moved < 0.02);
+    // The latency is the scheduler's (the rig's thread and hystlab-sim must both run), bounded
+    // above as the API's twin (test_estop_phases.cpp) is; quiet runs see 4-9 ms. The frame moves
+    // at the plan's 1 mm/s from the last sample before the press until the e-stop shows in the
+    // status word, then stops within the controller's own 0.02 mm. (A fixed 0.02 mm failed the
+    // API's twin in stop 42 when a host stall put the e-stop 54.6 ms after the request.)
+    CHECK(seen < 0.5);
+    CHECK(moved < 1.0 * (x0_age + seen) + 0.02);
     w.supervisor->set_time_offset(0.0);
     auto reset = w.push_rig_command(control::RigCommand::reset);
-    idle(5);
+    // The reset is confirmed by a status read on the rig's thread: served until it is (5 s at most).
+    for (int k = 0; k < 250 && reset.wait_for(std::chrono::seconds(0)) != std::future_status::ready; ++k) idle(1);
     REQUIRE(reset.wait_for(std::chrono::seconds(0)) == std::future_status::ready);
     CHECK(reset.get().result == control::CommandOutcome::Result::done);
   }

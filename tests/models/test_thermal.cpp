@@ -32,8 +32,8 @@ std::vector<double> reversal_input(double lo, double hi, int reversals, unsigned
   double cur = lo;
   for (int r = 0; r < reversals; ++r) {
     const bool up = r % 2 == 0;
-    const double target = up ? std::uniform_real_distribution<double>(cur + 0.2 * (hi - cur), hi)(rng)
-                             : std::uniform_real_distribution<double>(lo, cur - 0.2 * (cur - lo))(rng);
+    const double target =
+        up ? std::uniform_real_distribution<double>(cur + 0.2 * (hi - cur), hi)(rng) : std::uniform_real_distribution<double>(lo, cur - 0.2 * (cur - lo))(rng);
     const int n = std::max(1, static_cast<int>(std::fabs(target - cur) / step));
     for (int k = 1; k <= n; ++k) x.push_back(cur + (target - cur) * k / n);
     cur = target;
@@ -79,8 +79,8 @@ TEST_CASE("preisach: a new table reads the same memory (the force is linear in t
     CAPTURE(k);
     REQUIRE(a.step(x[k]) == doctest::Approx(b.step(x[k])).epsilon(1e-12));
   }
-  CHECK_THROWS_WITH_AS(a.replace_table(std::make_shared<const EverettTable>(Grid::make(0, 4, 8))), "preisach: the new table is not on the nodes of the model's table",
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(a.replace_table(std::make_shared<const EverettTable>(Grid::make(0, 4, 8))),
+                       "preisach: the new table is not on the nodes of the model's table", std::invalid_argument);
 }
 
 TEST_CASE("thermal table: refused with what is wrong; at an identified temperature the table itself, between them the blend") {
@@ -88,9 +88,11 @@ TEST_CASE("thermal table: refused with what is wrong; at an identified temperatu
   SimplifiedSmaModel s25(at(25)), s35(at(35));
   const EverettTable t25 = identify_virtual(s25, g), t35 = identify_virtual(s35, g);
   CHECK_THROWS_WITH_AS((void)make_thermal_table({25}, {t25}), "thermal table: tables at two temperatures at least are needed, got 1", std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)make_thermal_table({35, 25}, {t35, t25}), "thermal table: the temperatures must increase: 25 °C follows 35 °C", std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)make_thermal_table({35, 25}, {t35, t25}), "thermal table: the temperatures must increase: 25 °C follows 35 °C",
+                       std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)make_thermal_table({25, 35}, {t25, identify_virtual(s35, Grid::make(0, 4, 8))}),
-                       "thermal table: the table at 35 °C is not on the nodes of the table at 25 °C (identify every temperature on one grid)", std::invalid_argument);
+                       "thermal table: the table at 35 °C is not on the nodes of the table at 25 °C (identify every temperature on one grid)",
+                       std::invalid_argument);
   const ThermalTable tt = make_thermal_table({25, 35}, {t25, t35});
   const EverettTable mid = table_at(tt, 30), low = table_at(tt, 25), below = table_at(tt, 10);
   for (std::size_t k = 0; k < mid.values().size(); ++k) {
@@ -168,9 +170,9 @@ TEST_CASE("simplified model across temperature: the slope and the zero-stress te
   const SmaThermalFit fit = fit_sma_across_temperature(iso);
   const SmaParameters truth = table1_parameters();
   MESSAGE("C " << fit.C.value << " ± " << fit.C.sigma << " N/°C; Ms0 " << fit.Ms0.value << " ± " << fit.Ms0.sigma << "; Mf0 " << fit.Mf0.value << " ± "
-               << fit.Mf0.sigma << "; As0 " << fit.As0.value << " ± " << fit.As0.sigma << "; Af0 " << fit.Af0.value << " ± " << fit.Af0.sigma << " °C; residual "
-               << fit.rms_residual_N << " N");
-  const std::pair<Estimate, double> checks[] = {{fit.C, truth.C},     {fit.Ms0, truth.Ms0}, {fit.Mf0, truth.Mf0},      {fit.As0, truth.As0},
+               << fit.Mf0.sigma << "; As0 " << fit.As0.value << " ± " << fit.As0.sigma << "; Af0 " << fit.Af0.value << " ± " << fit.Af0.sigma
+               << " °C; residual " << fit.rms_residual_N << " N");
+  const std::pair<Estimate, double> checks[] = {{fit.C, truth.C},     {fit.Ms0, truth.Ms0}, {fit.Mf0, truth.Mf0}, {fit.As0, truth.As0},
                                                 {fit.Af0, truth.Af0}, {fit.KA, truth.KA},   {fit.KM, truth.KM}};
   for (const auto& [e, want] : checks) {
     CAPTURE(e.value);

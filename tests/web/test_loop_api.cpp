@@ -100,10 +100,11 @@ TEST_CASE("a run's loop keeps every descent, with the model's force from the ser
     CHECK(run_j["quality"]["samples"] == run_j["samples"]);
     // the simulator runs 20x faster than real time: 500 Hz of wall time is 25 Hz of rig time, as expected (no warning)
     // (a starved machine misses samples: the rate may fall short, never exceed; and only a rate
-    // that falls short of the expected one is warned about)
+    // that falls short of the expected one is warned about). The lower bound is the order of
+    // magnitude: the run lasts about a second of wall time, half of which a stall can take.
     const double rate = run_j["quality"]["rate_hz"].get<double>();
     CHECK(rate < 25 * 1.05);
-    CHECK(rate > 25 * 0.5);
+    CHECK(rate > 25 * 0.2);
     CHECK(run_j["quality"]["expected_rate_hz"].get<double>() == doctest::Approx(25));
     bool rate_warned = false;
     for (const json& w : run_j["quality"]["warnings"]) rate_warned = rate_warned || w.get<std::string>().find("of rig time") != std::string::npos;

@@ -77,7 +77,9 @@ TEST_CASE("a plan beyond the rig's envelope is refused at submission, the field 
 TEST_CASE("another process holds the database's write lock for 8 s: an abort acts at once and the API keeps answering") {
   LiveDaemon ld;
   auto c = ld.client();
-  const auto id = submit(c, waveform({0, 6.0}, 0.5));
+  // 0.1 mm/s: 60 rig-seconds, 3 s of wall time at 20 times, for the lock and the abort to come mid-run
+  // (at 0.5 mm/s the motion lasted 0.6 s, which a stalled test thread could let end first).
+  const auto id = submit(c, waveform({0, 6.0}, 0.1));
   REQUIRE(ld.wait_json("/api/campaigns/" + std::to_string(id), [](const json& j) { return j["state"] == "running"; }));
   std::atomic<bool> locked{false};
   std::thread holder([&] {  // a second connection, as another process's would be

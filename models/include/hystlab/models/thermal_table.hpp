@@ -26,7 +26,7 @@
 namespace hystlab::models {
 
 struct ThermalTable {
-  std::vector<double> temperatures_C;                   // strictly increasing
+  std::vector<double> temperatures_C;                       // strictly increasing
   std::vector<std::shared_ptr<const EverettTable>> tables;  // one per temperature, on one grid
 };
 
