@@ -307,6 +307,15 @@ LoadedModel load_model(const Options& opt) {
     p = read_params_file(path);
     m.description = "simplified SMA model, parameters " + path;
   }
+  if (opt.has("temperature")) {  // hystlab eval --temperature: the specimen at another temperature
+    p.T = opt.number("temperature", p.T);
+    m.description += " at " + format_number(p.T) + " °C";
+    try {
+      models::validate(p);
+    } catch (const std::invalid_argument& e) {
+      throw CliError("--temperature " + format_number(p.T) + ": " + e.what());
+    }
+  }
   m.model = std::make_unique<models::SimplifiedSmaModel>(p);
   return m;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // Shared plumbing of the hystlab CLI: options, files, CSV. Every user error is a CliError,
 // printed as one line by main() with exit code 2.
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -67,6 +68,7 @@ class Csv {
   static Csv parse(const std::string& text, const std::string& name);
   // The named column as finite numbers; errors name the file, line and column.
   [[nodiscard]] std::vector<double> column(const std::string& name) const;
+  [[nodiscard]] bool has_column(const std::string& name) const { return std::find(header_.begin(), header_.end(), name) != header_.end(); }
   [[nodiscard]] std::size_t rows() const { return rows_.size(); }
   [[nodiscard]] std::size_t line_of(std::size_t row) const { return lines_[row]; }
 

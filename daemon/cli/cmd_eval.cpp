@@ -1,21 +1,34 @@
 // hystlab eval / invert: drive a model with a series from a CSV file.
+#include <cmath>
 #include <iostream>
+#include <sstream>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/inverse.hpp"
 #include "hystlab/models/preisach_model.hpp"
+#include "hystlab/models/thermal_table.hpp"
 
 namespace hystlab::cli {
 
 namespace {
 const char* kEvalHelp = R"(usage: hystlab eval (--table T.json | --model simplified [--params P.json]) --input X.csv [-o Y.csv] [--clamp]
+       hystlab eval --model simplified [--params P.json] --temperature T --input X.csv [-o Y.csv]
+       hystlab eval --table T1.json,T2.json,... --identified-at T1,T2,... (--temperature T | a temperature_C column)
+                    --input X.csv [-o Y.csv] [--clamp]
 
 Evaluates the model on the displacement series in column displacement_mm of X.csv (other
 columns are ignored) and writes displacement_mm,force_N to Y.csv (or standard output).
 A table model covers only its range: an input outside it is an error unless --clamp is given,
 which clamps and reports how many inputs were clamped.
+
+With temperature as an input: the simplified model at --temperature T (°C; its transformation
+forces move by C per °C); or tables identified at several temperatures of one specimen, on one
+grid, joined into a temperature-aware Preisach model (blended linearly between the two
+identified temperatures around T; docs/MODELS_IMPLEMENTATION.md "Temperature"), at
+--temperature T or at each line's temperature_C in X.csv (then written as a third column). A
+temperature outside the identified ones is an error unless --clamp is given.
 )";
 
 const char* kInvertHelp = R"(usage: hystlab invert --table T.json --input F.csv [-o Y.csv]
@@ -27,9 +40,66 @@ from the current state is an error naming its line.
 )";
 }  // namespace
 
+namespace {
+// Tables at several temperatures, as one temperature-aware Preisach model.
+int run_thermal_eval(const Options& opt) {
+  std::vector<std::string> paths;
+  std::stringstream list(opt.require("table"));
+  for (std::string p; std::getline(list, p, ',');) paths.push_back(p);
+  const std::vector<double> temps = opt.numbers("identified-at");
+  if (paths.size() != temps.size())
+    throw CliError("--identified-at: " + std::to_string(temps.size()) + " temperatures for " + std::to_string(paths.size()) + " tables in --table");
+  std::vector<models::EverettTable> tables;
+  for (const std::string& p : paths) tables.push_back(read_table_file(p).table);
+  models::ThermalTable tt;
+  try {
+    tt = models::make_thermal_table(temps, std::move(tables));
+  } catch (const std::invalid_argument& e) {
+    throw CliError(std::string("--table/--identified-at: ") + e.what());
+  }
+  const double lo = tt.tables[0]->grid().lo, hi = tt.tables[0]->grid().hi, tlo = temps.front(), thi = temps.back();
+  const bool clamp = opt.has("clamp");
+  const Csv csv = Csv::load(opt.require("input"));
+  const std::vector<double> x = csv.column("displacement_mm");
+  std::vector<double> temp;
+  if (opt.has("temperature")) {
+    if (csv.has_column("temperature_C")) throw CliError("--temperature: " + opt.get("input") + " has a temperature_C column too; give one or the other");
+    temp.assign(x.size(), opt.number("temperature", 0));
+  } else if (csv.has_column("temperature_C")) {
+    temp = csv.column("temperature_C");
+  } else {
+    throw CliError("tables at several temperatures need --temperature T or a temperature_C column in " + opt.get("input"));
+  }
+  for (std::size_t k = 0; k < x.size() && !clamp; ++k) {
+    const std::string where = opt.has("temperature") ? "--temperature" : opt.get("input") + ": line " + std::to_string(csv.line_of(k));
+    if (!(temp[k] >= tlo && temp[k] <= thi))
+      throw CliError(where + ": temperature " + format_number(temp[k]) + " °C is outside the identified " + format_number(tlo) + ".." + format_number(thi) +
+                     " °C (--clamp clamps and counts)");
+    if (x[k] < lo || x[k] > hi)
+      throw CliError(opt.get("input") + ": line " + std::to_string(csv.line_of(k)) + ": displacement " + format_number(x[k]) +
+                     " mm is outside the tables' range " + format_number(lo) + ".." + format_number(hi) + " mm (--clamp clamps and counts)");
+  }
+  models::ThermalPreisachModel model(tt, !temp.empty() && std::isfinite(temp[0]) ? temp[0] : tlo);
+  std::vector<double> f(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    model.set_temperature(temp[k]);
+    f[k] = model.step(x[k]);
+  }
+  write_output(opt.get("output"),
+               opt.has("temperature") ? to_csv({"displacement_mm", "force_N"}, {x, f}) : to_csv({"displacement_mm", "temperature_C", "force_N"}, {x, temp, f}));
+  if (model.saturation_count() || model.temperature_saturation_count())
+    std::cerr << "hystlab: " << model.saturation_count() << " displacement(s) outside " << format_number(lo) << ".." << format_number(hi) << " mm and "
+              << model.temperature_saturation_count() << " temperature(s) outside " << format_number(tlo) << ".." << format_number(thi) << " °C were clamped\n";
+  return 0;
+}
+}  // namespace
+
 int run_eval(const Args& args) {
   if (print_help_if_asked(args, kEvalHelp)) return 0;
-  const Options opt(args, {"table", "model", "params", "input", "output"}, {"clamp"});
+  const Options opt(args, {"table", "model", "params", "input", "output", "temperature", "identified-at"}, {"clamp"});
+  if (opt.has("identified-at")) return run_thermal_eval(opt);
+  if (opt.has("temperature") && opt.has("table"))
+    throw CliError("--temperature: a table is identified at one temperature; give the tables of several with --table T1.json,T2.json --identified-at T1,T2");
   LoadedModel m = load_model(opt);
   const Csv csv = Csv::load(opt.require("input"));
   const std::vector<double> x = csv.column("displacement_mm");
