@@ -103,7 +103,8 @@ TEST_CASE("cli: eval at a temperature: tables identified at three joined, the si
   check_error(w.run("eval --table t22.json --temperature 22 --input X.csv"), "--temperature: a table is identified at one temperature");
   check_error(w.run("eval --model simplified --temperature 45 --input X.csv"), "--temperature 45: ");
   w.write("XT2.csv", "displacement_mm,temperature_C\n0,22\n1,40\n");
-  check_error(w.run("eval --table t22.json,t26.json --identified-at 22,26 --input XT2.csv"), "XT2.csv: line 3: temperature 40 °C is outside the identified 22..26 °C");
+  check_error(w.run("eval --table t22.json,t26.json --identified-at 22,26 --input XT2.csv"),
+              "XT2.csv: line 3: temperature 40 °C is outside the identified 22..26 °C");
   const auto clamped = w.run("eval --table t22.json,t26.json --identified-at 22,26 --input XT2.csv --clamp");
   CHECK(clamped.code == 0);
   CHECK(clamped.err.find("1 temperature(s) outside 22..26 °C were clamped") != std::string::npos);
