@@ -285,6 +285,30 @@ std::string aligned_table(const std::vector<Column>& columns, const std::vector<
   return out;
 }
 
+namespace {
+// Where the simplified model with p's parameters is defined, in words: from above Af0 (austenite
+// at rest) to where a transformation line becomes as steep as an elastic one (found by bisection:
+// every condition of validate() is linear in T).
+std::string superelastic_range(models::SmaParameters p) {
+  auto ok = [&p](double T) {
+    p.T = T;
+    try {
+      models::validate(p);
+      return true;
+    } catch (const std::invalid_argument&) {
+      return false;
+    }
+  };
+  double lo = p.Af0 + 1e-6, hi = p.Af0 + 1000;
+  if (!ok(lo)) return "the simplified model with these parameters is not superelastic at any temperature";
+  if (ok(hi)) return "the simplified model with these parameters holds above Af0 = " + format_number(p.Af0) + " °C";
+  for (int k = 0; k < 60; ++k) (ok(0.5 * (lo + hi)) ? lo : hi) = 0.5 * (lo + hi);
+  char b[128];
+  std::snprintf(b, sizeof b, "the simplified model with these parameters holds from Af0 = %g °C to %.1f °C", p.Af0, lo);
+  return b;
+}
+}  // namespace
+
 LoadedModel load_model(const Options& opt) {
   LoadedModel m;
   if (opt.has("table")) {
@@ -313,7 +337,7 @@ LoadedModel load_model(const Options& opt) {
     try {
       models::validate(p);
     } catch (const std::invalid_argument& e) {
-      throw CliError("--temperature " + format_number(p.T) + ": " + e.what());
+      throw CliError("--temperature " + format_number(p.T) + ": " + superelastic_range(p) + " (" + e.what() + ")");
     }
   }
   m.model = std::make_unique<models::SimplifiedSmaModel>(p);

@@ -1,4 +1,5 @@
 // hystlab eval / invert: drive a model with a series from a CSV file.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <sstream>
@@ -15,7 +16,7 @@ namespace hystlab::cli {
 namespace {
 const char* kEvalHelp = R"(usage: hystlab eval (--table T.json | --model simplified [--params P.json]) --input X.csv [-o Y.csv] [--clamp]
        hystlab eval --model simplified [--params P.json] --temperature T --input X.csv [-o Y.csv]
-       hystlab eval --table T1.json,T2.json,... --identified-at T1,T2,... (--temperature T | a temperature_C column)
+       hystlab eval --table T1.json,T2.json,... [--identified-at T1,T2,...] (--temperature T | a temperature_C column)
                     --input X.csv [-o Y.csv] [--clamp]
 
 Evaluates the model on the displacement series in column displacement_mm of X.csv (other
@@ -25,10 +26,13 @@ which clamps and reports how many inputs were clamped.
 
 With temperature as an input: the simplified model at --temperature T (°C; its transformation
 forces move by C per °C); or tables identified at several temperatures of one specimen, on one
-grid, joined into a temperature-aware Preisach model (blended linearly between the two
-identified temperatures around T; docs/MODELS_IMPLEMENTATION.md "Temperature"), at
+grid, comma-separated, joined into a temperature-aware Preisach model (blended linearly between
+the two identified temperatures around T, again when T moves 0.01 K; docs/
+MODELS_IMPLEMENTATION.md "Temperature"), at
 --temperature T or at each line's temperature_C in X.csv (then written as a third column). A
-temperature outside the identified ones is an error unless --clamp is given.
+temperature outside the identified ones is an error unless --clamp is given. Without
+--identified-at, each table's own provenance.temperature_C is taken (`hystlab identify --model
+simplified` writes the parameters' T_degC there).
 )";
 
 const char* kInvertHelp = R"(usage: hystlab invert --table T.json --input F.csv [-o Y.csv]
@@ -43,14 +47,29 @@ from the current state is an error naming its line.
 namespace {
 // Tables at several temperatures, as one temperature-aware Preisach model.
 int run_thermal_eval(const Options& opt) {
+  if (opt.has("model") || opt.has("params")) throw CliError("--identified-at joins tables: give --table T1.json,T2.json,... without --model or --params");
   std::vector<std::string> paths;
   std::stringstream list(opt.require("table"));
-  for (std::string p; std::getline(list, p, ',');) paths.push_back(p);
-  const std::vector<double> temps = opt.numbers("identified-at");
-  if (paths.size() != temps.size())
+  for (std::string p; std::getline(list, p, ',');) {
+    const auto b = p.find_first_not_of(" \t"), e = p.find_last_not_of(" \t");
+    paths.push_back(b == std::string::npos ? "" : p.substr(b, e - b + 1));
+  }
+  // The temperatures: --identified-at, or each table's own (provenance.temperature_C, which
+  // `hystlab identify --model simplified` writes), the tables then taken in their order.
+  std::vector<double> temps = opt.numbers("identified-at");
+  if (opt.has("identified-at") && paths.size() != temps.size())
     throw CliError("--identified-at: " + std::to_string(temps.size()) + " temperatures for " + std::to_string(paths.size()) + " tables in --table");
+  std::vector<std::pair<double, models::EverettTable>> read;
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    models::TableDocument doc = read_table_file(paths[k]);
+    if (!opt.has("identified-at") && !doc.provenance.temperature_C)
+      throw CliError(paths[k] + ": the table does not say the temperature it was identified at (provenance.temperature_C): give --identified-at T1,T2,...");
+    read.emplace_back(opt.has("identified-at") ? temps[k] : *doc.provenance.temperature_C, std::move(doc.table));
+  }
+  if (!opt.has("identified-at")) std::stable_sort(read.begin(), read.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  temps.clear();
   std::vector<models::EverettTable> tables;
-  for (const std::string& p : paths) tables.push_back(read_table_file(p).table);
+  for (auto& [T, t] : read) temps.push_back(T), tables.push_back(std::move(t));
   models::ThermalTable tt;
   try {
     tt = models::make_thermal_table(temps, std::move(tables));
@@ -79,10 +98,11 @@ int run_thermal_eval(const Options& opt) {
       throw CliError(opt.get("input") + ": line " + std::to_string(csv.line_of(k)) + ": displacement " + format_number(x[k]) +
                      " mm is outside the tables' range " + format_number(lo) + ".." + format_number(hi) + " mm (--clamp clamps and counts)");
   }
-  models::ThermalPreisachModel model(tt, !temp.empty() && std::isfinite(temp[0]) ? temp[0] : tlo);
+  models::ThermalPreisachModel model(tt, temp.at(0));  // the CSV's numbers are finite (Csv::column)
   std::vector<double> f(x.size());
   for (std::size_t k = 0; k < x.size(); ++k) {
     model.set_temperature(temp[k]);
+    temp[k] = model.temperature();  // as used: clamped with --clamp
     f[k] = model.step(x[k]);
   }
   write_output(opt.get("output"),
@@ -97,7 +117,7 @@ int run_thermal_eval(const Options& opt) {
 int run_eval(const Args& args) {
   if (print_help_if_asked(args, kEvalHelp)) return 0;
   const Options opt(args, {"table", "model", "params", "input", "output", "temperature", "identified-at"}, {"clamp"});
-  if (opt.has("identified-at")) return run_thermal_eval(opt);
+  if (opt.has("identified-at") || opt.get("table").find(',') != std::string::npos) return run_thermal_eval(opt);
   if (opt.has("temperature") && opt.has("table"))
     throw CliError("--temperature: a table is identified at one temperature; give the tables of several with --table T1.json,T2.json --identified-at T1,T2");
   LoadedModel m = load_model(opt);

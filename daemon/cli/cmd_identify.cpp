@@ -7,6 +7,7 @@
 #include "hystlab/models/fit_report.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/fot_identification.hpp"
+#include "hystlab/models/simplified_sma.hpp"
 #include "hystlab/models/sma_calibration.hpp"
 
 namespace hystlab::cli {
@@ -122,6 +123,7 @@ int run_identify(const Args& args) {
     prov.source = m.description;
     prov.method = "virtual-fot";
     prov.from = opt.get("params", "built-in Table 1");
+    if (const auto* sma = dynamic_cast<const models::SimplifiedSmaModel*>(m.model.get())) prov.temperature_C = sma->parameters().T;
     std::cout << "identified " << grid_text(g) << " (" << g.node_count() << " nodes) from the " << m.description << "\n";
   }
   write_file(out, models::table_to_json(table, prov).dump(2) + "\n");
@@ -167,7 +169,7 @@ int run_fit(const Args& args) {
   }
   const models::PreisachFitResult r = models::fit_preisach(x, y, grid, fo);
   const models::PriorFit& c = r.chosen;
-  models::TableProvenance prov{"displacement/force record", "lsq", now_iso8601(), path, models::fit_provenance(r)};
+  models::TableProvenance prov{"displacement/force record", "lsq", now_iso8601(), path, models::fit_provenance(r), {}};
   write_file(out, models::table_to_json(c.table, prov).dump(2) + "\n");
   std::cout << "fitted " << grid_text(c.table.grid()) << " to " << x.size() << " samples in " << format_number(r.seconds) << " s ("
             << format_number(static_cast<double>(r.peak_bytes) / 1048576.0) << " MiB)"

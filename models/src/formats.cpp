@@ -50,6 +50,8 @@ json table_to_json(const EverettTable& t, const TableProvenance& p) {
     for (int j = 0; j <= i; ++j) row.push_back(t.node_value(i, j));
     rows.push_back(std::move(row));
   }
+  json prov{{"source", p.source}, {"method", p.method}, {"created", p.created}, {"from", p.from}, {"n", g.n}, {"details", p.extra}};
+  if (p.temperature_C) prov["temperature_C"] = *p.temperature_C;
   return json{{"format", kTableFormat},
               {"version", g.uniform() ? kTableVersion : kTableVersionNodes},
               {"units", {{"displacement", "mm"}, {"force", "N"}}},
@@ -58,7 +60,7 @@ json table_to_json(const EverettTable& t, const TableProvenance& p) {
               {"nodes_mm", std::move(nodes)},
               {"force_offset_N", t.force_offset()},
               {"rows", std::move(rows)},
-              {"provenance", {{"source", p.source}, {"method", p.method}, {"created", p.created}, {"from", p.from}, {"n", g.n}, {"details", p.extra}}}};
+              {"provenance", std::move(prov)}};
 }
 
 TableDocument table_from_json(std::string_view text) {
@@ -133,6 +135,7 @@ TableDocument parse_table(std::string_view text) {
     doc.provenance.created = text_or_empty(*p, "created");
     doc.provenance.from = text_or_empty(*p, "from");
     if (const auto d = p->find("details"); d != p->end()) doc.provenance.extra = *d;
+    if (const auto t = p->find("temperature_C"); t != p->end()) doc.provenance.temperature_C = number(*t, "provenance.temperature_C", what);
   }
   return doc;
 }

@@ -15,9 +15,9 @@ std::string degrees_text(double v) {
   return b;
 }
 
-// The model's first temperature: a number, clamped to the identified range.
+// The model's first temperature: a number, clamped to the identified range of a checked table.
 double first_temperature(const ThermalTable& t, double T) {
-  if (t.temperatures_C.size() < 2) throw std::invalid_argument("thermal model: tables at two temperatures at least are needed");
+  check_thermal_table(t);
   if (!std::isfinite(T)) throw std::invalid_argument("thermal model: the temperature is not a finite number");
   return std::clamp(T, t.temperatures_C.front(), t.temperatures_C.back());
 }
@@ -32,27 +32,35 @@ void neighbours(const ThermalTable& t, double T, std::size_t& lo, double& w) noe
 }
 }  // namespace
 
-ThermalTable make_thermal_table(std::vector<double> temperatures_C, std::vector<EverettTable> tables) {
-  if (temperatures_C.size() != tables.size())
-    throw std::invalid_argument("thermal table: " + std::to_string(temperatures_C.size()) + " temperatures for " + std::to_string(tables.size()) + " tables");
-  if (tables.size() < 2) throw std::invalid_argument("thermal table: tables at two temperatures at least are needed, got " + std::to_string(tables.size()));
-  ThermalTable out;
-  for (std::size_t k = 0; k < tables.size(); ++k) {
-    const double T = temperatures_C[k];
+void check_thermal_table(const ThermalTable& t) {
+  if (t.temperatures_C.size() != t.tables.size())
+    throw std::invalid_argument("thermal table: " + std::to_string(t.temperatures_C.size()) + " temperatures for " + std::to_string(t.tables.size()) +
+                                " tables");
+  if (t.tables.size() < 2) throw std::invalid_argument("thermal table: tables at two temperatures at least are needed, got " + std::to_string(t.tables.size()));
+  for (std::size_t k = 0; k < t.tables.size(); ++k) {
+    const double T = t.temperatures_C[k];
+    if (!t.tables[k]) throw std::invalid_argument("thermal table: no table at temperature " + std::to_string(k + 1));
     if (!std::isfinite(T)) throw std::invalid_argument("thermal table: temperature " + std::to_string(k + 1) + " is not a finite number");
-    if (k > 0 && !(T > temperatures_C[k - 1]))
-      throw std::invalid_argument("thermal table: the temperatures must increase: " + degrees_text(T) + " °C follows " + degrees_text(temperatures_C[k - 1]) +
+    if (k > 0 && !(T > t.temperatures_C[k - 1]))
+      throw std::invalid_argument("thermal table: the temperatures must increase: " + degrees_text(T) + " °C follows " + degrees_text(t.temperatures_C[k - 1]) +
                                   " °C");
-    if (k > 0 && !tables[k].grid().same_nodes(tables[0].grid()))
+    if (k > 0 && !t.tables[k]->grid().same_nodes(t.tables[0]->grid()))
       throw std::invalid_argument("thermal table: the table at " + degrees_text(T) + " °C is not on the nodes of the table at " +
-                                  degrees_text(temperatures_C[0]) + " °C (identify every temperature on one grid)");
-    out.tables.push_back(std::make_shared<const EverettTable>(std::move(tables[k])));
+                                  degrees_text(t.temperatures_C[0]) + " °C (identify every temperature on one grid)");
   }
+}
+
+ThermalTable make_thermal_table(std::vector<double> temperatures_C, std::vector<EverettTable> tables) {
+  ThermalTable out;
+  for (EverettTable& e : tables) out.tables.push_back(std::make_shared<const EverettTable>(std::move(e)));
   out.temperatures_C = std::move(temperatures_C);
+  check_thermal_table(out);
   return out;
 }
 
 EverettTable table_at(const ThermalTable& t, double temperature_C) {
+  check_thermal_table(t);
+  if (std::isnan(temperature_C)) throw std::invalid_argument("thermal table: the temperature is not a number");
   std::size_t lo = 0;
   double w = 0;
   neighbours(t, temperature_C, lo, w);
@@ -70,16 +78,23 @@ ThermalPreisachModel::ThermalPreisachModel(ThermalTable table, double temperatur
       next_(std::make_shared<EverettTable>(*now_)),
       inner_(now_, options) {
   if (!(tolerance_K >= 0) || !std::isfinite(tolerance_K)) throw std::invalid_argument("thermal model: the tolerance must be a finite number of kelvin >= 0");
+  if (temperature_C != temperature_) ++t_saturations_;  // clamped to the identified range: counted
 }
 
-std::unique_ptr<HysteresisModel> ThermalPreisachModel::clone() const {
-  auto c = std::make_unique<ThermalPreisachModel>(*this);
-  // Its own two tables: a clone's new temperature must not write into the table this one reads.
-  c->now_ = std::make_shared<EverettTable>(*now_);
-  c->next_ = std::make_shared<EverettTable>(*next_);
-  c->inner_.replace_table(c->now_);
-  return c;
+ThermalPreisachModel::ThermalPreisachModel(const ThermalPreisachModel& o)
+    : thermal_(o.thermal_),
+      tolerance_K_(o.tolerance_K_),
+      temperature_(o.temperature_),
+      blended_for_(o.blended_for_),
+      t_saturations_(o.t_saturations_),
+      reblends_(o.reblends_),
+      now_(std::make_shared<EverettTable>(*o.now_)),
+      next_(std::make_shared<EverettTable>(*o.next_)),
+      inner_(o.inner_) {
+  inner_.use_copy_of_table(now_);  // the same values: the same memory, read from its own table
 }
+
+std::unique_ptr<HysteresisModel> ThermalPreisachModel::clone() const { return std::make_unique<ThermalPreisachModel>(*this); }
 
 void ThermalPreisachModel::retemper(double temperature_C) noexcept {
   const std::vector<double>& ts = thermal_.temperatures_C;

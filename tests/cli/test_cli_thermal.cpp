@@ -101,11 +101,38 @@ TEST_CASE("cli: eval at a temperature: tables identified at three joined, the si
   check_error(w.run("eval --table t22.json,t26.json --identified-at 22,26 --input X.csv"),
               "tables at several temperatures need --temperature T or a temperature_C column in X.csv");
   check_error(w.run("eval --table t22.json --temperature 22 --input X.csv"), "--temperature: a table is identified at one temperature");
-  check_error(w.run("eval --model simplified --temperature 45 --input X.csv"), "--temperature 45: ");
+  check_error(w.run("eval --model simplified --temperature 45 --input X.csv"),
+              "--temperature 45: the simplified model with these parameters holds from Af0 = 21.5 °C to 40.9 °C (parameters: ");
+  // Without --identified-at: each table's own temperature (identify wrote the parameters' T), in any order.
+  const auto own = w.run("eval --table t30.json,t22.json,t26.json --temperature 27 --input X.csv");
+  REQUIRE(own.code == 0);
+  CHECK(own.out == at27.out);
+  CHECK(nlohmann::json::parse(slurp(w / "t26.json"))["provenance"]["temperature_C"] == 26);
+  w.write("t_anon.json", [&] {
+    auto j = nlohmann::json::parse(slurp(w / "t26.json"));
+    j["provenance"].erase("temperature_C");
+    return j.dump();
+  }());
+  w.write("t_warm.json", [&] {
+    auto j = nlohmann::json::parse(slurp(w / "t26.json"));
+    j["provenance"]["temperature_C"] = "warm";
+    return j.dump();
+  }());
+  check_error(w.run("eval --table t22.json,t_warm.json --input XT.csv"), "'provenance.temperature_C' must be a number");
+  check_error(w.run("eval --table t22.json,t_anon.json --input XT.csv"),
+              "t_anon.json: the table does not say the temperature it was identified at (provenance.temperature_C): give --identified-at");
+  check_error(w.run("eval --table t22.json,t26.json --identified-at 22,26 --model simplified --input XT.csv"), "without --model or --params");
+  check_error(w.run("eval --table t22.json,t26.json --identified-at 22,26 --temperature 24 --input XT.csv"), "has a temperature_C column too");
+  w.write("XT3.csv", "displacement_mm,temperature_C\n0,22\n1,warm\n");
+  check_error(w.run("eval --table t22.json,t26.json --identified-at 22,26 --input XT3.csv"), "XT3.csv: line 3, column 'temperature_C': 'warm' is not a number");
+  REQUIRE(w.run("identify --model simplified --params p26.json --range 0,4 --subdivisions 8 -o t26_8.json").code == 0);
+  check_error(w.run("eval --table t22.json,t26_8.json --identified-at 22,26 --temperature 24 --input X.csv"),
+              "the table at 26 °C is not on the nodes of the table at 22 °C");
   w.write("XT2.csv", "displacement_mm,temperature_C\n0,22\n1,40\n");
   check_error(w.run("eval --table t22.json,t26.json --identified-at 22,26 --input XT2.csv"),
               "XT2.csv: line 3: temperature 40 °C is outside the identified 22..26 °C");
   const auto clamped = w.run("eval --table t22.json,t26.json --identified-at 22,26 --input XT2.csv --clamp");
   CHECK(clamped.code == 0);
   CHECK(clamped.err.find("1 temperature(s) outside 22..26 °C were clamped") != std::string::npos);
+  CHECK(column_of(clamped.out, 1) == std::vector<double>{22, 26});  // the temperature used, clamped
 }

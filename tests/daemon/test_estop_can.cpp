@@ -115,8 +115,9 @@ TEST_CASE("operator e-stop over CAN in every phase: written within two periods, 
     CHECK(seen >= 0);
     // The latency is the scheduler's (the rig's thread and hystlab-sim must both run): measured in
     // stop 44 over 20 runs of this test (100 presses) in the ASan tree with stress-ng --cpu 1
-    // beside it, median 7.5 ms, 95th percentile 28 ms, worst 164 ms; the bound is 3 times the
-    // worst, as the API's twin (test_estop_phases.cpp). Moved at most 0.003 mm then. The frame moves
+    // beside it, median 7.5 ms, 95th percentile 28 ms, worst 164 ms (paused, the frame held); the
+    // bound is 3 times the worst, as the API's twin's (tests/web/test_estop_phases.cpp). Moved at
+    // most 0.003 mm then. The frame moves
     // at the plan's 1 mm/s from the last sample before the press until the e-stop shows in the
     // status word, then stops within the controller's own 0.02 mm. (A fixed 0.02 mm failed the
     // API's twin in stop 42 when a host stall put the e-stop 54.6 ms after the request.)

@@ -2,6 +2,7 @@
 // File formats of tables and model parameters, as pure text <-> object conversions (no I/O).
 // Documented in docs/FORMATS.md. Errors throw FormatError naming the field and the reason.
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -29,6 +30,8 @@ struct TableProvenance {
   std::string created;                              // ISO 8601 time, supplied by the caller
   std::string from;                                 // input file, run id, ...
   nlohmann::json extra = nlohmann::json::object();  // accuracy, drift, fit figures
+  std::optional<double> temperature_C =
+      std::nullopt;  // the specimen's temperature when identified, when known (an initializer: brace-initialized provenances need not name it)
 };
 
 struct TableDocument {

@@ -53,6 +53,9 @@ class PreisachModel final : public HysteresisModel {
   // The same for a table known to be on the model's nodes (unchecked: the thermal model's tables
   // were checked once, when it was made).
   void replace_table_on_same_nodes(std::shared_ptr<const EverettTable> table) noexcept;
+  // A copy of the model's own table (the same nodes and values: a copied model's own): nothing is
+  // read again, so every later output is the same to the last bit.
+  void use_copy_of_table(std::shared_ptr<const EverettTable> copy) noexcept { table_ = std::move(copy); }
 
   [[nodiscard]] std::uint64_t merge_count() const noexcept { return merges_; }
   [[nodiscard]] std::uint64_t invalid_input_count() const noexcept { return invalid_; }

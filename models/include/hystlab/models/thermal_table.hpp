@@ -9,9 +9,10 @@
 // the simplified model (docs/MODELS.md §2) moves its transformation forces by C·ΔT but not its
 // loop's shape alone: the start of the forward plateau moves by C·ΔT/KA, its end by C·ΔT/KM, so
 // the plateau's slope steepens with T (Table 1: 12.3 N/mm at 25 °C, 21.8 N/mm at 35 °C) and no
-// translation of a table follows it. The forces on a plateau are linear in T; the blend is exact
-// there and wrong only near the corners, which move by C·ΔT/KA between two tables (docs/
-// MODELS_IMPLEMENTATION.md "Temperature": the held-out figures of both rules).
+// translation of a table follows it (argued, not measured). The blend is nearly right on the
+// plateaus (their force is rational in T, not linear: 0.50 N off at 2.5 mm midway between 30
+// and 34 °C) and wrong most near the corners, which move by C·ΔT/KA between two tables (docs/
+// MODELS_IMPLEMENTATION.md "Temperature": the held-out figures).
 //
 // Outside the identified range the model does not extrapolate: the temperature is clamped to the
 // range and counted (temperature_saturation_count), as an input outside the grid is.
@@ -33,8 +34,11 @@ struct ThermalTable {
 // Throws std::invalid_argument naming what is wrong: fewer than two tables, a temperature that is
 // not finite or not above the one before, a table on another grid than the first.
 [[nodiscard]] ThermalTable make_thermal_table(std::vector<double> temperatures_C, std::vector<EverettTable> tables);
+// The same checks on a table put together by hand (the model and table_at make them).
+void check_thermal_table(const ThermalTable& t);
 
-// The table at T (clamped to the identified range): the blend of its two neighbours.
+// The table at T (clamped to the identified range): the blend of its two neighbours. Throws
+// std::invalid_argument for a T that is not a number.
 [[nodiscard]] EverettTable table_at(const ThermalTable& t, double temperature_C);
 
 class ThermalPreisachModel final : public HysteresisModel {
@@ -42,6 +46,10 @@ class ThermalPreisachModel final : public HysteresisModel {
   // tolerance_K: the table is blended again when T has moved further than this from the one it
   // was blended for (0.01 K by default: C·0.01 K = 0.06 N with Table 1, the simulator's noise).
   ThermalPreisachModel(ThermalTable table, double temperature_C, PreisachOptions options = {}, double tolerance_K = 0.01);
+  // A copy has tables of its own (a new temperature of one never writes into what the other
+  // reads); assignment is not offered.
+  ThermalPreisachModel(const ThermalPreisachModel& other);
+  ThermalPreisachModel& operator=(const ThermalPreisachModel&) = delete;
 
   // The specimen's temperature from now on; the memory is kept (its forces re-read with the new
   // table). Not a step: a change of T at constant x moves F only through the table.
@@ -62,6 +70,7 @@ class ThermalPreisachModel final : public HysteresisModel {
   [[nodiscard]] std::size_t depth() const noexcept { return inner_.depth(); }
   [[nodiscard]] const ThermalTable& tables() const noexcept { return thermal_; }
 
+  // Back to the start state; the temperature and the counters of temperatures are kept.
   void reset() noexcept override { inner_.reset(); }
   [[gnu::always_inline]] double step(double x) noexcept override { return inner_.step(x); }
   [[nodiscard]] double peek(double x) const noexcept override { return inner_.peek(x); }
