@@ -131,7 +131,8 @@ int main() {
       for (double v : x) agree = agree && thermal.step(v) == one.step(v);
     }
     std::printf(
-        "  T °C | thermal Preisach | calibrated simplified | nearest table as is | nearest shifted | identified there (floor) | thermal / floor | nearest / "
+        "  T °C | thermal Preisach | calibrated simplified | nearest table as is | nearest shifted | both shifted, blended | identified there (floor) | "
+        "thermal / floor | nearest / "
         "thermal\n");
     for (std::size_t k = 0; k + 1 < ts.size(); k += spacing > 3 ? 1 : 2) {
       const double Tv = 0.5 * (ts[k] + ts[k + 1]);
@@ -141,8 +142,16 @@ int main() {
       PreisachModel as_is(tabs[k]);
       ShiftedTable shifted(tabs[k], fit.C.value * (Tv - ts[k]) / fit.KA.value, fit.KA.value);
       const double a = rms(thermal, truth, x), b = rms(calibrated, truth, x), c = rms(as_is, truth, x), e = rms(shifted, truth, x), d = rms(floor, truth, x);
-      std::printf("  %4.1f | %10.3f N     | %12.3f N        | %12.3f N      | %10.3f N    | %14.3f N         | %.2f            | %.1f\n", Tv, a, b, c, e, d,
-                  a / d, c / a);
+      // Both neighbours shifted to Tv along the austenite line, then blended.
+      ShiftedTable up(tabs[k], fit.C.value * (Tv - ts[k]) / fit.KA.value, fit.KA.value),
+          down(tabs[k + 1], fit.C.value * (Tv - ts[k + 1]) / fit.KA.value, fit.KA.value);
+      const double w = (Tv - ts[k]) / (ts[k + 1] - ts[k]);
+      double ss = 0;
+      truth.reset();
+      for (double v : x) ss += std::pow((1 - w) * up.step(v) + w * down.step(v) - truth.step(v), 2);
+      const double sb = std::sqrt(ss / static_cast<double>(x.size()));
+      std::printf("  %4.1f | %10.3f N     | %12.3f N        | %12.3f N      | %10.3f N    | %12.3f N          | %14.3f N         | %.2f            | %.1f\n",
+                  Tv, a, b, c, e, sb, d, a / d, c / a);
     }
   }
   std::printf("agreement: the thermal model at each identified temperature is that table's model: %s\n", agree ? "yes" : "NO");

@@ -9,7 +9,8 @@
 // the simplified model (docs/MODELS.md §2) moves its transformation forces by C·ΔT but not its
 // loop's shape alone: the start of the forward plateau moves by C·ΔT/KA, its end by C·ΔT/KM, so
 // the plateau's slope steepens with T (Table 1: 12.3 N/mm at 25 °C, 21.8 N/mm at 35 °C) and no
-// translation of a table follows it (argued, not measured). The blend is nearly right on the
+// translation of a table follows it (bench_thermal: a shift wins only above ~32 °C, where the
+// plateau's end leaves 0-4 mm, and loses 2-5 times below). The blend is nearly right on the
 // plateaus (their force is rational in T, not linear: 0.50 N off at 2.5 mm midway between 30
 // and 34 °C) and wrong most near the corners, which move by C·ΔT/KA between two tables (docs/
 // MODELS_IMPLEMENTATION.md "Temperature": the held-out figures).
