@@ -60,6 +60,7 @@ Table identify_virtual(const Params& p, const OptRange& range, const std::option
   models::SimplifiedSmaModel model(p.p);
   prov.source = "simplified SMA model" + (p.source.empty() ? std::string() : ", parameters " + p.source);
   prov.from = p.source.empty() ? "hystlab Python module" : p.source;
+  prov.temperature_C = p.p.T;  // as hystlab identify --model simplified writes it
   models::EverettTable t;
   {
     py::gil_scoped_release release;

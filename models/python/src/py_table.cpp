@@ -17,6 +17,7 @@ py::dict provenance_dict(const models::TableProvenance& p) {
   d["created"] = p.created;
   d["from"] = p.from;
   d["details"] = json_to_py(p.extra);
+  if (p.temperature_C) d["temperature_C"] = *p.temperature_C;  // when known (docs/FORMATS.md)
   return d;
 }
 
@@ -36,8 +37,12 @@ models::TableProvenance provenance_from(const py::handle& obj) {
       p.created = py::cast<std::string>(value);
     else if (k == "from")
       p.from = py::cast<std::string>(value);
-    else
-      throw std::invalid_argument("provenance: unknown key '" + k + "' (known: source, method, created, from, details)");
+    else if (k == "temperature_C") {
+      const double t = py::cast<double>(value);
+      if (!std::isfinite(t)) throw std::invalid_argument("provenance: temperature_C is not a finite number");
+      p.temperature_C = t;
+    } else
+      throw std::invalid_argument("provenance: unknown key '" + k + "' (known: source, method, created, from, details, temperature_C)");
   }
   return p;
 }
