@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 #include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
@@ -48,6 +49,21 @@ class Workdir {
   hystlab::test_support::TempDir tmp_{"cli"};
   fs::path dir_ = tmp_.path();
 };
+
+// The values of column `col` of a CSV text (its header skipped), as the CLI writes them.
+inline std::vector<double> csv_column(const std::string& csv, int col) {
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<double> v;
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::string cell;
+    for (int c = 0; c <= col; ++c) std::getline(ls, cell, ',');
+    v.push_back(std::stod(cell));
+  }
+  return v;
+}
 
 // One error line naming the problem, exit code 2, nothing on stdout.
 inline void check_error(const Result& r, const std::string& needle) {

@@ -49,19 +49,7 @@ std::string series_csv(const std::vector<double>& x, const std::vector<double>& 
   return s.str();
 }
 
-std::vector<double> column(const std::string& csv, int col) {
-  std::istringstream in(csv);
-  std::string line;
-  std::getline(in, line);
-  std::vector<double> v;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string cell;
-    for (int c = 0; c <= col; ++c) std::getline(ls, cell, ',');
-    v.push_back(std::stod(cell));
-  }
-  return v;
-}
+std::vector<double> column(const std::string& csv, int col) { return hystlab::test::csv_column(csv, col); }
 
 const std::vector<double> kPath = ramp_through({0.0, 3.5, 1.0, 3.0, 1.5, 4.0, 0.0}, 0.01);
 

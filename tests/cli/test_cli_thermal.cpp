@@ -17,24 +17,7 @@ using hystlab::test::check_error;
 using hystlab::test::slurp;
 using hystlab::test::Workdir;
 
-namespace cli_thermal {
-// The values of one column of a CSV text (header skipped).
-std::vector<double> column_of(const std::string& csv, int col) {
-  std::istringstream in(csv);
-  std::string line;
-  std::getline(in, line);
-  std::vector<double> v;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string cell;
-    for (int c = 0; c <= col; ++c) std::getline(ls, cell, ',');
-    v.push_back(std::stod(cell));
-  }
-  return v;
-}
-}  // namespace cli_thermal
-
-using cli_thermal::column_of;
+using hystlab::test::csv_column;
 
 TEST_CASE("cli: eval at a temperature: tables identified at three joined, the simplified model moved, refusals named") {
   Workdir w;
@@ -70,7 +53,7 @@ TEST_CASE("cli: eval at a temperature: tables identified at three joined, the si
   CAPTURE(at27.err);
   REQUIRE(at27.code == 0);
   ThermalPreisachModel lib(tt, 27);
-  const std::vector<double> f27 = column_of(at27.out, 1);
+  const std::vector<double> f27 = csv_column(at27.out, 1);
   REQUIRE(f27.size() == path.size());
   for (std::size_t k = 0; k < path.size(); ++k) CHECK(f27[k] == lib.step(path[k]));  // exact: shortest round-trip formatting
 
@@ -78,7 +61,7 @@ TEST_CASE("cli: eval at a temperature: tables identified at three joined, the si
   REQUIRE(ramp.code == 0);
   CHECK(ramp.out.rfind("displacement_mm,temperature_C,force_N\n", 0) == 0);
   ThermalPreisachModel ramped(tt, temp[0]);
-  const std::vector<double> fr = column_of(ramp.out, 2);
+  const std::vector<double> fr = csv_column(ramp.out, 2);
   REQUIRE(fr.size() == path.size());
   for (std::size_t k = 0; k < path.size(); ++k) {
     ramped.set_temperature(temp[k]);
@@ -90,7 +73,7 @@ TEST_CASE("cli: eval at a temperature: tables identified at three joined, the si
   SmaParameters p27 = table1_parameters();
   p27.T = 27;
   SimplifiedSmaModel truth(p27);
-  const std::vector<double> fs = column_of(sma.out, 1);
+  const std::vector<double> fs = csv_column(sma.out, 1);
   for (std::size_t k = 0; k < path.size(); ++k) CHECK(fs[k] == truth.step(path[k]));
 
   check_error(w.run("eval --table t22.json,t26.json --identified-at 22,26 --temperature 31 --input X.csv"),
@@ -134,5 +117,5 @@ TEST_CASE("cli: eval at a temperature: tables identified at three joined, the si
   const auto clamped = w.run("eval --table t22.json,t26.json --identified-at 22,26 --input XT2.csv --clamp");
   CHECK(clamped.code == 0);
   CHECK(clamped.err.find("1 temperature(s) outside 22..26 °C were clamped") != std::string::npos);
-  CHECK(column_of(clamped.out, 1) == std::vector<double>{22, 26});  // the temperature used, clamped
+  CHECK(csv_column(clamped.out, 1) == std::vector<double>{22, 26});  // the temperature used, clamped
 }
