@@ -69,28 +69,35 @@ int main(int argc, char** argv) {
     std::vector<double> http_ms, daemon_ms, moved_mm, baseline_ms;
     std::vector<std::vector<double>> by_phase(phases.size());
     int done = 0, failures = 0;
-    for (int k = 0; k < presses; ++k) {
-      const std::size_t ph = static_cast<std::size_t>(k) % phases.size();
+    // Reaching a phase races a short campaign (about 2 s): a host stall between seeing "ramping" and
+    // the pause arriving can let the campaign finish first (stop 49's CI: press 10, "paused" not
+    // reached, under a load average near 3). That is the benchmark missing its moment, not the
+    // e-stop failing: the campaign is aborted and the press tried again on a new one, up to 5 times.
+    auto submit = [&] {
       auto r = c.Post("/api/campaigns", json{{"plan", plan}}.dump(), "application/json");
       if (!r || r->status != 201) throw std::runtime_error("cannot submit a campaign: " + (r ? r->body : std::string("no answer")));
-      const long id = json::parse(r->body)["id"].get<long>();
-      const std::string camp = "/api/campaigns/" + std::to_string(id);
-      // Reach the phase (a press in the phase's first moments or later: spread by k).
-      bool there = true;
-      if (phases[ph] == "preamble") there = wait_for([&] { return phase_is("preamble", 0); }, 10);
-      if (phases[ph] == "ramping") there = wait_for([&] { return phase_is("ramping", 0); }, 10);
-      if (phases[ph] == "dwelling") there = wait_for([&] { return phase_is("dwelling", 0); }, 10);
-      if (phases[ph] == "paused") {
-        there = wait_for([&] { return phase_is("ramping", 0); }, 10);
-        c.Post((camp + "/pause").c_str(), "", "application/json");
-        there = there && wait_for([&] { return phase_is("paused", 0); }, 10);
-      }
-      if (phases[ph] == "safing") {
-        there = wait_for([&] { return phase_is("dwelling", 0); }, 10);
+      return "/api/campaigns/" + std::to_string(json::parse(r->body)["id"].get<long>());
+    };
+    auto reach = [&](const std::string& phase, const std::string& camp) {
+      if (phase == "just submitted") return true;
+      if (phase == "preamble" || phase == "ramping" || phase == "dwelling") return wait_for([&] { return phase_is(phase, 0); }, 10);
+      const bool paused = phase == "paused";
+      if (!wait_for([&] { return phase_is(paused ? "ramping" : "dwelling", 0); }, 10)) return false;
+      c.Post((camp + (paused ? "/pause" : "/abort")).c_str(), "", "application/json");
+      return wait_for([&] { return phase_is(phase, 0); }, 10);
+    };
+    int missed = 0;
+    for (int k = 0; k < presses; ++k) {
+      const std::size_t ph = static_cast<std::size_t>(k) % phases.size();
+      std::string camp = submit();
+      for (int attempt = 1; !reach(phases[ph], camp); ++attempt) {
+        if (attempt == 5) throw std::runtime_error("press " + std::to_string(k) + ": phase '" + phases[ph] + "' not reached in 5 campaigns");
+        ++missed;
         c.Post((camp + "/abort").c_str(), "", "application/json");
-        there = there && wait_for([&] { return phase_is("safing", 0); }, 10);
+        if (!wait_for([&] { return get(c, camp)["final"] == true && get(c, rig)["state"] == "idle"; }, 30))
+          throw std::runtime_error(camp + " never ended");
+        camp = submit();
       }
-      if (!there) throw std::runtime_error("press " + std::to_string(k) + ": phase '" + phases[ph] + "' not reached");
       std::this_thread::sleep_for(std::chrono::microseconds(1000 * (k % 7)));  // anywhere in the phase's periods
       const double x_press = get(c, rig)["sample"].value("displacement_mm", NAN);
       const double t0 = mono_now();
@@ -110,7 +117,7 @@ int main(int argc, char** argv) {
         daemon_ms.push_back(ans["waited_ms"].get<double>());
         by_phase[ph].push_back((t1 - t0) * 1e3);
       }
-      if (!wait_for([&] { return get(c, camp)["final"] == true; }, 30)) throw std::runtime_error("campaign " + std::to_string(id) + " never ended");
+      if (!wait_for([&] { return get(c, camp)["final"] == true; }, 30)) throw std::runtime_error(camp + " never ended");
       std::this_thread::sleep_for(std::chrono::milliseconds(120));  // idle reads: the snapshot shows where it rests
       const double rest = get(c, rig)["sample"].value("displacement_mm", NAN);
       if (std::isfinite(rest) && std::isfinite(x_press)) moved_mm.push_back(std::fabs(rest - x_press));
@@ -121,6 +128,7 @@ int main(int argc, char** argv) {
     const double period_ms = 1.0;
     std::printf("e-stop over %d presses at 1 kHz (hystlabd, hystlab-sim over Modbus TCP, time scale 1), %d not answered latched and confirmed\n", done,
                 failures);
+    std::printf("campaigns that ended before their press's phase was reached (tried again on a new one): %d\n", missed);
     std::printf("request -> answer (written, and seen in the status word), HTTP round trip: p50 %.2f ms, p99 %.2f ms, max %.2f ms\n", quantile(http_ms, 0.5),
                 quantile(http_ms, 0.99), quantile(http_ms, 1.0));
     std::printf("the daemon's own time, request taken -> status word confirmed: p50 %.2f ms (%.1f periods), p99 %.2f ms (%.1f periods), max %.2f ms\n",
