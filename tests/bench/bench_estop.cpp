@@ -94,8 +94,7 @@ int main(int argc, char** argv) {
         if (attempt == 5) throw std::runtime_error("press " + std::to_string(k) + ": phase '" + phases[ph] + "' not reached in 5 campaigns");
         ++missed;
         c.Post((camp + "/abort").c_str(), "", "application/json");
-        if (!wait_for([&] { return get(c, camp)["final"] == true && get(c, rig)["state"] == "idle"; }, 30))
-          throw std::runtime_error(camp + " never ended");
+        if (!wait_for([&] { return get(c, camp)["final"] == true && get(c, rig)["state"] == "idle"; }, 30)) throw std::runtime_error(camp + " never ended");
         camp = submit();
       }
       std::this_thread::sleep_for(std::chrono::microseconds(1000 * (k % 7)));  // anywhere in the phase's periods

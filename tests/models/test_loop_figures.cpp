@@ -2,6 +2,8 @@
 // cycle finding on records of known structure.
 #include <doctest/doctest.h>
 
+#include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -220,4 +222,53 @@ TEST_CASE("residual displacement of a loop with a permanent set, and of a cycle 
   // A cycle inside a loading (from a maximum, down and back up) unloads to no start: NaN.
   const auto inner = hystlab::models::loop_figures(std::vector<double>{2, 1, 2}, std::vector<double>{50, 30, 50}, 0, 1, 2);
   CHECK(std::isnan(inner.residual_mm));
+}
+
+namespace {
+// The sum of squares of the least-squares three-line fit with knots k1 < k2, over the points
+// themselves (the library's search uses prefix moments instead: this is its reference).
+double direct_hinge_ss(const std::vector<double>& x, const std::vector<double>& y, double k1, double k2) {
+  Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d b = Eigen::Vector4d::Zero();
+  auto row = [&](double v) { return Eigen::Vector4d(1.0, v, std::max(0.0, v - k1), std::max(0.0, v - k2)); };
+  for (std::size_t k = 0; k < x.size(); ++k) A += row(x[k]) * row(x[k]).transpose(), b += row(x[k]) * y[k];
+  const Eigen::Vector4d c = A.ldlt().solve(b);
+  double ss = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) ss += (row(x[k]).dot(c) - y[k]) * (row(x[k]).dot(c) - y[k]);
+  return ss;
+}
+}  // namespace
+
+TEST_CASE("branch knees: the search's knots fit at least as well as every pair of its coarse grid, on seeded noisy three-line branches") {
+  std::mt19937 rng(20261129);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int trial = 0; trial < 12; ++trial) {
+    const double lo = 10 * u(rng) - 5, span = 0.5 + 20 * u(rng);
+    const double k1 = lo + span * (0.1 + 0.3 * u(rng)), k2 = lo + span * (0.6 + 0.3 * u(rng));
+    const double s0 = 20 + 80 * u(rng), s1 = 5 * u(rng) - 2, s2 = 20 + 80 * u(rng), noise = 2 * u(rng);
+    const std::size_t n = 50 + static_cast<std::size_t>(700 * u(rng));  // below and above the 400 taken
+    CAPTURE(trial);
+    CAPTURE(n);
+    std::vector<double> x(n), y(n);
+    std::normal_distribution<double> e(0, noise);
+    for (std::size_t k = 0; k < n; ++k) {
+      x[k] = lo + span * u(rng);  // any order of displacement
+      y[k] = s0 * (x[k] - lo) + (s1 - s0) * std::max(0.0, x[k] - k1) + (s2 - s1) * std::max(0.0, x[k] - k2) + e(rng);
+    }
+    const auto b = hystlab::models::fit_branch_knees(x, y);
+    REQUIRE(b.has_value());
+    // The points the library takes: every stride-th, as documented (kMaxKneePoints).
+    const std::size_t stride = std::max<std::size_t>(1, (n + hystlab::models::kMaxKneePoints - 1) / hystlab::models::kMaxKneePoints);
+    std::vector<double> tx, ty;
+    for (std::size_t k = 0; k < n; k += stride) tx.push_back(x[k]), ty.push_back(y[k]);
+    const double found = direct_hinge_ss(tx, ty, b->lower_mm, b->upper_mm);
+    CHECK(b->rms_N == doctest::Approx(std::sqrt(found / static_cast<double>(tx.size()))).epsilon(1e-9));
+    const double step = (b->hi_mm - b->lo_mm) / 40;
+    double grid_best = 1e300;
+    for (int i = 1; i < 40; ++i)
+      for (int j = i + 1; j < 40; ++j) grid_best = std::min(grid_best, direct_hinge_ss(tx, ty, b->lo_mm + step * i, b->lo_mm + step * j));
+    CHECK(found <= grid_best * (1 + 1e-9) + 1e-9);
+    CHECK(std::fabs(b->lower_mm - k1) < 0.05 * span);
+    CHECK(std::fabs(b->upper_mm - k2) < 0.05 * span);
+  }
 }
