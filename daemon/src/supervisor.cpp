@@ -176,6 +176,7 @@ std::optional<std::string> Supervisor::begin_arming(double now) {
   if (state_ == RigState::disconnected) return "the rig is not connected";
   if (state_ != RigState::idle) return "the rig is busy (" + std::string(to_string(state_)) + ")";
   arming_written_ = false;
+  arming_retries_ = 0;
   arming_deadline_ = deadline(now, s_.arm_timeout_s);
   go(now, RigState::arming, "arming: checking ready");
   return std::nullopt;
@@ -195,16 +196,25 @@ Supervisor::Arming Supervisor::arming_step(double now, const StatusView& v, std:
     return failed(why);
   }
   if (!arming_written_) {
+    std::error_code ec = rig_->set_mode(s_.mode);
+    std::string what = "cannot write mode " + std::to_string(s_.mode);
+    if (!ec || ec == drivers::RigError::unsupported) {
+      mode_written_ = !ec;  // a map without a mode register: none is said to be set
+      // The setpoint is where the rig is, before enable: a stale setpoint from an earlier campaign
+      // must never become motion the moment the drive is enabled.
+      ec = shaker_ ? rig_->command_shaker(0.0, 0.0, true) : rig_->command(v.position_mm, s_.safe_rate_mm_s);
+      if (!ec && !shaker_) ec = rig_->hold(true);
+      if (!ec && !shaker_) ec = rig_->arm(true);
+      what = "cannot enable the rig";
+    }
+    // An answer lost (a busy controller; stop 50's clean clone: hystlab-sim missed its 50 ms three
+    // times in a second beside two browsers, and the campaign failed to arm) is asked again: every
+    // write of the handshake is idempotent (the mode, the setpoint where the rig is, hold, enable),
+    // so the whole handshake is written again on the next tick, until the arm deadline. A refusal
+    // (an exception answer) or a lost link fails at once.
+    if (ec == drivers::RigError::timeout && now <= arming_deadline_) return ++arming_retries_, Arming::pending;
+    if (ec) return failed(what + ": " + ec.message() + (arming_retries_ > 0 ? " (" + std::to_string(arming_retries_ + 1) + " attempts)" : std::string()));
     arming_written_ = true;
-    const std::error_code mode = rig_->set_mode(s_.mode);
-    if (mode && mode != drivers::RigError::unsupported) return failed("cannot write mode " + std::to_string(s_.mode) + ": " + mode.message());
-    mode_written_ = !mode;  // a map without a mode register: none is said to be set
-    // The setpoint is where the rig is, before enable: a stale setpoint from an earlier campaign
-    // must never become motion the moment the drive is enabled.
-    std::error_code ec = shaker_ ? rig_->command_shaker(0.0, 0.0, true) : rig_->command(v.position_mm, s_.safe_rate_mm_s);
-    if (!ec && !shaker_) ec = rig_->hold(true);
-    if (!ec && !shaker_) ec = rig_->arm(true);
-    if (ec) return failed("cannot enable the rig: " + ec.message());
     return Arming::pending;
   }
   if (v.status & st::enabled) {

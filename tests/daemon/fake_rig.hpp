@@ -45,6 +45,8 @@ class FakeRig final : public drivers::Rig {
   // The next this many non-zero drive writes are taken but answered late (a timeout), as a busy
   // controller's: the host does not know the write was taken.
   int late_drive_answers = 0;
+  // The next this many mode writes are taken but answered late (a timeout): arming's handshake.
+  int late_mode_answers = 0;
   std::uint16_t required_mode = 1;
   std::vector<FaultEvent> plan;
 
@@ -83,6 +85,7 @@ class FakeRig final : public drivers::Rig {
     if (auto ec = link()) return ec;
     ++log.mode_writes;
     mode_ = m;
+    if (late_mode_answers > 0) return --late_mode_answers, RigError::timeout;
     return {};
   }
   std::error_code reset_faults() noexcept override {

@@ -143,6 +143,29 @@ TEST_CASE("arming handshake: mode written, enabled required in time, a rig not r
     CHECK(h.state_of(j.id) == "failed");
     CHECK_FALSE(h.saw(RigState::armed));
   }
+  SUBCASE("answers lost while arming: the handshake is written again and the campaign runs") {
+    Harness h;
+    h.rig.late_mode_answers = 3;
+    const auto j = h.job(waveform({0, 1, 0}));
+    const auto r = h.run(j);
+    CHECK(r.end == CampaignEnd::completed);
+    CHECK(h.rig.log.mode_writes >= 4);
+    CHECK(h.saw(RigState::armed));
+  }
+  SUBCASE("a controller that never answers the handshake fails at the arm deadline, saying so and how often it was asked") {
+    Harness h;
+    h.rig.late_mode_answers = 1'000'000;
+    const auto j = h.job(waveform({0, 1, 0}));
+    const auto r = h.run(j);
+    CHECK(r.end == CampaignEnd::failed);
+    CAPTURE(r.reason);
+    CHECK(r.reason.find("cannot write mode 1: timeout") != std::string::npos);
+    CHECK(r.reason.find(" attempts)") != std::string::npos);
+    CHECK(h.rig.log.mode_writes > 10);
+    CHECK(h.rig.log.enable_writes == 0);
+    CHECK(h.rig.position() == doctest::Approx(0.0));
+    CHECK_FALSE(h.saw(RigState::armed));
+  }
   SUBCASE("a rig with a latched fault is not armed") {
     Harness h;
     h.rig.plan.push_back({FaultEvent::latch_fault, 0.0, 0.0, 7});

@@ -142,6 +142,7 @@ class Supervisor {
   std::string latch_reason_;
   std::uint16_t fault_code_ = 0;
   bool arming_written_ = false;
+  int arming_retries_ = 0;     // handshakes written again after a lost answer (arming_step)
   bool mode_written_ = false;  // the map has a mode register and it was written on arming
   double arming_deadline_ = 0;
   bool resetting_ = false;
