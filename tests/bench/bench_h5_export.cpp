@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/build_paths.hpp"
 #include "hystlab/db/store.hpp"
 
 extern char** environ;

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "../support/build_paths.hpp"
 #include "../support/temp_dir.hpp"
 
 namespace hystlab::test {
@@ -33,7 +34,7 @@ class Workdir {
  public:
   fs::path operator/(const std::string& name) const { return dir_ / name; }
   void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
-  Result run(const std::string& args) const { return run_raw("env -u HYSTLAB_DAEMON -u HYSTLAB_TOKEN '" HYSTLAB_CLI "' " + args); }
+  Result run(const std::string& args) const { return run_raw("env -u HYSTLAB_DAEMON -u HYSTLAB_TOKEN '" + HYSTLAB_CLI + "' " + args); }
   // command: a shell command line (the CLI with an environment of its own).
   Result run_raw(const std::string& command) const {
     const std::string cmd = "cd '" + dir_.string() + "' && " + command + " > out.txt 2> err.txt < /dev/null";

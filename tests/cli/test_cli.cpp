@@ -25,6 +25,7 @@
 #include "cli_workdir.hpp"
 #include "hystlab/db/store.hpp"
 
+#include "../support/build_paths.hpp"
 #include "hystlab/models/formats.hpp"
 #include "hystlab/models/fot_identification.hpp"
 #include "hystlab/models/loop_figures.hpp"
@@ -418,7 +419,7 @@ TEST_CASE("cli: submit, preview and the commands go to the running hystlabd over
   CHECK(none.out.find("waveform") == std::string::npos);  // a preview queues nothing
 
   // $HYSTLAB_DAEMON and $HYSTLAB_TOKEN stand for the options.
-  const std::string env = "env HYSTLAB_DAEMON=http://127.0.0.1:" + std::to_string(d.port()) + " HYSTLAB_TOKEN=" + token + " '" HYSTLAB_CLI "' ";
+  const std::string env = "env HYSTLAB_DAEMON=http://127.0.0.1:" + std::to_string(d.port()) + " HYSTLAB_TOKEN=" + token + " '" + HYSTLAB_CLI + "' ";
   const Result queued = w.run_raw(env + "campaign submit --plan plan.json");
   CAPTURE(queued.err);
   REQUIRE(queued.code == 0);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/build_paths.hpp"
 #include "cli_workdir.hpp"
 
 using namespace hystlab::test;
@@ -42,8 +43,8 @@ void check_header_forces(const Workdir& w, const std::string& table, const std::
                                 "  FILE* in = fopen(\"X.csv\", \"r\"); char head[64]; if (!in || !fgets(head, sizeof head, in)) return 1;\n"
                                 "  while (fscanf(in, \"%lf\", &x) == 1) { hystlab_model_step(m, x, &f); printf(\"%.17g\\n\", f); }\n"
                                 "  hystlab_model_free(m); return 0;\n}\n");
-  const std::string cc = "cd '" + (w / "").string() + "' && cc -std=c99 -Wall -Werror " HYSTLAB_C_FLAGS " -I'" HYSTLAB_CAPI_INCLUDE "' " + name +
-                         "_main.c '" HYSTLAB_CAPI_LIB "' -Wl,-rpath,'" + std::filesystem::path(HYSTLAB_CAPI_LIB).parent_path().string() + "' -o " + name +
+  const std::string cc = "cd '" + (w / "").string() + "' && cc -std=c99 -Wall -Werror " HYSTLAB_C_FLAGS " -I'" + HYSTLAB_CAPI_INCLUDE + "' " + name +
+                         "_main.c '" + HYSTLAB_CAPI_LIB + "' -Wl,-rpath,'" + std::filesystem::path(HYSTLAB_CAPI_LIB).parent_path().string() + "' -o " + name +
                          "_main && ./" + name + "_main > " + name + "_forces.txt";
   REQUIRE(std::system(cc.c_str()) == 0);
   const Result eval = w.run("eval --table " + table + " --input X.csv");

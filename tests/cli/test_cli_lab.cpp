@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/build_paths.hpp"
 #include "../support/postgres_server.hpp"
 #include "cli_workdir.hpp"
 #include "hystlab/db/replicator.hpp"
@@ -149,9 +150,9 @@ struct Lab {
   }
   // The CLI with the lab's password in $PGPASSWORD (libpq's own).
   [[nodiscard]] Result run(const Workdir& w, const std::string& args) const {
-    Result rr = w.run_raw("env -u HYSTLAB_PG PGPASSWORD='" + std::string(PostgresServer::kPassword) + "' '" HYSTLAB_CLI "' " + args);
+    Result rr = w.run_raw("env -u HYSTLAB_PG PGPASSWORD='" + std::string(PostgresServer::kPassword) + "' '" + HYSTLAB_CLI + "' " + args);
     std::fprintf(stderr, "$ hystlab %s\n%s%s[exit %d]\n", args.c_str(), rr.out.substr(0, 1500).c_str(), rr.err.c_str(), rr.code);
-    return w.run_raw("env -u HYSTLAB_PG PGPASSWORD='" + std::string(PostgresServer::kPassword) + "' '" HYSTLAB_CLI "' " + args);
+    return w.run_raw("env -u HYSTLAB_PG PGPASSWORD='" + std::string(PostgresServer::kPassword) + "' '" + HYSTLAB_CLI + "' " + args);
   }
   [[nodiscard]] std::string pg() const { return "--pg " + server.url(); }
 };
@@ -329,7 +330,7 @@ TEST_CASE("runs export --pg: a run's CSV from the lab equal byte for byte to the
   // The shaker's columns; to a file with -o, the password from --pg-password-file.
   const Result file = w.run("runs export 2 --db " + l.b_db + " -o lite.csv");
   REQUIRE(file.code == 0);
-  const Result pg = w.run_raw("env -u PGPASSWORD '" HYSTLAB_CLI "' runs export 2 " + l.pg() + " --daemon frame-pc-2 -o lab.csv --pg-password-file " +
+  const Result pg = w.run_raw("env -u PGPASSWORD '" + HYSTLAB_CLI + "' runs export 2 " + l.pg() + " --daemon frame-pc-2 -o lab.csv --pg-password-file " +
                               (l.dir / "pgpass").string());
   CAPTURE(pg.err);
   REQUIRE(pg.code == 0);
@@ -403,10 +404,10 @@ TEST_CASE("lab: one clear error each (no server, a refused password, a password 
   const std::string url = l.server.url();
   check_error(l.run(w, "lab campaigns --pg postgresql://hystlab@127.0.0.1:" + std::to_string(test_support::free_port()) + "/lab"),
               "cannot connect to the lab database");
-  check_error(w.run_raw("env PGPASSWORD=wrong '" HYSTLAB_CLI "' lab campaigns --pg " + url), "refused the password");
+  check_error(w.run_raw("env PGPASSWORD=wrong '" + HYSTLAB_CLI + "' lab campaigns --pg " + url), "refused the password");
   w.write("bad-pass", "wrong\n");
-  check_error(w.run_raw("env -u PGPASSWORD '" HYSTLAB_CLI "' lab tables --pg " + url + " --pg-password-file bad-pass"), "refused the password");
-  check_error(w.run_raw("env -u PGPASSWORD '" HYSTLAB_CLI "' lab tables --pg " + url + " --pg-password-file no-such-file"),
+  check_error(w.run_raw("env -u PGPASSWORD '" + HYSTLAB_CLI + "' lab tables --pg " + url + " --pg-password-file bad-pass"), "refused the password");
+  check_error(w.run_raw("env -u PGPASSWORD '" + HYSTLAB_CLI + "' lab tables --pg " + url + " --pg-password-file no-such-file"),
               "--pg-password-file: cannot read 'no-such-file'");
   check_error(
       l.run(w, "lab campaigns --pg postgresql://hystlab:" + std::string(PostgresServer::kPassword) + "@127.0.0.1:" + std::to_string(l.server.port()) + "/lab"),

@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "../support/build_paths.hpp"
 #include "../support/daemon_process.hpp"
 #include "../support/temp_dir.hpp"
 #include "hystlab/db/store.hpp"

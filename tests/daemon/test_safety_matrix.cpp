@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "../support/build_paths.hpp"
 #include "safety_cells.hpp"
 
 using namespace hystlab;

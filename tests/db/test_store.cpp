@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "../support/build_paths.hpp"
 #include "../support/temp_dir.hpp"
 #include "hystlab/db/sample_writer.hpp"
 #include "hystlab/db/schema.hpp"

@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "../support/build_paths.hpp"
 
 extern char** environ;
 

@@ -5,6 +5,7 @@
 #include <map>
 #include <string>
 
+#include "../support/build_paths.hpp"
 #include "hystlab/drivers/modbus_rig.hpp"
 #include "hystlab/protocols/default_maps.hpp"
 #include "sim_process.hpp"
@@ -49,14 +50,14 @@ TEST_CASE("mbpoll reads the default map's documented values at rest, and a setpo
 }
 
 TEST_CASE("mbpoll reads the vendor B map: other addresses, swapped words, scaled integers") {
-  hystlab::test::SimProcess sim({"--port", "0", "--noise", "0", "--map", HYSTLAB_MAPS "/vendor_b_load_frame.json"});
+  hystlab::test::SimProcess sim({"--port", "0", "--noise", "0", "--map", HYSTLAB_MAPS + "/vendor_b_load_frame.json"});
   auto in = mbpoll(sim.modbus_port, 17, 3, 3000, 10);
   REQUIRE(in.size() == 10);
   CHECK(in[3000] == 1);  // status: ready
   CHECK(in[3002] == 0);
   hystlab::drivers::ModbusRigConfig c;
   c.port = sim.modbus_port;
-  std::FILE* f = std::fopen(HYSTLAB_MAPS "/vendor_b_load_frame.json", "r");
+  std::FILE* f = std::fopen((HYSTLAB_MAPS + "/vendor_b_load_frame.json").c_str(), "r");
   REQUIRE(f);
   std::string text;
   for (int ch; (ch = std::fgetc(f)) != EOF;) text += static_cast<char>(ch);

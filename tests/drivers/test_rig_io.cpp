@@ -7,6 +7,7 @@
 #include <sstream>
 #include <thread>
 
+#include "../support/build_paths.hpp"
 #include "hystlab/drivers/can_rig.hpp"
 #include "hystlab/drivers/modbus_rig.hpp"
 #include "hystlab/drivers/rig_factory.hpp"
@@ -167,8 +168,8 @@ TEST_CASE("modbus tcp: a late answer to a timed-out read is never taken for the 
 }
 
 TEST_CASE("modbus tcp: the second vendor map (scaled integers, swapped words) end to end") {
-  const std::string map = slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json");
-  SimProcess sim({"--port", "0", "--time-scale", "10", "--noise", "0", "--map", HYSTLAB_MAPS "/vendor_b_load_frame.json"});
+  const std::string map = slurp(HYSTLAB_MAPS + "/vendor_b_load_frame.json");
+  SimProcess sim({"--port", "0", "--time-scale", "10", "--noise", "0", "--map", HYSTLAB_MAPS + "/vendor_b_load_frame.json"});
   ModbusRig rig(tcp_config(sim.modbus_port, map));
   REQUIRE_FALSE(rig.connect(steady_now()));
   REQUIRE_FALSE(rig.set_mode(1));                               // vendor B's map has a mode register too
@@ -472,7 +473,7 @@ TEST_CASE("rigs from configuration: a simulated rig is only a different address"
   bad({{"transport", "can"}}, "exactly one is required");
   bad({{"transport", "modbus-tcp"}, {"baudrate", 9600}}, "rigs[1].baudrate is not a known field");
   bad({{"transport", "modbus-tcp"}, {"block_reads", "yes"}}, "rigs[1].block_reads must be true or false");
-  bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"map", nlohmann::json::parse(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json"))}},
+  bad({{"transport", "modbus-tcp"}, {"block_reads", true}, {"map", nlohmann::json::parse(slurp(HYSTLAB_MAPS + "/vendor_b_load_frame.json"))}},
       "rigs[1].block_reads cannot be used: rig: block reads need a register map with a sample_window");
   auto windowless_shaker = nlohmann::json::parse(protocols::kDefaultShakerMap);
   windowless_shaker.erase("sample_window");

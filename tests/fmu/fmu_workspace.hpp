@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "../support/build_paths.hpp"
 #include "../support/temp_dir.hpp"
 #include "fmu_importer.hpp"
 

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "../support/build_paths.hpp"
 #include "../support/daemon_process.hpp"
 #include "../support/postgres_server.hpp"
 

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "../support/build_paths.hpp"
 #include "hystlab/domain/events.hpp"
 
 namespace domain = hystlab::domain;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "../support/build_paths.hpp"
 #include "hystlab/protocols/can_protocol.hpp"
 #include "hystlab/protocols/modbus_crc.hpp"
 #include "hystlab/protocols/register_map.hpp"
@@ -43,7 +44,7 @@ double dec(const MapEntry& e, std::array<std::uint16_t, 2> w) {
 // The shipped load frame map, changed by mutate, must be refused with needle in the message.
 template <class Mutate>
 void refused_after(Mutate mutate, const char* needle) {
-  auto j = nlohmann::json::parse(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  auto j = nlohmann::json::parse(slurp(HYSTLAB_MAPS + "/default_load_frame.json"));
   mutate(j);
   CAPTURE(needle);
   CHECK_THROWS_WITH_AS((void)RegisterMap::from_json(j.dump()), doctest::Contains(needle), MapError);
@@ -85,16 +86,16 @@ TEST_CASE("register encoding: range and finiteness are typed errors") {
 }
 
 TEST_CASE("register maps: the shipped maps load, with their read blocks") {
-  const RegisterMap a = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  const RegisterMap a = RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/default_load_frame.json"));
   CHECK(a.slave_id() == 1);
   REQUIRE(a.find(Signal::force_N));
   CHECK(a.find(Signal::force_N)->address == 2);
   REQUIRE(a.measurement_blocks().size() == 1);
   CHECK(a.measurement_blocks()[0].count == 12);
-  const RegisterMap b = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json"));
+  const RegisterMap b = RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/vendor_b_load_frame.json"));
   CHECK(b.find(Signal::displacement_mm)->word_order == WordOrder::swapped);
   CHECK(b.measurement_blocks()[0].start == 3000);
-  const RegisterMap s = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json"));
+  const RegisterMap s = RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/default_shaker.json"));
   CHECK(s.kind() == RigKind::shaker);
 }
 
@@ -122,7 +123,7 @@ TEST_CASE("register maps: a bad map is rejected with the field named") {
 }
 
 TEST_CASE("register maps: the controller signals fault_reset and host_heartbeat, and fault_codes") {
-  const RegisterMap a = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  const RegisterMap a = RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/default_load_frame.json"));
   REQUIRE(a.find(Signal::fault_reset));
   CHECK(a.find(Signal::fault_reset)->table == ModbusTable::coil);
   CHECK(a.find(Signal::fault_reset)->address == 3);
@@ -138,15 +139,15 @@ TEST_CASE("register maps: the controller signals fault_reset and host_heartbeat,
   CHECK(a.fault_text(4) == "host heartbeat lost");
   CHECK(a.fault_text(7).empty());
   CHECK(a.fault_text(0).empty());
-  const RegisterMap s = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json"));
+  const RegisterMap s = RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/default_shaker.json"));
   CHECK(s.find(Signal::fault_reset)->address == 2);
   CHECK(s.fault_text(3) == "e-stop pressed");
-  const RegisterMap b = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json"));
+  const RegisterMap b = RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/vendor_b_load_frame.json"));
   CHECK(b.find(Signal::fault_reset)->address == 19);
   CHECK_FALSE(b.find(Signal::host_heartbeat));
   CHECK(b.fault_text(1).empty());  // no fault_codes: no texts
   // A map without the optional controller signals still loads.
-  auto j = nlohmann::json::parse(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  auto j = nlohmann::json::parse(slurp(HYSTLAB_MAPS + "/default_load_frame.json"));
   j["signals"].erase("fault_reset");
   j["signals"].erase("host_heartbeat");
   j.erase("fault_codes");
@@ -170,13 +171,13 @@ TEST_CASE("register maps: bad fault_codes, fault_reset or host_heartbeat are ref
 }
 
 TEST_CASE("sample windows: the shipped map's window, and records that encode and decode back") {
-  const RegisterMap m = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json"));
+  const RegisterMap m = RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/default_load_frame.json"));
   REQUIRE(m.sample_window());
   const SampleWindow& w = *m.sample_window();
   CHECK(w.record_width == 10);  // counter, displacement, force, command (2 each), status, fault
   CHECK(w.records_per_read() == 12);
   CHECK(w.period_s == doctest::Approx(0.001));
-  const RegisterMap shaker = RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json"));
+  const RegisterMap shaker = RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/default_shaker.json"));
   REQUIRE(shaker.sample_window());
   CHECK(shaker.sample_window()->record_width == 12);  // counter, 2 displacements, 2 accelerations (2 each), status, fault
   CHECK(shaker.sample_window()->records_per_read() == 10);
@@ -205,9 +206,9 @@ TEST_CASE("sample windows: the shipped map's window, and records that encode and
 }
 
 TEST_CASE("the controller's sample clock: sample_period_s, or the window's period; a bad one is named") {
-  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_shaker.json")).sample_period_s() == doctest::Approx(0.001));
-  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS "/default_load_frame.json")).sample_period_s() == doctest::Approx(0.001));
-  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS "/vendor_b_load_frame.json")).sample_period_s() == 0.0);  // it does not say
+  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/default_shaker.json")).sample_period_s() == doctest::Approx(0.001));
+  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/default_load_frame.json")).sample_period_s() == doctest::Approx(0.001));
+  CHECK(RegisterMap::from_json(slurp(HYSTLAB_MAPS + "/vendor_b_load_frame.json")).sample_period_s() == 0.0);  // it does not say
   refused_after([](auto& j) { j["sample_period_s"] = 0; }, "sample_period_s must be a number of seconds > 0 and <= 1");
   refused_after([](auto& j) { j["sample_period_s"] = "1 ms"; }, "sample_period_s must be a number of seconds > 0 and <= 1");
   refused_after([](auto& j) { j["sample_period_s"] = 0.002; }, "sample_period_s differs from sample_window.period_s");

@@ -21,6 +21,7 @@
 #include <string>
 #include <thread>
 #include <vector>
+#include "build_paths.hpp"
 #include "temp_dir.hpp"
 
 extern char** environ;

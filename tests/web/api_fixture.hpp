@@ -19,6 +19,7 @@
 #include <string>
 #include <thread>
 
+#include "../support/build_paths.hpp"
 #include "../support/temp_dir.hpp"
 #include "hystlab/daemon/daemon.hpp"
 #include "hystlab/daemon/daemon_control.hpp"
@@ -47,7 +48,7 @@ inline json fot_plan(int n, double rate_mm_s = 1.0) {
 class LiveDaemon {
  public:
   explicit LiveDaemon(const std::function<void(daemon::DaemonConfig&)>& adjust = {}) {
-    setenv("HYSTLAB_SIM", HYSTLAB_SIM, 1);
+    setenv("HYSTLAB_SIM", HYSTLAB_SIM.c_str(), 1);
     json cfg{{"rigs", {{{"name", "sim frame"}, {"simulate", {{"time_scale", 20}, {"noise_N", 0.05}}}}}}};
     config = daemon::parse_daemon_config(cfg, dir.path.string());
     config.db_path = (dir.path / "api.db").string();

@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "../support/build_paths.hpp"
 #include "api_fixture.hpp"
 #include "hystlab/models/accuracy.hpp"
 #include "hystlab/models/formats.hpp"
