@@ -195,6 +195,14 @@ Supervisor::Arming Supervisor::arming_step(double now, const StatusView& v, std:
     (void)check_bits(now, v);  // an e-stop or a fault latches here too
     return failed(why);
   }
+  // Since begin_arming the link may have been lost (the state is then disconnected, and the hold
+  // and the disable are re-asserted when the rig answers): nothing of the handshake may be written
+  // again, and a stale enabled bit arms nothing. (A review of stop 50's retry: a controller that
+  // loses write answers loses read answers too.)
+  if (state_ != RigState::arming) {
+    reason = "the link to the rig was lost while arming (" + std::string(to_string(state_)) + "): held and disabled";
+    return Arming::failed;
+  }
   if (!arming_written_) {
     std::error_code ec = rig_->set_mode(s_.mode);
     std::string what = "cannot write mode " + std::to_string(s_.mode);
@@ -215,6 +223,7 @@ Supervisor::Arming Supervisor::arming_step(double now, const StatusView& v, std:
     if (ec == drivers::RigError::timeout && now <= arming_deadline_) return ++arming_retries_, Arming::pending;
     if (ec) return failed(what + ": " + ec.message() + (arming_retries_ > 0 ? " (" + std::to_string(arming_retries_ + 1) + " attempts)" : std::string()));
     arming_written_ = true;
+    arming_deadline_ = deadline(now, s_.arm_timeout_s);  // "within X s of enable": from this write
     return Arming::pending;
   }
   if (v.status & st::enabled) {

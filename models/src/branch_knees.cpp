@@ -119,6 +119,8 @@ double line_ss(const Points& p) {
 
 std::optional<BranchKnees> fit_branch_knees(std::span<const double> x, std::span<const double> y) {
   if (x.size() < 10 || x.size() != y.size()) return std::nullopt;
+  for (std::size_t k = 0; k < x.size(); ++k)  // the moments sort by x: a NaN has no order
+    if (!std::isfinite(x[k]) || !std::isfinite(y[k])) return std::nullopt;
   const Points p = thin(x, y);
   const auto [mn, mx] = std::minmax_element(p.x.begin(), p.x.end());
   const double lo = *mn, hi = *mx;

@@ -430,8 +430,14 @@ try {
   const warnings = [];  // the page's own account of a failed update (shown if a check fails)
   page.on('console', m => { if (m.type() === 'error') errors.push(m.text()); else if (m.type() === 'warning') warnings.push(m.text()); });
   pageWarnings = warnings;
-  // Every 5xx the page received, by request, said in the log (the console message names no URL).
-  page.on('response', r => { if (r.status() >= 500) console.log(`     the page's ${r.request().method()} ${new URL(r.url()).pathname} was answered ${r.status()}`); });
+  // Every 5xx the page received, by request and with the API's error, said in the log (the
+  // console message names no URL).
+  page.on('response', r => {
+    if (r.status() < 500) return;
+    const what = `${r.request().method()} ${new URL(r.url()).pathname}`;
+    r.json().then(b => console.log(`     the page's ${what} was answered ${r.status()} (${b && b.error})`),
+      () => console.log(`     the page's ${what} was answered ${r.status()} (no JSON body)`));
+  });
   // A 4xx the page handles (a plan error, an endpoint an older daemon lacks) is logged by the
   // browser as a failed resource: not a script error. So is a 503, the API's answer while a rig
   // does not answer (docs/API.md: "rig unreachable"): this test freezes the frame's controller for

@@ -166,6 +166,18 @@ TEST_CASE("arming handshake: mode written, enabled required in time, a rig not r
     CHECK(h.rig.position() == doctest::Approx(0.0));
     CHECK_FALSE(h.saw(RigState::armed));
   }
+  SUBCASE("the link lost between two handshakes: nothing is written again, the rig is never enabled, the reason says so") {
+    Harness h;
+    h.rig.late_mode_answers = 30;                            // the first ~10 ticks' handshakes lose their answer ...
+    h.rig.plan.push_back({FaultEvent::drop, 0.01, 0.3, 0});  // ... then the link is gone for 0.29 s
+    const auto r = h.run(h.job(waveform({0, 1, 0})));
+    CHECK(r.end == CampaignEnd::failed);
+    CAPTURE(r.reason);
+    CHECK(r.reason.find("lost while arming") != std::string::npos);
+    CHECK(h.rig.log.enable_writes == 0);
+    CHECK_FALSE(h.rig.enabled());
+    CHECK_FALSE(h.saw(RigState::armed));
+  }
   SUBCASE("a rig with a latched fault is not armed") {
     Harness h;
     h.rig.plan.push_back({FaultEvent::latch_fault, 0.0, 0.0, 7});

@@ -24,7 +24,7 @@ struct BranchKnees {
   }
 };
 
-// The branch's samples in any order of displacement; at least 10, spanning a displacement range.
+// The branch's samples in any order of displacement; at least 10, finite, spanning a displacement range.
 // At most kMaxPoints samples are used (evenly taken). The knots are found by a grid search over the
 // branch's range refined three times (to 1/40,000 of the range). nullopt when the branch is too short.
 [[nodiscard]] std::optional<BranchKnees> fit_branch_knees(std::span<const double> displacement, std::span<const double> force);
