@@ -29,9 +29,18 @@ TEST_CASE("operator e-stop from the API latches the rig; a campaign is refused u
   REQUIRE(ld.wait_json("/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "idle"; }));
   auto r = c.Post("/api/rigs/sim%20frame/estop", "", "application/json");
   REQUIRE(r);
-  CHECK(r->status == 200);  // answered once latched and confirmed by the rig, never before
-  CHECK(json::parse(r->body)["latched"] == true);
-  CHECK(json::parse(r->body)["state"] == "estopped");
+  CAPTURE(r->body);
+  // 200 once latched and confirmed by the rig, never before; or, when the controller lost the
+  // write's answer (hystlab-sim misses its 50 ms on a loaded machine: stop 50's last clean clone),
+  // 503 "rig unreachable" as docs/API.md says, the latch held in the daemon all the same and the
+  // e-stop written again at the rig's next answer: the state below is the rig's either way.
+  if (r->status == 503) {
+    CHECK(json::parse(r->body)["error"] == "rig unreachable");
+  } else {
+    CHECK(r->status == 200);
+    CHECK(json::parse(r->body)["latched"] == true);
+    CHECK(json::parse(r->body)["state"] == "estopped");
+  }
   REQUIRE(ld.wait_json(
       "/api/rigs/sim%20frame", [](const json& j) { return j["state"] == "estopped" && j["latched"] == true; }, 10));
   const auto refused = c.Post("/api/campaigns", json{{"plan", waveform({0, 1})}}.dump(), "application/json");
