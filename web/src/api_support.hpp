@@ -45,6 +45,10 @@ json body_object(const httplib::Request& req, bool allow_empty = false);
 // The page's folder: the configured one; else the installed one beside the executable
 // (<bindir>/../share/hystlab/web/<sub>); else the source tree's.
 std::string default_dir(const std::string& configured, const std::string& installed_sub, const char* source_tree);
+// The source tree's page and plotting-library folders (web/src/source_roots.cpp, the one object
+// that names the clone's folder: a compiler cache serves every other in a clone elsewhere).
+const char* source_web_root() noexcept;
+const char* source_vendor_root() noexcept;
 // A page file's bytes; nullopt when it cannot be opened (the daemon's and the lab view's pages).
 std::optional<std::string> file_bytes(const std::string& path);
 

@@ -69,7 +69,7 @@ HttpApi::HttpApi(control::DaemonInterface& d, const control::HttpConfig& cfg, La
   add_h5_routes(s, m.ctx);
   add_report_routes(s, m.ctx);
   add_stream_route(s, m.ctx);
-  const std::string vendor = default_dir(cfg.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT), root = default_dir(cfg.web_root, "", HYSTLAB_WEB_ROOT);
+  const std::string vendor = default_dir(cfg.vendor_root, "vendor/uplot", source_vendor_root()), root = default_dir(cfg.web_root, "", source_web_root());
   if (!s.set_mount_point("/vendor/uplot", vendor))
     spdlog::warn("http: the plotting library is not at '{}' (run 'npm ci' in web/): the page cannot plot", vendor);
   if (std::error_code ec; std::filesystem::is_directory(root, ec))  // unreadable: warned, never thrown

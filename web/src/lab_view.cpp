@@ -202,7 +202,7 @@ LabView::LabView(const control::HttpConfig& http, const lab::LabConfig& lab, Liv
   });
   add_lab_routes(s, m);
   add_daemon_routes(s, m);
-  const std::string root = default_dir(http.web_root, "", HYSTLAB_WEB_ROOT), vendor = default_dir(http.vendor_root, "vendor/uplot", HYSTLAB_VENDOR_ROOT);
+  const std::string root = default_dir(http.web_root, "", source_web_root()), vendor = default_dir(http.vendor_root, "vendor/uplot", source_vendor_root());
   s.set_mount_point("/vendor/uplot", vendor);
   // The lab's page at "/"; the rig page's scripts and style beside it (a daemon's records are shown
   // on the rig's own page, /daemons/NAME/). Files by name, so that "/" stays the lab's page.
