@@ -6,7 +6,6 @@
 #include <netinet/in.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -29,28 +28,20 @@ extern char** environ;
 
 namespace hystlab::test_support {
 
-// Starts args[0] with args, its stdout and stderr into the file `log`. The child is ended
-// (SIGTERM: a daemon stops its own simulator) when the test that started it dies: a test that
-// crashed (an ASan report, a timeout's SIGKILL) left its two daemons, their simulators and their
-// work running for the rest of the session (stop 51: a lab test's sanitizer abort left them
-// taking a tenth of a core for half an hour, under the next run's timings). Call it from the
-// thread that owns the child: the signal follows the thread that forked, not the process.
+// Starts args[0] with args, its stdout and stderr into the file `log`.
 inline pid_t spawn_logged(const std::vector<std::string>& args, const std::string& log) {
-  if (args.empty() || access(args[0].c_str(), X_OK) != 0) throw std::runtime_error("cannot start " + (args.empty() ? std::string("nothing") : args[0]));
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
   std::vector<std::string> a = args;
   std::vector<char*> argv;
   for (auto& s : a) argv.push_back(s.data());
   argv.push_back(nullptr);
-  const pid_t parent = getpid();
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("cannot start " + args[0] + ": fork failed");
-  if (pid == 0) {  // only async-signal-safe calls until execve
-    if (prctl(PR_SET_PDEATHSIG, SIGTERM) != 0 || getppid() != parent) _exit(127);
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0 || dup2(fd, 1) < 0 || dup2(fd, 2) < 0) _exit(127);
-    execve(argv[0], argv.data(), environ);
-    _exit(127);
-  }
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) throw std::runtime_error("cannot start " + args.at(0));
   return pid;
 }
 
