@@ -71,11 +71,21 @@ int main(int argc, char** argv) {
   // 1 kHz (the CI runs the defaults: 10 times real time, about a minute).
   int exports = 20, subdivisions = 24;
   double time_scale = 10;  // rig seconds per wall second
-  for (int k = 1; k + 1 < argc; k += 2) {
+  for (int k = 1; k < argc; k += 2) {
     const std::string arg = argv[k];
-    if (arg == "--exports") exports = std::atoi(argv[k + 1]);
-    if (arg == "--time-scale") time_scale = std::atof(argv[k + 1]);
-    if (arg == "--subdivisions") subdivisions = std::atoi(argv[k + 1]);
+    const double value = k + 1 < argc ? std::atof(argv[k + 1]) : 0;
+    if (arg == "--exports" && value >= 1)
+      exports = static_cast<int>(value);
+    else if (arg == "--time-scale" && value > 0)
+      time_scale = value;
+    else if (arg == "--subdivisions" && value >= 2)
+      subdivisions = static_cast<int>(value);
+    else {
+      const bool known = arg == "--exports" || arg == "--time-scale" || arg == "--subdivisions";
+      std::printf("bench_readers: %s '%s' (options: --exports N >= 1, --time-scale S > 0, --subdivisions N >= 2)\n",
+                  known ? "no valid number after" : "unknown option", arg.c_str());
+      return 2;
+    }
   }
   try {
     const json config{{"rigs", {{{"name", "sim frame"}, {"simulate", {{"time_scale", time_scale}}}}}}};

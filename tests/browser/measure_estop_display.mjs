@@ -53,6 +53,7 @@ try {
 } finally {
   await browser.close();
   await stopDaemon(daemon.proc);
+  fs.rmSync(dir, { recursive: true, force: true });
 }
 const sorted = [...times].sort((a, b) => a - b);
 const q = p => sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];
